@@ -1,0 +1,54 @@
+// An opened OpenCL device: its context, its default in-order queue, its compiled programs and
+// its buffer pool. Everything that runs on a device goes through one of these.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "inertialnet/buffer_pool.hpp"
+#include "inertialnet/cl_handle.hpp"
+#include "inertialnet/device_info.hpp"
+#include "inertialnet/error.hpp"
+#include "inertialnet/program_cache.hpp"
+
+namespace inertialnet {
+
+class Queue;
+
+struct DeviceOptions {
+  DiskCacheMode program_cache = DiskCacheMode::Auto;  // $INERTIALNET_NO_CACHE forces Off
+  std::filesystem::path cache_directory;              // empty: default_cache_directory()
+  bool profiling = false;                             // profiling on the default queue
+};
+
+class Device {
+ public:
+  explicit Device(const DeviceInfo& info, DeviceOptions options = {});
+  ~Device();
+  Device(const Device&) = delete;
+  Device& operator=(const Device&) = delete;
+
+  const DeviceInfo& info() const noexcept { return info_; }
+  cl_device_id id() const noexcept { return info_.device_id; }
+  cl_context context() const noexcept { return context_.get(); }
+  // For error messages: this device, and optionally the kernel involved.
+  ClSite site(const std::string& kernel = {}) const { return ClSite{info_.name, kernel}; }
+
+  ProgramCache& programs() noexcept { return *programs_; }
+  BufferPool& buffers() noexcept { return *buffers_; }
+
+  // The default in-order queue. Use it from one thread at a time.
+  Queue& queue() noexcept { return *queue_; }
+  // Another in-order queue (one per host thread, or to overlap transfers with compute).
+  std::unique_ptr<Queue> create_queue(bool profiling = false);
+
+ private:
+  DeviceInfo info_;
+  ContextHandle context_;
+  std::unique_ptr<ProgramCache> programs_;
+  std::unique_ptr<BufferPool> buffers_;
+  std::unique_ptr<Queue> queue_;
+};
+
+}  // namespace inertialnet

@@ -1,0 +1,91 @@
+// Compiled OpenCL programs, once per (device, driver, source, options).
+//
+// Kernel sources are the files of kernels_cl/, embedded into the library at build time, one
+// "family" per file (correlation, warp, …). Parameters are passed as -D build options (as in
+// DLPrimitives), so one family compiles to several programs.
+//
+// Two cache levels: programs built in this process are kept in memory; compiled binaries are
+// kept on disk under $INERTIALNET_CACHE_DIR, else $XDG_CACHE_HOME/inertialnet, else
+// ~/.cache/inertialnet, keyed by platform, device, driver version, source hash and options, so
+// a second start skips compilation. Files are written to a temporary name and renamed (safe
+// with concurrent processes); a corrupt or foreign file is ignored and rebuilt.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "inertialnet/cl_handle.hpp"
+#include "inertialnet/device_info.hpp"
+
+namespace inertialnet {
+
+enum class DiskCacheMode {
+  Auto,  // per platform: off where the driver caches better itself (see program_cache.cpp)
+  On,
+  Off,
+};
+
+// Environment variable that turns the disk cache off when set to anything but "" or "0".
+inline constexpr const char* kNoCacheEnvironmentVariable = "INERTIALNET_NO_CACHE";
+// Environment variable that moves the cache directory.
+inline constexpr const char* kCacheDirEnvironmentVariable = "INERTIALNET_CACHE_DIR";
+
+// Where the disk cache lives when no directory is given explicitly.
+std::filesystem::path default_cache_directory();
+
+struct ProgramCacheStats {
+  std::size_t memory_hits = 0;    // served from this process's programs
+  std::size_t disk_hits = 0;      // loaded from a cached binary
+  std::size_t source_builds = 0;  // compiled from source
+  std::size_t disk_writes = 0;    // binaries stored
+  std::size_t disk_rejected = 0;  // cache files ignored as corrupt, foreign or unloadable
+};
+
+// The embedded kernel families ("elementwise", "correlation", …) and their sources.
+std::vector<std::string> embedded_kernel_families();
+std::string_view embedded_kernel_source(std::string_view family);  // invalid_input if unknown
+
+class ProgramCache {
+ public:
+  ProgramCache(const DeviceInfo& device, cl_context context, DiskCacheMode mode,
+               std::filesystem::path directory);
+  ProgramCache(const ProgramCache&) = delete;
+  ProgramCache& operator=(const ProgramCache&) = delete;
+
+  // The program of an embedded family built with `defines` (e.g. "-DTILE=16").
+  cl_program program(const std::string& family, const std::string& defines = {});
+  // Any source; `name` appears in error messages. A failed build throws with the build log.
+  cl_program program_from_source(const std::string& name, const std::string& source,
+                                 const std::string& defines = {});
+
+  // The options every build gets: -cl-std from the device's OpenCL C version, fp16 where
+  // cl_khr_fp16 is reported, then `defines`.
+  std::string build_options(const std::string& defines) const;
+
+  bool disk_cache_enabled() const { return disk_enabled_; }
+  const std::filesystem::path& directory() const { return directory_; }
+  ProgramCacheStats stats() const;
+
+ private:
+  std::string cache_key(const std::string& source, const std::string& options) const;
+  ProgramHandle load_binary(const std::filesystem::path& file, const std::string& key,
+                            const std::string& options);
+  void store_binary(cl_program program, const std::filesystem::path& file, const std::string& key);
+  ProgramHandle build(const std::string& name, const std::string& source, const std::string& options);
+
+  DeviceInfo device_;
+  cl_context context_;
+  bool disk_enabled_;
+  std::filesystem::path directory_;
+  mutable std::mutex mutex_;
+  std::map<std::string, ProgramHandle> programs_;  // by cache key
+  ProgramCacheStats stats_;
+};
+
+}  // namespace inertialnet

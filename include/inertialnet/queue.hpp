@@ -1,0 +1,124 @@
+// An in-order command queue and the kernels launched on it.
+//
+// Kernel objects carry argument state, so they are not shared between host threads: each Queue
+// keeps its own kernels, and a Queue is used by one thread at a time.
+//
+// Argument convention (every kernel in kernels_cl/ follows it): a tensor argument is passed as
+// two kernel arguments, the buffer and the element offset of the tensor's first element
+//   __global const float* restrict x, const int x_offset
+// so that views (channel slices of a concatenation, one sample of a batch) need no copies.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <type_traits>
+
+#include "inertialnet/cl_handle.hpp"
+#include "inertialnet/error.hpp"
+#include "inertialnet/tensor.hpp"
+
+namespace inertialnet {
+
+class Device;
+
+// Up to three work dimensions; unused trailing dimensions are 0.
+struct Range {
+  std::array<std::size_t, 3> size{0, 0, 0};
+  Range() = default;
+  Range(std::size_t x) : size{x, 0, 0} {}
+  Range(std::size_t x, std::size_t y) : size{x, y, 0} {}
+  Range(std::size_t x, std::size_t y, std::size_t z) : size{x, y, z} {}
+  unsigned dimensions() const { return size[2] ? 3u : size[1] ? 2u : size[0] ? 1u : 0u; }
+};
+
+// A completed-or-pending command; wait() blocks, the profiling times need a profiling queue.
+class Event {
+ public:
+  Event() = default;
+  explicit Event(EventHandle handle, std::string what = {}) : handle_(std::move(handle)), what_(std::move(what)) {}
+  cl_event handle() const noexcept { return handle_.get(); }
+  explicit operator bool() const noexcept { return static_cast<bool>(handle_); }
+  void wait() const;
+  // Nanoseconds between start and end of the command (profiling queues only).
+  std::uint64_t duration_ns() const;
+
+ private:
+  EventHandle handle_;
+  std::string what_;
+};
+
+class Kernel {
+ public:
+  Kernel(KernelHandle handle, std::string label, ClSite site)
+      : handle_(std::move(handle)), label_(std::move(label)), site_(std::move(site)) {}
+  cl_kernel handle() const noexcept { return handle_.get(); }
+  const std::string& label() const noexcept { return label_; }  // "family/kernel"
+  const ClSite& site() const noexcept { return site_; }
+
+  // Sets all arguments in order; a Tensor expands to (buffer, int offset).
+  template <class... Args>
+  Kernel& set_args(const Args&... args) {
+    cl_uint index = 0;
+    (set(index, args), ...);
+    return *this;
+  }
+
+ private:
+  template <class T>
+  void set(cl_uint& index, const T& value) {
+    if constexpr (std::is_same_v<T, Tensor>) {
+      const cl_mem buffer = value.buffer();
+      set_raw(index++, sizeof(cl_mem), &buffer);
+      const cl_int offset = value.offset_int();
+      set_raw(index++, sizeof(cl_int), &offset);
+    } else {
+      static_assert(std::is_trivially_copyable_v<T>, "kernel arguments are plain values");
+      set_raw(index++, sizeof(T), &value);
+    }
+  }
+  void set_raw(cl_uint index, std::size_t size, const void* value);
+
+  KernelHandle handle_;
+  std::string label_;
+  ClSite site_;
+};
+
+class Queue {
+ public:
+  Queue(Device& device, bool profiling);
+  ~Queue();
+  Queue(const Queue&) = delete;
+  Queue& operator=(const Queue&) = delete;
+
+  Device& device() const noexcept { return device_; }
+  cl_command_queue handle() const noexcept { return queue_.get(); }
+  bool profiling() const noexcept { return profiling_; }
+
+  // The kernel `name` of the embedded family `family` built with `defines`; created once per
+  // queue and reused.
+  Kernel& kernel(const std::string& family, const std::string& name, const std::string& defines = {});
+
+  // Enqueues `kernel` over `global` work-items. With `local` given, global is rounded up to a
+  // multiple of it (kernels guard their index against the true size). Returns the event when
+  // `want_event` is set (e.g. for profiling or a cross-queue dependency).
+  Event launch(Kernel& kernel, Range global, Range local = {}, bool want_event = false);
+
+  // Makes later commands of this queue wait for `event` (which may belong to another queue).
+  void wait_for(const Event& event);
+  // An event that completes when everything enqueued so far has completed.
+  Event marker();
+  void flush();
+  void finish();
+
+ private:
+  Device& device_;
+  bool profiling_;
+  QueueHandle queue_;
+  std::map<std::string, std::unique_ptr<Kernel>> kernels_;
+};
+
+}  // namespace inertialnet

@@ -1,0 +1,80 @@
+#include "inertialnet/ops/gemm.hpp"
+
+#include <clblast.h>
+
+#include "inertialnet/device.hpp"
+
+namespace inertialnet {
+
+namespace {
+
+clblast::Transpose to_clblast(Transpose t) { return t == Transpose::Yes ? clblast::Transpose::kYes : clblast::Transpose::kNo; }
+
+// Checks that a row-major `rows`×`cols` matrix stored with `view.leading_dimension`, repeated
+// `batch` times `stride` apart, lies inside its buffer.
+void check_operand(const char* name, const MatrixView& view, std::size_t rows, std::size_t cols, std::size_t stride,
+                   std::size_t batch) {
+  if (!view.buffer) throw invalid_input(std::string("GEMM operand ") + name + " has no buffer");
+  if (view.leading_dimension < cols) {
+    throw invalid_input(std::string("GEMM operand ") + name + ": leading dimension " +
+                        std::to_string(view.leading_dimension) + " is smaller than its " + std::to_string(cols) +
+                        " columns");
+  }
+  const std::size_t extent = (rows - 1) * view.leading_dimension + cols;
+  const std::size_t last = view.offset + (batch - 1) * stride + extent;
+  if (last > view.buffer_floats) {
+    throw invalid_input(std::string("GEMM operand ") + name + " (" + std::to_string(rows) + "×" + std::to_string(cols) +
+                        ", ld " + std::to_string(view.leading_dimension) + ", offset " + std::to_string(view.offset) +
+                        (batch > 1 ? ", " + std::to_string(batch) + " batches" : std::string()) + ") needs " +
+                        std::to_string(last) + " floats, its buffer holds " + std::to_string(view.buffer_floats));
+  }
+}
+
+void check_problem(Transpose ta, Transpose tb, std::size_t m, std::size_t n, std::size_t k, const MatrixView& a,
+                   std::size_t sa, const MatrixView& b, std::size_t sb, const MatrixView& c, std::size_t sc,
+                   std::size_t batch) {
+  if (m == 0 || n == 0 || k == 0 || batch == 0) {
+    throw invalid_input("GEMM with an empty dimension: m=" + std::to_string(m) + " n=" + std::to_string(n) +
+                        " k=" + std::to_string(k) + " batch=" + std::to_string(batch));
+  }
+  // As stored (row-major): A is m×k, or k×m when transposed; likewise B.
+  check_operand("A", a, ta == Transpose::No ? m : k, ta == Transpose::No ? k : m, sa, batch);
+  check_operand("B", b, tb == Transpose::No ? k : n, tb == Transpose::No ? n : k, sb, batch);
+  check_operand("C", c, m, n, sc, batch);
+}
+
+}  // namespace
+
+MatrixView MatrixView::of(const Tensor& tensor, std::size_t leading_dimension, std::size_t extra_offset) {
+  return MatrixView{tensor.buffer(), tensor.offset() + extra_offset, leading_dimension, tensor.buffer_floats()};
+}
+
+void gemm(Queue& queue, Transpose transpose_a, Transpose transpose_b, std::size_t m, std::size_t n, std::size_t k,
+          float alpha, const MatrixView& a, const MatrixView& b, float beta, const MatrixView& c) {
+  check_problem(transpose_a, transpose_b, m, n, k, a, 0, b, 0, c, 0, 1);
+  cl_command_queue handle = queue.handle();
+  const auto status = clblast::Gemm<float>(clblast::Layout::kRowMajor, to_clblast(transpose_a), to_clblast(transpose_b),
+                                           m, n, k, alpha, a.buffer, a.offset, a.leading_dimension, b.buffer, b.offset,
+                                           b.leading_dimension, beta, c.buffer, c.offset, c.leading_dimension, &handle,
+                                           nullptr);
+  check_clblast(static_cast<int>(status), "clblast::Gemm", queue.device().site("clblast/Xgemm"));
+}
+
+void gemm_strided_batched(Queue& queue, Transpose transpose_a, Transpose transpose_b, std::size_t m, std::size_t n,
+                          std::size_t k, float alpha, const MatrixView& a, std::size_t stride_a, const MatrixView& b,
+                          std::size_t stride_b, float beta, const MatrixView& c, std::size_t stride_c,
+                          std::size_t batch) {
+  check_problem(transpose_a, transpose_b, m, n, k, a, stride_a, b, stride_b, c, stride_c, batch);
+  if (batch == 1) {
+    gemm(queue, transpose_a, transpose_b, m, n, k, alpha, a, b, beta, c);
+    return;
+  }
+  cl_command_queue handle = queue.handle();
+  const auto status = clblast::GemmStridedBatched<float>(
+      clblast::Layout::kRowMajor, to_clblast(transpose_a), to_clblast(transpose_b), m, n, k, alpha, a.buffer, a.offset,
+      a.leading_dimension, stride_a, b.buffer, b.offset, b.leading_dimension, stride_b, beta, c.buffer, c.offset,
+      c.leading_dimension, stride_c, batch, &handle, nullptr);
+  check_clblast(static_cast<int>(status), "clblast::GemmStridedBatched", queue.device().site("clblast/XgemmStridedBatched"));
+}
+
+}  // namespace inertialnet

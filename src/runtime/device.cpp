@@ -1,0 +1,48 @@
+#include "inertialnet/device.hpp"
+
+#include <cstdlib>
+
+#include "inertialnet/queue.hpp"
+
+namespace inertialnet {
+
+namespace {
+
+void CL_CALLBACK report_context_error(const char* message, const void*, std::size_t, void*) {
+  // Drivers report asynchronous failures (e.g. a kernel fault) here; the failing call also
+  // returns an error, which is what the user sees. Keep the driver's words on stderr.
+  std::fprintf(stderr, "inertialnet: OpenCL driver: %s\n", message);
+}
+
+DiskCacheMode effective_cache_mode(DiskCacheMode requested) {
+  const char* no_cache = std::getenv(kNoCacheEnvironmentVariable);
+  if (no_cache && *no_cache && std::string(no_cache) != "0") return DiskCacheMode::Off;
+  return requested;
+}
+
+}  // namespace
+
+Device::Device(const DeviceInfo& info, DeviceOptions options) : info_(info) {
+  if (!info_.device_id) throw invalid_input("device '" + info_.name + "' has no OpenCL handle (not discovered)");
+  const cl_context_properties properties[] = {
+      CL_CONTEXT_PLATFORM, reinterpret_cast<cl_context_properties>(info_.platform_id), 0};
+  cl_int status = CL_SUCCESS;
+  context_ = ContextHandle(clCreateContext(properties, 1, &info_.device_id, report_context_error, nullptr, &status));
+  check_cl(status, "clCreateContext", site());
+
+  std::filesystem::path directory =
+      options.cache_directory.empty() ? default_cache_directory() : options.cache_directory;
+  programs_ = std::make_unique<ProgramCache>(info_, context_.get(), effective_cache_mode(options.program_cache),
+                                             std::move(directory));
+  buffers_ = std::make_unique<BufferPool>(context_.get(), info_.name, info_.max_alloc_bytes);
+  queue_ = std::make_unique<Queue>(*this, options.profiling);
+}
+
+Device::~Device() {
+  // Drain outstanding work before the context goes: buffers may still be in use by kernels.
+  if (queue_) clFinish(queue_->handle());
+}
+
+std::unique_ptr<Queue> Device::create_queue(bool profiling) { return std::make_unique<Queue>(*this, profiling); }
+
+}  // namespace inertialnet

@@ -1,0 +1,239 @@
+#include "inertialnet/program_cache.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "inertialnet/error.hpp"
+#include "runtime/embedded_kernels.hpp"
+#include "runtime/hash.hpp"
+
+namespace inertialnet {
+
+namespace {
+
+// Cache file layout: magic, key length (u32), key, binary length (u64), binary,
+// fnv1a64(binary) (u64). The key is stored in full so that a hash collision or a file from
+// another device/driver reads as foreign, and the checksum catches truncation and corruption.
+constexpr char kMagic[8] = {'I', 'N', 'C', 'L', 'P', 'R', 'G', '1'};
+
+std::string hex64(std::uint64_t value) {
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(value));
+  return text;
+}
+
+bool env_set(const char* name) {
+  const char* value = std::getenv(name);
+  return value && *value;
+}
+
+std::uint64_t hash_bytes(const unsigned char* data, std::size_t size) {
+  return detail::fnv1a64(std::string_view(reinterpret_cast<const char*>(data), size));
+}
+
+std::string build_log(cl_program program, cl_device_id device) {
+  std::size_t size = 0;
+  if (clGetProgramBuildInfo(program, device, CL_PROGRAM_BUILD_LOG, 0, nullptr, &size) != CL_SUCCESS) return {};
+  std::string log(size, '\0');
+  if (clGetProgramBuildInfo(program, device, CL_PROGRAM_BUILD_LOG, size, log.data(), nullptr) != CL_SUCCESS) return {};
+  while (!log.empty() && (log.back() == '\0' || log.back() == '\n' || log.back() == ' ')) log.pop_back();
+  return log;
+}
+
+bool decide_disk_cache(DiskCacheMode mode, const DeviceInfo& device) {
+  switch (mode) {
+    case DiskCacheMode::On: return true;
+    case DiskCacheMode::Off: return false;
+    case DiskCacheMode::Auto: break;
+  }
+  // PoCL keeps its own kernel cache ($POCL_CACHE_DIR) keyed by source and options, and our
+  // binary round trip through CL_PROGRAM_BINARIES measured slower than letting PoCL find its
+  // own entry (see the measurements in README.md, "Program cache"). Every other platform gets
+  // our cache.
+  return !device.is_pocl();
+}
+
+}  // namespace
+
+std::filesystem::path default_cache_directory() {
+  if (env_set(kCacheDirEnvironmentVariable)) return std::getenv(kCacheDirEnvironmentVariable);
+  if (env_set("XDG_CACHE_HOME")) return std::filesystem::path(std::getenv("XDG_CACHE_HOME")) / "inertialnet";
+  if (env_set("HOME")) return std::filesystem::path(std::getenv("HOME")) / ".cache" / "inertialnet";
+  return std::filesystem::temp_directory_path() / "inertialnet-cache";
+}
+
+std::vector<std::string> embedded_kernel_families() {
+  std::vector<std::string> families;
+  for (const auto& source : detail::embedded_kernel_sources()) families.emplace_back(source.family);
+  return families;
+}
+
+std::string_view embedded_kernel_source(std::string_view family) {
+  for (const auto& source : detail::embedded_kernel_sources()) {
+    if (source.family == family) return source.source;
+  }
+  throw invalid_input("no embedded kernel family '" + std::string(family) + "'");
+}
+
+ProgramCache::ProgramCache(const DeviceInfo& device, cl_context context, DiskCacheMode mode,
+                           std::filesystem::path directory)
+    : device_(device), context_(context), disk_enabled_(decide_disk_cache(mode, device)),
+      directory_(std::move(directory)) {}
+
+std::string ProgramCache::build_options(const std::string& defines) const {
+  std::string options = "-cl-std=CL" + std::to_string(device_.opencl_c_major) + "." +
+                        std::to_string(device_.opencl_c_minor);
+  if (device_.fp16) options += " -DINERTIALNET_FP16=1";
+  if (!defines.empty()) options += " " + defines;
+  return options;
+}
+
+std::string ProgramCache::cache_key(const std::string& source, const std::string& options) const {
+  std::ostringstream key;
+  key << "platform=" << device_.platform_name << " " << device_.platform_version << "\n"
+      << "device=" << device_.name << "\n"
+      << "driver=" << device_.driver_version << "\n"
+      << "source=" << hex64(detail::fnv1a64(source)) << " " << source.size() << "\n"
+      << "options=" << options << "\n";
+  return key.str();
+}
+
+cl_program ProgramCache::program(const std::string& family, const std::string& defines) {
+  const std::string_view source = embedded_kernel_source(family);
+  return program_from_source(family, std::string(source), defines);
+}
+
+cl_program ProgramCache::program_from_source(const std::string& name, const std::string& source,
+                                             const std::string& defines) {
+  const std::string options = build_options(defines);
+  const std::string key = cache_key(source, options);
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (auto found = programs_.find(key); found != programs_.end()) {
+    ++stats_.memory_hits;
+    return found->second.get();
+  }
+  const std::filesystem::path file = directory_ / (hex64(detail::fnv1a64(key)) + ".clbin");
+  ProgramHandle program;
+  if (disk_enabled_) program = load_binary(file, key, options);
+  if (program) {
+    ++stats_.disk_hits;
+  } else {
+    program = build(name, source, options);
+    ++stats_.source_builds;
+    if (disk_enabled_) store_binary(program.get(), file, key);
+  }
+  return programs_.emplace(key, std::move(program)).first->second.get();
+}
+
+ProgramHandle ProgramCache::build(const std::string& name, const std::string& source, const std::string& options) {
+  const char* text = source.c_str();
+  const std::size_t length = source.size();
+  cl_int status = CL_SUCCESS;
+  ProgramHandle program(clCreateProgramWithSource(context_, 1, &text, &length, &status));
+  check_cl(status, "clCreateProgramWithSource", ClSite{device_.name, name});
+  status = clBuildProgram(program.get(), 1, &device_.device_id, options.c_str(), nullptr, nullptr);
+  if (status != CL_SUCCESS) {
+    const std::string log = build_log(program.get(), device_.device_id);
+    throw runtime_error("OpenCL call clBuildProgram failed with " + cl_error_name(status) + " (" +
+                        std::to_string(status) + ") on device '" + device_.name + "' for kernel family '" +
+                        name + "' with options '" + options + "'. Build log:\n" +
+                        (log.empty() ? std::string("(the driver gave no log)") : log));
+  }
+  return program;
+}
+
+ProgramHandle ProgramCache::load_binary(const std::filesystem::path& file, const std::string& key,
+                                        const std::string& options) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) return {};  // not cached yet
+  auto reject = [&]() {
+    ++stats_.disk_rejected;
+    return ProgramHandle();
+  };
+  char magic[sizeof kMagic];
+  std::uint32_t key_length = 0;
+  if (!in.read(magic, sizeof magic) || std::memcmp(magic, kMagic, sizeof kMagic) != 0) return reject();
+  if (!in.read(reinterpret_cast<char*>(&key_length), sizeof key_length) || key_length != key.size()) return reject();
+  std::string stored_key(key_length, '\0');
+  if (!in.read(stored_key.data(), key_length) || stored_key != key) return reject();
+  std::uint64_t binary_length = 0;
+  if (!in.read(reinterpret_cast<char*>(&binary_length), sizeof binary_length) || binary_length == 0 ||
+      binary_length > (1ull << 30)) {
+    return reject();
+  }
+  std::vector<unsigned char> binary(binary_length);
+  std::uint64_t checksum = 0;
+  if (!in.read(reinterpret_cast<char*>(binary.data()), static_cast<std::streamsize>(binary_length)) ||
+      !in.read(reinterpret_cast<char*>(&checksum), sizeof checksum) ||
+      checksum != hash_bytes(binary.data(), binary.size())) {
+    return reject();
+  }
+  const unsigned char* data = binary.data();
+  const std::size_t size = binary.size();
+  cl_int binary_status = CL_SUCCESS;
+  cl_int status = CL_SUCCESS;
+  ProgramHandle program(clCreateProgramWithBinary(context_, 1, &device_.device_id, &size, &data, &binary_status, &status));
+  if (status != CL_SUCCESS || binary_status != CL_SUCCESS) return reject();
+  // A binary still needs clBuildProgram; a driver that refuses it (an update changed the format
+  // without changing its version string) makes us fall back to the source.
+  if (clBuildProgram(program.get(), 1, &device_.device_id, options.c_str(), nullptr, nullptr) != CL_SUCCESS) {
+    return reject();
+  }
+  return program;
+}
+
+void ProgramCache::store_binary(cl_program program, const std::filesystem::path& file, const std::string& key) {
+  std::size_t size = 0;
+  if (clGetProgramInfo(program, CL_PROGRAM_BINARY_SIZES, sizeof size, &size, nullptr) != CL_SUCCESS || size == 0) {
+    return;  // this driver does not hand out binaries: nothing to cache
+  }
+  std::vector<unsigned char> binary(size);
+  unsigned char* data = binary.data();
+  if (clGetProgramInfo(program, CL_PROGRAM_BINARIES, sizeof data, &data, nullptr) != CL_SUCCESS) return;
+
+  // The cache is an optimisation: failing to write it must never fail the caller.
+  std::error_code error;
+  std::filesystem::create_directories(directory_, error);
+  if (error) return;
+  static std::atomic<unsigned> counter{0};
+  const std::filesystem::path temporary =
+      file.string() + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++);
+  {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    const std::uint32_t key_length = static_cast<std::uint32_t>(key.size());
+    const std::uint64_t binary_length = binary.size();
+    const std::uint64_t checksum = hash_bytes(binary.data(), binary.size());
+    out.write(kMagic, sizeof kMagic);
+    out.write(reinterpret_cast<const char*>(&key_length), sizeof key_length);
+    out.write(key.data(), static_cast<std::streamsize>(key.size()));
+    out.write(reinterpret_cast<const char*>(&binary_length), sizeof binary_length);
+    out.write(reinterpret_cast<const char*>(binary.data()), static_cast<std::streamsize>(binary.size()));
+    out.write(reinterpret_cast<const char*>(&checksum), sizeof checksum);
+    if (!out.flush()) {
+      out.close();
+      std::filesystem::remove(temporary, error);
+      return;
+    }
+  }
+  // rename() is atomic within a file system: readers see the old file or the whole new one.
+  std::filesystem::rename(temporary, file, error);
+  if (error) {
+    std::filesystem::remove(temporary, error);
+    return;
+  }
+  ++stats_.disk_writes;
+}
+
+ProgramCacheStats ProgramCache::stats() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return stats_;
+}
+
+}  // namespace inertialnet

@@ -1,0 +1,101 @@
+#include "inertialnet/queue.hpp"
+
+#include "inertialnet/device.hpp"
+
+namespace inertialnet {
+
+void Event::wait() const {
+  if (!handle_) return;
+  const cl_event event = handle_.get();
+  check_cl(clWaitForEvents(1, &event), "clWaitForEvents", ClSite{{}, what_});
+}
+
+std::uint64_t Event::duration_ns() const {
+  if (!handle_) return 0;
+  wait();
+  cl_ulong start = 0, end = 0;
+  check_cl(clGetEventProfilingInfo(handle_.get(), CL_PROFILING_COMMAND_START, sizeof start, &start, nullptr),
+           "clGetEventProfilingInfo(CL_PROFILING_COMMAND_START)", ClSite{{}, what_});
+  check_cl(clGetEventProfilingInfo(handle_.get(), CL_PROFILING_COMMAND_END, sizeof end, &end, nullptr),
+           "clGetEventProfilingInfo(CL_PROFILING_COMMAND_END)", ClSite{{}, what_});
+  return end > start ? end - start : 0;
+}
+
+void Kernel::set_raw(cl_uint index, std::size_t size, const void* value) {
+  const cl_int status = clSetKernelArg(handle_.get(), index, size, value);
+  if (status != CL_SUCCESS) {
+    check_cl(status, ("clSetKernelArg(" + std::to_string(index) + ")").c_str(), site_);
+  }
+}
+
+Queue::Queue(Device& device, bool profiling) : device_(device), profiling_(profiling) {
+  cl_int status = CL_SUCCESS;
+  const cl_command_queue_properties properties = profiling ? CL_QUEUE_PROFILING_ENABLE : 0;
+  queue_ = QueueHandle(clCreateCommandQueue(device.context(), device.id(), properties, &status));
+  check_cl(status, "clCreateCommandQueue", device.site());
+}
+
+Queue::~Queue() {
+  if (queue_) clFinish(queue_.get());
+}
+
+Kernel& Queue::kernel(const std::string& family, const std::string& name, const std::string& defines) {
+  const std::string key = family + '\n' + name + '\n' + defines;
+  auto found = kernels_.find(key);
+  if (found != kernels_.end()) return *found->second;
+
+  const cl_program program = device_.programs().program(family, defines);
+  const std::string label = family + "/" + name;
+  cl_int status = CL_SUCCESS;
+  KernelHandle handle(clCreateKernel(program, name.c_str(), &status));
+  check_cl(status, "clCreateKernel", device_.site(label));
+  auto kernel = std::make_unique<Kernel>(std::move(handle), label, device_.site(label));
+  return *kernels_.emplace(key, std::move(kernel)).first->second;
+}
+
+Event Queue::launch(Kernel& kernel, Range global, Range local, bool want_event) {
+  const unsigned dims = global.dimensions();
+  if (dims == 0) throw invalid_input("kernel " + kernel.label() + " launched over an empty range");
+  const bool with_local = local.dimensions() != 0;
+  if (with_local && local.dimensions() != dims) {
+    throw invalid_input("kernel " + kernel.label() + ": local range has " + std::to_string(local.dimensions()) +
+                        " dimensions, global " + std::to_string(dims));
+  }
+  std::size_t global_size[3] = {1, 1, 1};
+  std::size_t local_size[3] = {1, 1, 1};
+  for (unsigned d = 0; d < dims; ++d) {
+    global_size[d] = global.size[d];
+    if (with_local) {
+      local_size[d] = local.size[d];
+      global_size[d] = (global_size[d] + local_size[d] - 1) / local_size[d] * local_size[d];
+    }
+  }
+  EventHandle event;
+  check_cl(clEnqueueNDRangeKernel(queue_.get(), kernel.handle(), dims, nullptr, global_size,
+                                  with_local ? local_size : nullptr, 0, nullptr,
+                                  want_event ? event.reset_and_get_address() : nullptr),
+           "clEnqueueNDRangeKernel", kernel.site());
+  return want_event ? Event(std::move(event), kernel.label()) : Event();
+}
+
+void Queue::wait_for(const Event& event) {
+  if (!event) return;
+  const cl_event handle = event.handle();
+  // A marker with a wait list makes every later command of an in-order queue wait for it.
+  EventHandle marker;
+  check_cl(clEnqueueMarkerWithWaitList(queue_.get(), 1, &handle, marker.reset_and_get_address()),
+           "clEnqueueMarkerWithWaitList", device_.site());
+}
+
+Event Queue::marker() {
+  EventHandle event;
+  check_cl(clEnqueueMarkerWithWaitList(queue_.get(), 0, nullptr, event.reset_and_get_address()),
+           "clEnqueueMarkerWithWaitList", device_.site());
+  return Event(std::move(event), "marker");
+}
+
+void Queue::flush() { check_cl(clFlush(queue_.get()), "clFlush", device_.site()); }
+
+void Queue::finish() { check_cl(clFinish(queue_.get()), "clFinish", device_.site()); }
+
+}  // namespace inertialnet

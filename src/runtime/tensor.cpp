@@ -1,0 +1,160 @@
+#include "inertialnet/tensor.hpp"
+
+#include <limits>
+#include <sstream>
+
+#include "inertialnet/device.hpp"
+#include "inertialnet/queue.hpp"
+
+namespace inertialnet {
+
+std::string to_string(const Shape& shape) {
+  std::ostringstream out;
+  out << '[';
+  for (std::size_t i = 0; i < shape.size(); ++i) out << (i ? ", " : "") << shape[i];
+  out << ']';
+  return out.str();
+}
+
+std::int64_t element_count(const Shape& shape) {
+  std::int64_t count = 1;
+  for (const auto d : shape) count *= d;
+  return shape.empty() ? 0 : count;
+}
+
+Tensor Tensor::empty(Device& device, const Shape& shape) {
+  if (shape.empty()) throw invalid_input("a tensor needs at least one dimension");
+  for (const auto d : shape) {
+    if (d <= 0) throw invalid_input("tensor shape " + to_string(shape) + " has a zero or negative size");
+  }
+  const auto count = element_count(shape);
+  if (count > std::numeric_limits<int>::max()) {
+    throw invalid_input("tensor shape " + to_string(shape) + " has more than 2^31 elements");
+  }
+  Tensor tensor;
+  tensor.shape_ = shape;
+  tensor.buffer_ = device.buffers().acquire(static_cast<std::size_t>(count) * sizeof(float));
+  tensor.batch_stride_ = tensor.sample_size();
+  return tensor;
+}
+
+Tensor Tensor::from_host(Queue& queue, const Shape& shape, const std::vector<float>& data) {
+  Tensor tensor = empty(queue.device(), shape);
+  tensor.upload(queue, data.data(), data.size());
+  return tensor;
+}
+
+std::int64_t Tensor::dim(int axis) const {
+  const int r = rank();
+  const int a = axis < 0 ? axis + r : axis;
+  if (a < 0 || a >= r) {
+    throw invalid_input("axis " + std::to_string(axis) + " is out of range for shape " + to_string(shape_));
+  }
+  return shape_[static_cast<std::size_t>(a)];
+}
+
+std::int64_t Tensor::dim4(int axis) const {
+  if (rank() != 4) throw invalid_input("expected an NCHW tensor, got shape " + to_string(shape_));
+  return shape_[static_cast<std::size_t>(axis)];
+}
+
+int Tensor::offset_int() const {
+  // Kernels index with 32-bit integers (fast on every device), so the last element a kernel
+  // may touch, offset + (N-1)·batch_stride + sample_size - 1, must fit one.
+  const std::size_t last = offset_ + (static_cast<std::size_t>(dim(0)) - 1) * batch_stride_ + sample_size();
+  if (last > static_cast<std::size_t>(std::numeric_limits<int>::max())) {
+    throw invalid_input("tensor of shape " + to_string(shape_) + " at offset " + std::to_string(offset_) +
+                        " does not fit 32-bit kernel indexing");
+  }
+  return static_cast<int>(offset_);
+}
+
+std::size_t Tensor::sample_size() const {
+  if (shape_.empty()) return 0;
+  return static_cast<std::size_t>(numel() / shape_[0]);
+}
+
+Tensor Tensor::channels(std::int64_t first, std::int64_t count) const {
+  if (rank() < 2) throw invalid_input("channel slice of a tensor of shape " + to_string(shape_));
+  if (first < 0 || count <= 0 || first + count > shape_[1]) {
+    throw invalid_input("channels [" + std::to_string(first) + ", " + std::to_string(first + count) +
+                        ") are outside a tensor of shape " + to_string(shape_));
+  }
+  std::size_t inner = 1;
+  for (std::size_t i = 2; i < shape_.size(); ++i) inner *= static_cast<std::size_t>(shape_[i]);
+  Tensor view = *this;
+  view.shape_[1] = count;
+  view.offset_ = offset_ + static_cast<std::size_t>(first) * inner;
+  return view;
+}
+
+Tensor Tensor::sample(std::int64_t index) const {
+  if (index < 0 || index >= dim(0)) {
+    throw invalid_input("sample " + std::to_string(index) + " is outside a batch of " + std::to_string(dim(0)));
+  }
+  Tensor view = *this;
+  view.shape_[0] = 1;
+  view.offset_ = offset_ + static_cast<std::size_t>(index) * batch_stride_;
+  view.batch_stride_ = view.sample_size();
+  return view;
+}
+
+Tensor Tensor::reshaped(const Shape& shape) const {
+  if (element_count(shape) != numel()) {
+    throw invalid_input("cannot reshape " + to_string(shape_) + " to " + to_string(shape) + ": element counts differ");
+  }
+  if (!contiguous()) throw invalid_input("cannot reshape the non-contiguous view " + to_string(shape_));
+  Tensor view = *this;
+  view.shape_ = shape;
+  view.batch_stride_ = view.sample_size();
+  return view;
+}
+
+void Tensor::upload(Queue& queue, const float* data, std::size_t count) {
+  if (count != static_cast<std::size_t>(numel())) {
+    throw invalid_input("uploading " + std::to_string(count) + " values into a tensor of shape " + to_string(shape_));
+  }
+  const std::size_t batch = static_cast<std::size_t>(dim(0));
+  const std::size_t sample = sample_size();
+  const ClSite site = queue.device().site();
+  if (contiguous()) {
+    check_cl(clEnqueueWriteBuffer(queue.handle(), buffer(), CL_TRUE, offset_ * sizeof(float), count * sizeof(float),
+                                  data, 0, nullptr, nullptr),
+             "clEnqueueWriteBuffer", site);
+    return;
+  }
+  for (std::size_t b = 0; b < batch; ++b) {
+    check_cl(clEnqueueWriteBuffer(queue.handle(), buffer(), CL_TRUE, (offset_ + b * batch_stride_) * sizeof(float),
+                                  sample * sizeof(float), data + b * sample, 0, nullptr, nullptr),
+             "clEnqueueWriteBuffer", site);
+  }
+}
+
+void Tensor::download(Queue& queue, float* data, std::size_t count) const {
+  if (count != static_cast<std::size_t>(numel())) {
+    throw invalid_input("downloading a tensor of shape " + to_string(shape_) + " into " + std::to_string(count) +
+                        " values");
+  }
+  const std::size_t batch = static_cast<std::size_t>(dim(0));
+  const std::size_t sample = sample_size();
+  const ClSite site = queue.device().site();
+  if (contiguous()) {
+    check_cl(clEnqueueReadBuffer(queue.handle(), buffer(), CL_TRUE, offset_ * sizeof(float), count * sizeof(float),
+                                 data, 0, nullptr, nullptr),
+             "clEnqueueReadBuffer", site);
+    return;
+  }
+  for (std::size_t b = 0; b < batch; ++b) {
+    check_cl(clEnqueueReadBuffer(queue.handle(), buffer(), CL_TRUE, (offset_ + b * batch_stride_) * sizeof(float),
+                                 sample * sizeof(float), data + b * sample, 0, nullptr, nullptr),
+             "clEnqueueReadBuffer", site);
+  }
+}
+
+std::vector<float> Tensor::to_host(Queue& queue) const {
+  std::vector<float> data(static_cast<std::size_t>(numel()));
+  download(queue, data.data(), data.size());
+  return data;
+}
+
+}  // namespace inertialnet
