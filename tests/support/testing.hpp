@@ -1,0 +1,38 @@
+// Helpers shared by the test suites: the device under test, random data and comparisons.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "inertialnet/inertialnet.hpp"
+
+namespace inertialnet::testing {
+
+// The device the suites run on: $INERTIALNET_TEST_DEVICE, else $INERTIALNET_DEVICE, else the
+// default (first GPU, else first CPU), so the same suite runs on PoCL in CI and on a GPU.
+// Opened once per process.
+Device& test_device();
+Queue& test_queue();
+
+// Uniform values in [lo, hi) from a fixed seed.
+std::vector<float> random_vector(std::size_t count, std::uint32_t seed, float lo = -1.0f, float hi = 1.0f);
+
+// Largest |a-b| / (|b| + floor) over the elements, and a gtest assertion on it that reports
+// the worst index. `floor` keeps near-zero references from inflating the relative error.
+struct Difference {
+  double max_abs = 0;
+  double max_rel = 0;
+  std::size_t worst_index = 0;
+};
+Difference compare(const std::vector<float>& actual, const std::vector<float>& expected, double floor = 1e-3);
+::testing::AssertionResult all_close(const std::vector<float>& actual, const std::vector<float>& expected,
+                                     double relative_tolerance, double floor = 1e-3);
+
+// A fresh, empty directory under the system temp dir, removed at process exit.
+std::string temporary_directory(const std::string& stem);
+
+}  // namespace inertialnet::testing
