@@ -1,0 +1,59 @@
+// inertialnet — angular rates from image sequences with FlowNet2 + InertialNet on OpenCL.
+// Exit codes: 0 success, 1 runtime failure, 2 bad usage or bad input.
+#include <cstdlib>
+#include <iostream>
+#include <map>
+
+#include "commands.hpp"
+#include "inertialnet/error.hpp"
+#include "inertialnet/program_cache.hpp"
+
+int main(int argc, char** argv) {
+  using namespace inertialnet;
+  CLI::App app{"inertialnet: camera angular velocity from image sequences (FlowNet2 + InertialNet on OpenCL)",
+               "inertialnet"};
+  app.require_subcommand(1);
+  app.fallthrough();  // global options may follow the subcommand: `inertialnet devices --device 1`
+  cli::GlobalOptions global;
+  app.add_option("-d,--device", global.device,
+                 "device: N, P:D, cpu, gpu, accelerator, a name substring, or all (env INERTIALNET_DEVICE)");
+  app.add_flag("--no-cache", global.no_cache, "do not read or write the on-disk program cache");
+  app.set_version_flag("--version", "inertialnet 0.1.0");
+  app.footer("Exit codes: 0 ok, 1 runtime failure, 2 bad usage or bad input.");
+
+  std::map<CLI::App*, cli::Command> commands;
+  {
+    CLI::App* sub = app.add_subcommand("devices", "list the OpenCL platforms and devices");
+    commands[sub] = cli::register_devices(*sub, global);
+  }
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return 2;
+  }
+
+  if (global.no_cache) ::setenv(kNoCacheEnvironmentVariable, "1", 1);
+  try {
+    for (auto& [sub, run] : commands) {
+      if (sub->parsed()) return run();
+    }
+    return 2;
+  } catch (const Error& e) {
+    std::cerr << "inertialnet: error: " << e.what() << "\n";
+    return e.exit_code();
+  } catch (const std::bad_alloc&) {
+    std::cerr << "inertialnet: error: out of host memory\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "inertialnet: error: " << e.what() << "\n";
+    return 1;
+  }
+}
