@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# Installs the Debian packages that building, testing and running InertialNet-CL need
+# (OpenCL headers and ICD loader, PoCL for the CPU, CLBlast, OpenCV, Eigen, GoogleTest,
+# Google Benchmark, CLI11, nlohmann-json, CMake and a C++17 compiler).
+# Does nothing when everything is present. Works as root (no sudo needed) or through sudo.
+set -euo pipefail
+
+packages=(
+  build-essential cmake pkg-config
+  opencl-headers ocl-icd-opencl-dev pocl-opencl-icd clinfo
+  libclblast-dev
+  libopencv-dev libeigen3-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+  libcli11-dev nlohmann-json3-dev
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  status=$(dpkg-query -W -f='${db:Status-Status}' "$p" 2>/dev/null || true)
+  [ "$status" = "installed" ] || missing+=("$p")
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "setup: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+if [ "$(id -u)" -eq 0 ]; then
+  as_root=()
+elif command -v sudo >/dev/null 2>&1; then
+  as_root=(sudo)
+else
+  echo "setup: missing packages (${missing[*]}) and neither root nor sudo to install them" >&2
+  exit 1
+fi
+
+echo "setup: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+"${as_root[@]}" apt-get update -qq
+"${as_root[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
