@@ -1,0 +1,74 @@
+// `inertialnet eval`: predicted angular rates (a rates CSV) against a EuRoC sequence's gyroscope.
+//
+// Each rates row is matched to the camera frame with the same timestamp (rows are stamped with
+// the pair's second frame t_k) and compared with the gyro synchronised onto that frame
+// (imu_sync.hpp). Metrics are reported against the raw gyro and, when a bias is known, against
+// gyro − bias; the RMS(t) series, histograms and plots use gyro − bias when there is one.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "inertialnet/euroc.hpp"
+#include "inertialnet/imu_sync.hpp"
+#include "inertialnet/metrics.hpp"
+#include "inertialnet/plots.hpp"
+#include "inertialnet/rates_csv.hpp"
+
+namespace inertialnet {
+
+struct EvalOptions {
+  SyncOptions sync;
+  std::string head_suffix;           // "" compares wx,wy,wz; "_geometric" compares wx_geometric,…
+  HistogramOptions histogram;
+  // When set: the rate plot is written here and the histogram plot beside it, with "_hist"
+  // added to the stem (out.png → out_hist.png).
+  std::filesystem::path plot;
+  PlotStyle style;
+};
+
+struct EvalReport {
+  std::string sequence;
+  std::string rates_file;
+  std::string head;                  // "wx,wy,wz" or "wx_geometric,wy_geometric,wz_geometric"
+  std::size_t rate_rows = 0;
+  std::size_t frames_in_sequence = 0;
+  std::size_t imu_samples = 0;       // in the whole sequence
+  std::size_t imu_samples_in_span = 0;
+  std::size_t rows_not_frames = 0;   // rows whose timestamp is no camera timestamp of the sequence
+  std::size_t rows_without_truth = 0;  // rows on frames the IMU does not cover (or frame 0 for mean)
+
+  SyncTarget target = SyncTarget::Spline;
+  bool camera_frame = false;
+  BiasSource bias_source = BiasSource::None;
+  Vec3 bias_imu_frame{};             // rad/s
+
+  // Matched frames, in time order.
+  std::vector<std::int64_t> t_ns;
+  std::vector<Vec3> predicted, truth_raw, truth_corrected;  // rad/s; corrected = raw without a bias
+  ErrorStats raw;                            // against the raw gyro
+  std::optional<ErrorStats> corrected;       // against gyro − bias, when a bias is known
+  std::vector<double> rms_t;                 // Eq. 1 (deg/s), against the corrected truth
+  std::array<Histogram, 3> histograms;       // errors (deg/s), against the corrected truth
+
+  std::vector<std::string> plots;            // files written
+  std::vector<std::string> notes;            // how the truth was made
+  std::vector<std::string> warnings;         // reader and matching problems
+
+  std::size_t frames_evaluated() const { return t_ns.size(); }
+  std::string table() const;                 // human-readable report, Table 1 layout
+  std::string json(bool include_series = false) const;  // pretty JSON (series: per-frame values)
+};
+
+// Throws invalid_input when no rates row matches a frame with ground truth.
+EvalReport evaluate(const RatesTable& rates, const EurocSequence& sequence, const EvalOptions& options = {});
+// Reads both; the images themselves are not needed and not checked.
+EvalReport evaluate(const std::filesystem::path& rates_csv, const std::filesystem::path& sequence,
+                    const EvalOptions& options = {});
+
+}  // namespace inertialnet

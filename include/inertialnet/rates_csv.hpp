@@ -1,0 +1,41 @@
+// The angular-rates CSV that `predict` writes and `eval` reads:
+//
+//   timestamp_ns,wx,wy,wz[,extra,…]
+//   1403715273312143104,0.0123,-0.0456,0.0789
+//
+// One row per frame pair, stamped with the pair's second frame t_k; rates in rad/s. Further
+// named columns may follow (a second head: wx_geometric,wy_geometric,wz_geometric). Values are
+// written with %.9g, enough to round-trip a float exactly. Reading trims whitespace, skips blank
+// lines and '#' comments before the header, and rejects malformed rows, non-finite values and
+// timestamps that do not strictly increase, naming the file and line.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "inertialnet/vec3.hpp"
+
+namespace inertialnet {
+
+struct RatesTable {
+  std::vector<std::int64_t> t_ns;
+  std::vector<Vec3> w;                             // wx, wy, wz (rad/s)
+  std::vector<std::string> extra_names;            // further columns, in file order
+  std::vector<std::vector<double>> extra;          // extra[c][row]
+
+  std::size_t size() const { return t_ns.size(); }
+  // The column named `name` ("wx", "wz_geometric", …); throws invalid_input listing the columns.
+  std::vector<double> column(const std::string& name) const;
+  // Columns wx<suffix>, wy<suffix>, wz<suffix> as rates ("" gives w, "_geometric" a second head).
+  std::vector<Vec3> rates(const std::string& suffix = "") const;
+  // Throws invalid_input unless every column has one value per row and extra names are unique.
+  void validate() const;
+};
+
+RatesTable read_rates_csv(const std::filesystem::path& path);
+void write_rates_csv(const std::filesystem::path& path, const RatesTable& table);
+
+}  // namespace inertialnet

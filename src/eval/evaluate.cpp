@@ -1,0 +1,206 @@
+#include "inertialnet/evaluate.hpp"
+
+#include <cstdio>
+
+#include <nlohmann/json.hpp>
+
+#include "inertialnet/error.hpp"
+
+namespace inertialnet {
+
+namespace {
+
+std::string fmt3(const Vec3& v, const char* format = "%.2f") {
+  char a[32], b[32], c[32];
+  std::snprintf(a, sizeof a, format, v[0]);
+  std::snprintf(b, sizeof b, format, v[1]);
+  std::snprintf(c, sizeof c, format, v[2]);
+  return std::string("(") + a + ", " + b + ", " + c + ")";
+}
+
+nlohmann::json vec_json(const Vec3& v) { return nlohmann::json::array({v[0], v[1], v[2]}); }
+
+nlohmann::json stats_json(const ErrorStats& s) {
+  return {{"frames", s.frames},
+          {"rmse_deg_s", vec_json(s.rmse)},
+          {"mean_error_deg_s", vec_json(s.mean)},
+          {"max_abs_error_deg_s", vec_json(s.max_abs)},
+          {"rms_t_deg_s", {{"mean", s.rms_t_mean}, {"median", s.rms_t_median}, {"max", s.rms_t_max}}}};
+}
+
+std::filesystem::path histogram_path(const std::filesystem::path& plot) {
+  std::filesystem::path p = plot;
+  p.replace_filename(plot.stem().string() + "_hist" + plot.extension().string());
+  return p;
+}
+
+}  // namespace
+
+EvalReport evaluate(const RatesTable& rates, const EurocSequence& seq, const EvalOptions& options) {
+  rates.validate();
+  EvalReport r;
+  r.sequence = seq.name;
+  r.rate_rows = rates.size();
+  r.frames_in_sequence = seq.frames.size();
+  r.imu_samples = seq.imu.size();
+  r.warnings = seq.warnings;
+  const std::vector<Vec3> predicted = rates.rates(options.head_suffix);
+  r.head = "wx" + options.head_suffix + ",wy" + options.head_suffix + ",wz" + options.head_suffix;
+
+  const GyroTruth truth = sync_gyro(seq, options.sync);
+  r.target = truth.target;
+  r.camera_frame = truth.camera_frame;
+  r.bias_source = truth.bias_source;
+  r.bias_imu_frame = truth.bias_imu_frame;
+  r.imu_samples_in_span = truth.imu_samples_in_span;
+  r.notes = truth.notes;
+  const std::vector<Vec3> corrected = truth.corrected();
+
+  // Both lists are sorted by time: one merge pass matches rows to targets and, separately, to
+  // camera frames (to tell "not a frame" from "a frame without ground truth").
+  std::size_t j = 0, f = 0;
+  for (std::size_t i = 0; i < rates.size(); ++i) {
+    const std::int64_t t = rates.t_ns[i];
+    while (f < seq.frames.size() && seq.frames[f].t_ns < t) ++f;
+    const bool is_frame = f < seq.frames.size() && seq.frames[f].t_ns == t;
+    while (j < truth.t_ns.size() && truth.t_ns[j] < t) ++j;
+    if (j < truth.t_ns.size() && truth.t_ns[j] == t) {
+      r.t_ns.push_back(t);
+      r.predicted.push_back(predicted[i]);
+      r.truth_raw.push_back(truth.raw[j]);
+      r.truth_corrected.push_back(corrected[j]);
+    } else if (is_frame) {
+      ++r.rows_without_truth;
+    } else {
+      ++r.rows_not_frames;
+    }
+  }
+  if (!seq.frames.empty() && rates.t_ns.front() == seq.frames.front().t_ns) {
+    r.warnings.push_back("The first rates row carries the sequence's first camera timestamp; eval "
+                         "assumes each row is stamped with the second frame of its pair.");
+  }
+  if (r.rows_not_frames > 0) {
+    r.warnings.push_back(std::to_string(r.rows_not_frames) + " of " + std::to_string(r.rate_rows) +
+                         " rates rows carry timestamps that are not camera timestamps of " +
+                         seq.name + " and were ignored.");
+  }
+  if (r.rows_without_truth > 0) {
+    r.warnings.push_back(std::to_string(r.rows_without_truth) + " rates rows fall on frames without "
+                         "ground truth (outside the IMU's span, or frame 0 for the mean target) and "
+                         "were ignored.");
+  }
+  if (r.t_ns.empty()) {
+    throw invalid_input("None of the " + std::to_string(r.rate_rows) + " rows of the rates file "
+                        "matches a camera frame of " + seq.name + " that has ground truth (rates run from " +
+                        std::to_string(rates.t_ns.front()) + " to " + std::to_string(rates.t_ns.back()) +
+                        " ns; the gyro targets from " + std::to_string(truth.t_ns.front()) + " to " +
+                        std::to_string(truth.t_ns.back()) + " ns).");
+  }
+
+  const bool has_bias = truth.bias_source != BiasSource::None;
+  r.raw = error_stats(r.predicted, r.truth_raw);
+  if (has_bias) r.corrected = error_stats(r.predicted, r.truth_corrected);
+  r.rms_t = rms_error_deg_s(r.predicted, r.truth_corrected);
+  r.histograms = error_histograms_deg_s(r.predicted, r.truth_corrected, options.histogram);
+
+  if (!options.plot.empty()) {
+    std::vector<double> t_s(r.t_ns.size());
+    for (std::size_t i = 0; i < t_s.size(); ++i) t_s[i] = static_cast<double>(r.t_ns[i] - r.t_ns.front()) * 1e-9;
+    PlotStyle style = options.style;
+    if (has_bias && style.truth_label == PlotStyle{}.truth_label) style.truth_label += " - bias";
+    const std::string frame = r.camera_frame ? "camera frame" : "IMU frame";
+    plot_rates(options.plot, t_s, r.predicted, r.truth_corrected,
+               seq.name + ": angular rate (" + frame + ", target: " + to_string(r.target) + ")", style);
+    r.plots.push_back(options.plot.string());
+    const auto hist = histogram_path(options.plot);
+    plot_error_histograms(hist, r.histograms,
+                          seq.name + ": prediction error" + (has_bias ? " (against gyro - bias)" : ""), style);
+    r.plots.push_back(hist.string());
+  }
+  return r;
+}
+
+EvalReport evaluate(const std::filesystem::path& rates_csv, const std::filesystem::path& sequence,
+                    const EvalOptions& options) {
+  const RatesTable rates = read_rates_csv(rates_csv);
+  EurocReadOptions read;
+  read.check_images = false;
+  const EurocSequence seq = read_euroc(sequence, read);
+  EvalReport r = evaluate(rates, seq, options);
+  r.rates_file = rates_csv.string();
+  return r;
+}
+
+std::string EvalReport::table() const {
+  std::string s = "Evaluation of " + (rates_file.empty() ? std::string("predicted rates") : rates_file) +
+                  " (" + head + ") on " + sequence + "\n";
+  s += "  frames evaluated: " + std::to_string(frames_evaluated()) + " of " +
+       std::to_string(rate_rows) + " rates rows (" + std::to_string(frames_in_sequence) +
+       " frames in the sequence)\n";
+  s += "  ground truth: gyro, target " + to_string(target) + ", " +
+       (camera_frame ? "camera frame" : "IMU frame") + ", bias " + to_string(bias_source);
+  if (bias_source != BiasSource::None) s += " " + fmt3(bias_imu_frame, "%.5f") + " rad/s (IMU frame)";
+  s += "\n\n";
+
+  std::vector<RmseRow> rows;
+  rows.push_back({sequence, frames_in_sequence, imu_samples, frames_evaluated(), raw.rmse, "raw gyro"});
+  if (corrected) rows.push_back({sequence, frames_in_sequence, imu_samples, frames_evaluated(), corrected->rmse, "gyro - bias"});
+  s += format_rmse_table(rows);
+
+  const ErrorStats& main = corrected ? *corrected : raw;
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "\nRMS(t) (Eq. 1%s): mean %.2f, median %.2f, max %.2f deg/s\n",
+                corrected ? ", against gyro - bias" : "", main.rms_t_mean, main.rms_t_median, main.rms_t_max);
+  s += buf;
+  s += "mean error " + fmt3(main.mean) + " deg/s, max |error| " + fmt3(main.max_abs) + " deg/s\n";
+  for (const auto& n : notes) s += "note: " + n + "\n";
+  for (const auto& w : warnings) s += "warning: " + w + "\n";
+  for (const auto& p : plots) s += "plot: " + p + "\n";
+  return s;
+}
+
+std::string EvalReport::json(bool include_series) const {
+  nlohmann::json j;
+  j["sequence"] = sequence;
+  j["rates_file"] = rates_file;
+  j["head"] = head;
+  j["rate_rows"] = rate_rows;
+  j["frames_in_sequence"] = frames_in_sequence;
+  j["frames_evaluated"] = frames_evaluated();
+  j["imu_samples"] = imu_samples;
+  j["imu_samples_in_span"] = imu_samples_in_span;
+  j["rows_not_frames"] = rows_not_frames;
+  j["rows_without_truth"] = rows_without_truth;
+  j["target"] = to_string(target);
+  j["frame"] = camera_frame ? "camera" : "imu";
+  j["bias"] = {{"source", to_string(bias_source)}};
+  if (bias_source != BiasSource::None) j["bias"]["imu_frame_rad_s"] = vec_json(bias_imu_frame);
+  j["raw"] = stats_json(raw);
+  j["bias_corrected"] = corrected ? stats_json(*corrected) : nlohmann::json(nullptr);
+  nlohmann::json hist = nlohmann::json::object();
+  static const char* axes[3] = {"wx", "wy", "wz"};
+  hist["lo_deg_s"] = histograms[0].lo;
+  hist["hi_deg_s"] = histograms[0].hi;
+  hist["bins"] = histograms[0].bins();
+  for (int k = 0; k < 3; ++k) {
+    hist[axes[k]] = {{"counts", histograms[k].counts}, {"below", histograms[k].below}, {"above", histograms[k].above}};
+  }
+  j["error_histogram"] = hist;
+  j["plots"] = plots;
+  j["notes"] = notes;
+  j["warnings"] = warnings;
+  if (include_series) {
+    nlohmann::json series = nlohmann::json::array();
+    for (std::size_t i = 0; i < t_ns.size(); ++i) {
+      series.push_back({{"timestamp_ns", t_ns[i]},
+                        {"predicted_rad_s", vec_json(predicted[i])},
+                        {"truth_raw_rad_s", vec_json(truth_raw[i])},
+                        {"truth_corrected_rad_s", vec_json(truth_corrected[i])},
+                        {"rms_t_deg_s", rms_t[i]}});
+    }
+    j["series"] = series;
+  }
+  return j.dump(2);
+}
+
+}  // namespace inertialnet

@@ -1,0 +1,348 @@
+#include "inertialnet/imu_sync.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+#include "inertialnet/error.hpp"
+#include "inertialnet/spline.hpp"
+
+namespace inertialnet {
+
+namespace {
+
+std::string fmt(const char* format, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, format, v);
+  return buf;
+}
+
+std::string vec_str(const Vec3& v) {
+  char buf[128];
+  std::snprintf(buf, sizeof buf, "(%.6g, %.6g, %.6g)", v[0], v[1], v[2]);
+  return buf;
+}
+
+std::string plural(std::size_t n, const char* one, const char* many) {
+  return std::to_string(n) + " " + (n == 1 ? one : many);
+}
+
+// Seconds from `origin`: the int64 subtraction is exact, so only the offset is rounded.
+double seconds(std::int64_t t_ns, std::int64_t origin) {
+  return static_cast<double>(t_ns - origin) * 1e-9;
+}
+
+// Ground-truth bias at time t (linear interpolation; the end value is held outside the span).
+Vec3 gt_bias_at(const std::vector<GroundTruthSample>& gt, std::int64_t t_ns, bool* held) {
+  if (t_ns <= gt.front().t_ns) {
+    *held = t_ns < gt.front().t_ns;
+    return gt.front().gyro_bias;
+  }
+  if (t_ns >= gt.back().t_ns) {
+    *held = t_ns > gt.back().t_ns;
+    return gt.back().gyro_bias;
+  }
+  *held = false;
+  const auto it = std::upper_bound(gt.begin(), gt.end(), t_ns,
+                                   [](std::int64_t t, const GroundTruthSample& s) { return t < s.t_ns; });
+  const auto& b = *it;
+  const auto& a = *(it - 1);
+  const double w = static_cast<double>(t_ns - a.t_ns) / static_cast<double>(b.t_ns - a.t_ns);
+  Vec3 v;
+  for (int k = 0; k < 3; ++k) v[k] = (1 - w) * a.gyro_bias[k] + w * b.gyro_bias[k];
+  return v;
+}
+
+struct StaticEstimate {
+  bool ok = false;
+  Vec3 mean{}, std{};
+  std::size_t samples = 0;
+};
+
+StaticEstimate estimate_static_start(const std::vector<ImuSample>& imu, const StaticStartRule& rule) {
+  StaticEstimate e;
+  const std::int64_t end = imu.front().t_ns + static_cast<std::int64_t>(std::llround(rule.window_s * 1e9));
+  Vec3 sum{}, sum2{};
+  for (const auto& s : imu) {
+    if (s.t_ns > end) break;
+    ++e.samples;
+    for (int k = 0; k < 3; ++k) sum[k] += s.gyro[k];
+  }
+  if (e.samples < 2) return e;
+  for (int k = 0; k < 3; ++k) e.mean[k] = sum[k] / static_cast<double>(e.samples);
+  // Two passes: the variance of a near-constant signal is tiny next to its mean squared.
+  for (std::size_t i = 0; i < e.samples; ++i) {
+    for (int k = 0; k < 3; ++k) {
+      const double d = imu[i].gyro[k] - e.mean[k];
+      sum2[k] += d * d;
+    }
+  }
+  for (int k = 0; k < 3; ++k) e.std[k] = std::sqrt(sum2[k] / static_cast<double>(e.samples - 1));
+  e.ok = std::max({e.std[0], e.std[1], e.std[2]}) <= rule.max_std_rad_s;
+  return e;
+}
+
+}  // namespace
+
+std::string to_string(SyncTarget target) { return target == SyncTarget::Spline ? "spline" : "mean"; }
+
+std::string to_string(BiasSource source) {
+  switch (source) {
+    case BiasSource::None: return "none";
+    case BiasSource::Given: return "given";
+    case BiasSource::GroundTruth: return "ground_truth";
+    case BiasSource::StaticStart: return "static_start";
+    case BiasSource::Automatic: return "automatic";
+  }
+  return "unknown";
+}
+
+SyncTarget parse_sync_target(const std::string& text) {
+  if (text == "spline") return SyncTarget::Spline;
+  if (text == "mean") return SyncTarget::Mean;
+  throw invalid_input("Unknown synchronisation target \"" + text + "\": expected spline or mean.");
+}
+
+Vec3 parse_vec3(const std::string& text, const std::string& what) {
+  Vec3 v{};
+  std::size_t pos = 0;
+  for (int k = 0; k < 3; ++k) {
+    const std::size_t comma = k < 2 ? text.find(',', pos) : text.size();
+    if (comma == std::string::npos) break;
+    std::string field = text.substr(pos, comma - pos);
+    const auto b = field.find_first_not_of(" \t");
+    const auto e = field.find_last_not_of(" \t");
+    field = b == std::string::npos ? "" : field.substr(b, e - b + 1);
+    char* end = nullptr;
+    v[k] = std::strtod(field.c_str(), &end);
+    if (field.empty() || *end != '\0' || !std::isfinite(v[k])) {
+      throw invalid_input(what + " should be three numbers x,y,z; \"" + field + "\" is not a number.");
+    }
+    pos = comma + 1;
+    if (k == 2) return v;
+  }
+  throw invalid_input(what + " should be three comma-separated numbers x,y,z, found \"" + text + "\".");
+}
+
+std::vector<Vec3> GyroTruth::corrected() const {
+  if (bias.empty()) return raw;
+  std::vector<Vec3> out(raw.size());
+  for (std::size_t i = 0; i < raw.size(); ++i) out[i] = raw[i] - bias[i];
+  return out;
+}
+
+GyroTruth sync_gyro(const std::vector<std::int64_t>& cam, const std::vector<ImuSample>& imu,
+                    const SyncOptions& options, const std::vector<GroundTruthSample>* ground_truth,
+                    const Mat3* imu_to_camera) {
+  if (cam.empty()) throw invalid_input("Synchronisation: there are no camera timestamps.");
+  if (imu.size() < 2) {
+    throw invalid_input("Synchronisation: the IMU has " + std::to_string(imu.size()) +
+                        " samples; at least 2 are needed for a spline.");
+  }
+  for (std::size_t i = 1; i < cam.size(); ++i) {
+    if (cam[i] <= cam[i - 1]) {
+      throw invalid_input("Synchronisation: camera timestamp " + std::to_string(i) + " (" +
+                          std::to_string(cam[i]) + ") does not follow timestamp " +
+                          std::to_string(i - 1) + " (" + std::to_string(cam[i - 1]) + ").");
+    }
+  }
+  if (options.camera_frame && !imu_to_camera) {
+    throw invalid_input("Synchronisation: rates in the camera frame need the camera's T_BS "
+                        "(mav0/cam0/sensor.yaml), which is not available.");
+  }
+  if (options.target == SyncTarget::Mean && cam.size() < 2) {
+    throw invalid_input("Synchronisation: the mean target needs at least 2 camera frames.");
+  }
+
+  GyroTruth out;
+  out.target = options.target;
+  out.camera_frame = options.camera_frame;
+
+  const std::int64_t t0 = imu.front().t_ns, t1 = imu.back().t_ns;
+  // Frame k needs IMU data over [need_from(k), cam[k]].
+  const bool mean = options.target == SyncTarget::Mean;
+  const std::size_t first_possible = mean ? 1 : 0;
+  std::size_t first = first_possible;
+  while (first < cam.size() && (mean ? cam[first - 1] : cam[first]) < t0) ++first;
+  std::size_t last = cam.size();  // one past the last kept frame
+  while (last > first && cam[last - 1] > t1) --last;
+  const double imu_len = seconds(t1, t0);
+  if (first >= last) {
+    throw invalid_input("Synchronisation: the IMU (" + fmt("%.3f", imu_len) +
+                        " s of data from t = " + std::to_string(t0) + " ns) covers none of the " +
+                        std::to_string(cam.size()) + " camera frames (t = " +
+                        std::to_string(cam.front()) + " to " + std::to_string(cam.back()) +
+                        " ns); the spline does not extrapolate.");
+  }
+  out.dropped_before = first;
+  out.dropped_after = cam.size() - last;
+  if (mean) {
+    out.notes.push_back("Target: mean of the spline over each frame interval [t_{k-1}, t_k]; "
+                        "frame 0 has no previous frame and no target.");
+  } else {
+    out.notes.push_back("Target: natural cubic spline evaluated at each camera timestamp.");
+  }
+  if (first > first_possible) {
+    out.notes.push_back("The IMU starts " + fmt("%.3f", seconds(t0, cam.front())) +
+                        " s after the first camera frame: " +
+                        plural(first - first_possible, "frame", "frames") +
+                        " before it have no ground truth and were dropped.");
+  }
+  if (out.dropped_after > 0) {
+    out.notes.push_back("The IMU ends " + fmt("%.3f", seconds(cam.back(), t1)) +
+                        " s before the last camera frame: " +
+                        plural(out.dropped_after, "frame", "frames") +
+                        " after it have no ground truth and were dropped.");
+  }
+
+  // Splines in seconds since the first IMU sample.
+  std::vector<double> x(imu.size());
+  std::vector<double> y[3];
+  for (auto& axis : y) axis.resize(imu.size());
+  for (std::size_t i = 0; i < imu.size(); ++i) {
+    x[i] = seconds(imu[i].t_ns, t0);
+    for (int k = 0; k < 3; ++k) y[k][i] = imu[i].gyro[k];
+  }
+  const CubicSpline splines[3] = {CubicSpline(x, y[0]), CubicSpline(x, y[1]), CubicSpline(x, y[2])};
+
+  const std::size_t n = last - first;
+  out.t_ns.resize(n);
+  out.frame_index.resize(n);
+  out.raw.resize(n);
+  std::vector<std::int64_t> bias_time(n);
+  for (std::size_t j = 0; j < n; ++j) {
+    const std::size_t k = first + j;
+    out.t_ns[j] = cam[k];
+    out.frame_index[j] = k;
+    if (mean) {
+      const double a = seconds(cam[k - 1], t0), b = seconds(cam[k], t0);
+      for (int c = 0; c < 3; ++c) out.raw[j][c] = splines[c].mean(a, b);
+      bias_time[j] = cam[k - 1] + (cam[k] - cam[k - 1]) / 2;
+    } else {
+      const double t = seconds(cam[k], t0);
+      for (int c = 0; c < 3; ++c) out.raw[j][c] = splines[c](t);
+      bias_time[j] = cam[k];
+    }
+  }
+  const std::int64_t span_from = mean ? cam[first - 1] : cam[first];
+  const std::int64_t span_to = cam[last - 1];
+  out.imu_samples_in_span = static_cast<std::size_t>(
+      std::count_if(imu.begin(), imu.end(),
+                    [&](const ImuSample& s) { return s.t_ns >= span_from && s.t_ns <= span_to; }));
+
+  // Bias, in the IMU frame first.
+  BiasSource source = options.bias;
+  const bool have_gt = ground_truth && !ground_truth->empty();
+  StaticEstimate still;
+  if (source == BiasSource::Automatic) {
+    if (have_gt) {
+      source = BiasSource::GroundTruth;
+    } else {
+      still = estimate_static_start(imu, options.static_start);
+      source = still.ok ? BiasSource::StaticStart : BiasSource::None;
+      if (!still.ok) {
+        out.notes.push_back("No gyro bias: the sequence has no ground truth and its first " +
+                            fmt("%.2f", options.static_start.window_s) +
+                            " s of IMU data are not static (gyro std " + vec_str(still.std) +
+                            " rad/s); pass a bias explicitly to correct for it.");
+      }
+    }
+  }
+  std::vector<Vec3> bias;
+  switch (source) {
+    case BiasSource::None:
+    case BiasSource::Automatic:
+      break;
+    case BiasSource::Given:
+      bias.assign(n, options.gyro_bias);
+      out.bias_imu_frame = options.gyro_bias;
+      out.notes.push_back("Gyro bias given: " + vec_str(options.gyro_bias) + " rad/s (IMU frame).");
+      break;
+    case BiasSource::GroundTruth: {
+      if (!have_gt) {
+        throw invalid_input("Synchronisation: a ground-truth gyro bias was asked for, but the "
+                            "sequence has no mav0/state_groundtruth_estimate0/data.csv.");
+      }
+      bias.resize(n);
+      std::size_t held = 0;
+      Vec3 sum{};
+      for (std::size_t j = 0; j < n; ++j) {
+        bool h = false;
+        bias[j] = gt_bias_at(*ground_truth, bias_time[j], &h);
+        held += h ? 1 : 0;
+        for (int c = 0; c < 3; ++c) sum[c] += bias[j][c];
+      }
+      for (int c = 0; c < 3; ++c) out.bias_imu_frame[c] = sum[c] / static_cast<double>(n);
+      out.notes.push_back("Gyro bias from the ground truth's b_w_RS_S columns, interpolated at "
+                          "each target (mean " + vec_str(out.bias_imu_frame) + " rad/s).");
+      if (held > 0) {
+        out.notes.push_back(plural(held, "frame lies", "frames lie") +
+                            " outside the ground truth's time span; the nearest ground-truth "
+                            "bias was held for them.");
+      }
+      break;
+    }
+    case BiasSource::StaticStart: {
+      if (options.bias == BiasSource::StaticStart) {
+        still = estimate_static_start(imu, options.static_start);
+        if (!still.ok) {
+          throw invalid_input("Synchronisation: the first " +
+                              fmt("%.2f", options.static_start.window_s) +
+                              " s of IMU data are not static (gyro std " + vec_str(still.std) +
+                              " rad/s, limit " + fmt("%.3g", options.static_start.max_std_rad_s) +
+                              " rad/s on every axis), so no static-start bias can be estimated.");
+        }
+      }
+      bias.assign(n, still.mean);
+      out.bias_imu_frame = still.mean;
+      out.notes.push_back("Gyro bias estimated from a static start: mean of the first " +
+                          plural(still.samples, "IMU sample", "IMU samples") + " (" +
+                          fmt("%.2f", options.static_start.window_s) + " s, gyro std " +
+                          vec_str(still.std) + " rad/s): " + vec_str(still.mean) + " rad/s.");
+      break;
+    }
+  }
+  out.bias_source = source == BiasSource::Automatic ? BiasSource::None : source;
+
+  if (options.camera_frame) {
+    for (auto& v : out.raw) v = mul(*imu_to_camera, v);
+    for (auto& v : bias) v = mul(*imu_to_camera, v);
+    out.notes.push_back("Rates rotated into the camera frame: w_C = R_BS^T * w_B.");
+  } else {
+    out.notes.push_back("Rates in the IMU (body) frame.");
+  }
+  out.bias = std::move(bias);
+  return out;
+}
+
+Mat3 imu_to_camera_rotation(const EurocSequence& sequence) {
+  if (!sequence.camera) {
+    throw invalid_input("Rates in the camera frame need the camera calibration " +
+                        (sequence.mav0 / "cam0" / "sensor.yaml").string() + ", which was not found.");
+  }
+  const Mat3 r_cam = sequence.camera->rotation_BS();
+  const Mat3 r_imu = sequence.imu_rotation_BS.value_or(Mat3{1, 0, 0, 0, 1, 0, 0, 0, 1});
+  // R_CS = R_BS,camᵀ · R_BS,imu
+  Mat3 r{};
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      double s = 0;
+      for (int k = 0; k < 3; ++k) s += r_cam[3 * k + i] * r_imu[3 * k + j];
+      r[3 * i + j] = s;
+    }
+  }
+  return r;
+}
+
+GyroTruth sync_gyro(const EurocSequence& sequence, const SyncOptions& options) {
+  std::vector<std::int64_t> cam(sequence.frames.size());
+  for (std::size_t i = 0; i < cam.size(); ++i) cam[i] = sequence.frames[i].t_ns;
+  std::optional<Mat3> rotation;
+  if (options.camera_frame) rotation = imu_to_camera_rotation(sequence);
+  const std::vector<GroundTruthSample>* gt =
+      sequence.ground_truth ? &*sequence.ground_truth : nullptr;
+  return sync_gyro(cam, sequence.imu, options, gt, rotation ? &*rotation : nullptr);
+}
+
+}  // namespace inertialnet

@@ -1,0 +1,393 @@
+#include "inertialnet/euroc.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <opencv2/core.hpp>
+
+#include "inertialnet/error.hpp"
+#include "io/csv_util.hpp"
+
+namespace fs = std::filesystem;
+
+namespace inertialnet {
+
+Mat3 CameraCalibration::rotation_BS() const {
+  return {T_BS[0], T_BS[1], T_BS[2], T_BS[4], T_BS[5], T_BS[6], T_BS[8], T_BS[9], T_BS[10]};
+}
+
+namespace {
+
+// Rows of a CSV file with a fixed number of fields, header and comments skipped. Every data row
+// must have exactly `n_fields` fields; a header is recognised as a non-numeric first row.
+struct Row {
+  std::size_t line;
+  std::vector<std::string> fields;
+};
+
+std::vector<Row> read_rows(const fs::path& path, const std::string& what, std::size_t n_fields,
+                           const std::string& layout) {
+  csv::LineReader reader(path, what);
+  std::vector<Row> rows;
+  std::string line;
+  bool first = true;
+  while (reader.next(line)) {
+    if (csv::is_blank_or_comment(line)) continue;
+    const auto fields = csv::split(line);
+    // Some exports write the header without '#': accept it only as the first line.
+    const bool header = first && !csv::looks_numeric(fields.front());
+    first = false;
+    if (header) continue;
+    if (fields.size() != n_fields) {
+      throw invalid_input(path.string() + " line " + std::to_string(reader.line_number()) +
+                          ": expected " + std::to_string(n_fields) + " comma-separated fields (" +
+                          layout + "), found " + std::to_string(fields.size()) + ".");
+    }
+    Row row{reader.line_number(), {}};
+    row.fields.reserve(fields.size());
+    for (auto f : fields) row.fields.emplace_back(f);
+    rows.push_back(std::move(row));
+  }
+  if (rows.empty()) throw invalid_input(what + " " + path.string() + " has no data rows.");
+  return rows;
+}
+
+void check_order(const fs::path& path, const std::vector<Row>& rows,
+                 const std::vector<std::int64_t>& t, std::vector<std::string>* warnings) {
+  std::vector<std::size_t> lines(rows.size());
+  for (std::size_t i = 0; i < rows.size(); ++i) lines[i] = rows[i].line;
+  csv::check_timestamps(path, t, lines, warnings);
+}
+
+// --- YAML through cv::FileStorage (it reads the originals' "%YAML:1.0" header) ---------------
+
+cv::FileStorage open_yaml(const fs::path& path) {
+  if (!fs::exists(path)) throw invalid_input("Calibration file " + path.string() + " does not exist.");
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  std::string text = buffer.str();
+  // OpenCV's parser insists on its own directive; Kalibr and hand-written files often omit it
+  // or write the YAML 1.x spelling.
+  if (text.rfind("%YAML", 0) != 0) {
+    text = "%YAML:1.0\n" + text;
+  } else if (text.rfind("%YAML:", 0) != 0) {
+    text.replace(0, text.find('\n'), "%YAML:1.0");
+  }
+  cv::FileStorage storage;
+  try {
+    storage.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
+  } catch (const cv::Exception& e) {
+    // OpenCV 4 puts the parser's message in `func` and the parser function's name in `err`.
+    throw invalid_input("Calibration file " + path.string() + " is not valid YAML (OpenCV: " +
+                        e.err + " " + e.func + ").");
+  }
+  if (!storage.isOpened()) throw invalid_input("Calibration file " + path.string() + " is not valid YAML.");
+  return storage;
+}
+
+double read_number(const cv::FileNode& node, const fs::path& path, const std::string& key) {
+  if (!node.isInt() && !node.isReal()) {
+    throw invalid_input(path.string() + ": " + key + " should be a number.");
+  }
+  return node.real();
+}
+
+std::vector<double> read_numbers(const cv::FileNode& node, const fs::path& path,
+                                 const std::string& key) {
+  if (!node.isSeq()) throw invalid_input(path.string() + ": " + key + " should be a list of numbers.");
+  std::vector<double> values;
+  for (auto it = node.begin(); it != node.end(); ++it) {
+    values.push_back(read_number(*it, path, key + "[" + std::to_string(values.size()) + "]"));
+  }
+  return values;
+}
+
+std::array<double, 16> read_T_BS(const cv::FileStorage& storage, const fs::path& path) {
+  const cv::FileNode node = storage["T_BS"];
+  if (node.empty()) throw invalid_input(path.string() + " has no T_BS entry.");
+  // EuRoC writes {cols: 4, rows: 4, data: [...]}; a bare 16-element list is accepted too.
+  std::vector<double> data;
+  if (node.isMap()) {
+    const cv::FileNode rows = node["rows"], cols = node["cols"];
+    if ((!rows.empty() && read_number(rows, path, "T_BS.rows") != 4) ||
+        (!cols.empty() && read_number(cols, path, "T_BS.cols") != 4)) {
+      throw invalid_input(path.string() + ": T_BS should be 4×4.");
+    }
+    data = read_numbers(node["data"], path, "T_BS.data");
+  } else {
+    data = read_numbers(node, path, "T_BS");
+  }
+  if (data.size() != 16) {
+    throw invalid_input(path.string() + ": T_BS should hold 16 numbers (4×4 row-major), found " +
+                        std::to_string(data.size()) + ".");
+  }
+  std::array<double, 16> T{};
+  std::copy(data.begin(), data.end(), T.begin());
+  // A transform that is not rigid would silently mix the gyro axes: reject it.
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      double dot = 0;
+      for (int k = 0; k < 3; ++k) dot += T[4 * i + k] * T[4 * j + k];
+      if (std::abs(dot - (i == j ? 1.0 : 0.0)) > 1e-3) {
+        throw invalid_input(path.string() + ": the top-left 3×3 of T_BS is not a rotation matrix "
+                            "(rows are not orthonormal within 1e-3).");
+      }
+    }
+  }
+  if (std::abs(T[12]) > 1e-9 || std::abs(T[13]) > 1e-9 || std::abs(T[14]) > 1e-9 ||
+      std::abs(T[15] - 1) > 1e-9) {
+    throw invalid_input(path.string() + ": the last row of T_BS should be [0, 0, 0, 1].");
+  }
+  return T;
+}
+
+std::string read_string(const cv::FileNode& node) {
+  return node.isString() ? node.string() : std::string();
+}
+
+fs::path find_mav0(const fs::path& root) {
+  if (fs::is_directory(root / "mav0")) return root / "mav0";
+  if (root.filename() == "mav0" && fs::is_directory(root)) return root;
+  // A mav0 folder is recognised by its content as well, whatever its name.
+  if (fs::is_directory(root / "cam0") && fs::exists(root / "cam0" / "data.csv")) return root;
+  return {};
+}
+
+bool is_image_extension(const fs::path& p) {
+  std::string ext = p.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext == ".png" || ext == ".jpg" || ext == ".jpeg";
+}
+
+// Natural order: digit runs compare by value, so frame2.png sorts before frame10.png.
+bool natural_less(const std::string& a, const std::string& b) {
+  std::size_t i = 0, j = 0;
+  while (i < a.size() && j < b.size()) {
+    if (std::isdigit(static_cast<unsigned char>(a[i])) && std::isdigit(static_cast<unsigned char>(b[j]))) {
+      std::size_t i0 = i, j0 = j;
+      while (i0 < a.size() && a[i0] == '0') ++i0;
+      while (j0 < b.size() && b[j0] == '0') ++j0;
+      std::size_t i1 = i0, j1 = j0;
+      while (i1 < a.size() && std::isdigit(static_cast<unsigned char>(a[i1]))) ++i1;
+      while (j1 < b.size() && std::isdigit(static_cast<unsigned char>(b[j1]))) ++j1;
+      if (i1 - i0 != j1 - j0) return i1 - i0 < j1 - j0;
+      const int c = a.compare(i0, i1 - i0, b, j0, j1 - j0);
+      if (c != 0) return c < 0;
+      if (i1 - i != j1 - j) return i1 - i < j1 - j;  // fewer leading zeros first
+      i = i1;
+      j = j1;
+    } else {
+      if (a[i] != b[j]) return a[i] < b[j];
+      ++i;
+      ++j;
+    }
+  }
+  return a.size() - i < b.size() - j;
+}
+
+}  // namespace
+
+bool is_euroc_folder(const fs::path& root) { return !find_mav0(root).empty(); }
+
+std::vector<CameraFrame> read_camera_csv(const fs::path& csv, const fs::path& image_dir,
+                                         bool check_images, std::vector<std::string>* warnings) {
+  const auto rows = read_rows(csv, "EuRoC camera file", 2, "timestamp [ns], filename");
+  std::vector<CameraFrame> frames(rows.size());
+  std::vector<std::int64_t> t(rows.size());
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const auto& r = rows[i];
+    t[i] = csv::parse_int64(r.fields[0], csv, r.line, "the timestamp [ns]");
+    if (r.fields[1].empty()) {
+      throw invalid_input(csv.string() + " line " + std::to_string(r.line) + ": the filename is empty.");
+    }
+    frames[i] = {t[i], r.fields[1], image_dir / r.fields[1]};
+  }
+  check_order(csv, rows, t, warnings);
+  if (check_images) {
+    std::size_t missing = 0;
+    std::size_t first = 0;
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+      if (!fs::is_regular_file(frames[i].path)) {
+        if (missing++ == 0) first = i;
+      }
+    }
+    if (missing > 0) {
+      throw invalid_input(csv.string() + " lists " + std::to_string(missing) + " of " +
+                          std::to_string(frames.size()) +
+                          " images that do not exist; the first is " + frames[first].path.string() +
+                          " (line " + std::to_string(rows[first].line) + ").");
+    }
+  }
+  return frames;
+}
+
+CameraCalibration read_camera_yaml(const fs::path& yaml) {
+  const cv::FileStorage storage = open_yaml(yaml);
+  CameraCalibration c;
+  c.T_BS = read_T_BS(storage, yaml);
+
+  const auto intrinsics = read_numbers(storage["intrinsics"], yaml, "intrinsics");
+  c.camera_model = read_string(storage["camera_model"]);
+  if (intrinsics.size() != 4) {
+    throw invalid_input(yaml.string() + ": intrinsics should be [fu, fv, cu, cv], found " +
+                        std::to_string(intrinsics.size()) + " numbers.");
+  }
+  std::copy(intrinsics.begin(), intrinsics.end(), c.intrinsics.begin());
+  if (c.intrinsics[0] <= 0 || c.intrinsics[1] <= 0) {
+    throw invalid_input(yaml.string() + ": the focal lengths fu, fv should be positive.");
+  }
+
+  const auto resolution = read_numbers(storage["resolution"], yaml, "resolution");
+  if (resolution.size() != 2 || resolution[0] < 1 || resolution[1] < 1 ||
+      resolution[0] != std::floor(resolution[0]) || resolution[1] != std::floor(resolution[1])) {
+    throw invalid_input(yaml.string() + ": resolution should be [width, height] in pixels.");
+  }
+  c.width = static_cast<int>(resolution[0]);
+  c.height = static_cast<int>(resolution[1]);
+
+  if (!storage["rate_hz"].empty()) {
+    c.rate_hz = read_number(storage["rate_hz"], yaml, "rate_hz");
+    if (!(c.rate_hz > 0)) throw invalid_input(yaml.string() + ": rate_hz should be positive.");
+  }
+  c.distortion_model = read_string(storage["distortion_model"]);
+  if (!storage["distortion_coefficients"].empty()) {
+    c.distortion = read_numbers(storage["distortion_coefficients"], yaml, "distortion_coefficients");
+  }
+  const std::size_t expected = (c.distortion_model == "radial-tangential" ||
+                                c.distortion_model == "equidistant") ? 4 : 0;
+  if (expected != 0 && c.distortion.size() != expected) {
+    throw invalid_input(yaml.string() + ": the " + c.distortion_model + " model takes " +
+                        std::to_string(expected) + " distortion coefficients, found " +
+                        std::to_string(c.distortion.size()) + ".");
+  }
+  return c;
+}
+
+std::array<double, 16> read_sensor_T_BS(const fs::path& yaml) {
+  return read_T_BS(open_yaml(yaml), yaml);
+}
+
+std::vector<ImuSample> read_imu_csv(const fs::path& csv, std::vector<std::string>* warnings) {
+  const auto rows = read_rows(csv, "EuRoC IMU file", 7,
+                              "timestamp [ns], gyro x y z [rad/s], accel x y z [m/s^2]");
+  static const char* names[7] = {"the timestamp [ns]", "w_RS_S_x", "w_RS_S_y", "w_RS_S_z",
+                                 "a_RS_S_x", "a_RS_S_y", "a_RS_S_z"};
+  std::vector<ImuSample> imu(rows.size());
+  std::vector<std::int64_t> t(rows.size());
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const auto& r = rows[i];
+    imu[i].t_ns = t[i] = csv::parse_int64(r.fields[0], csv, r.line, names[0]);
+    for (int k = 0; k < 3; ++k) {
+      imu[i].gyro[k] = csv::parse_double(r.fields[1 + k], csv, r.line, names[1 + k]);
+      imu[i].accel[k] = csv::parse_double(r.fields[4 + k], csv, r.line, names[4 + k]);
+    }
+  }
+  check_order(csv, rows, t, warnings);
+  return imu;
+}
+
+std::vector<GroundTruthSample> read_ground_truth_csv(const fs::path& csv,
+                                                     std::vector<std::string>* warnings) {
+  const auto rows = read_rows(csv, "EuRoC ground-truth file", 17,
+                              "timestamp, p xyz, q wxyz, v xyz, gyro bias xyz, accel bias xyz");
+  std::vector<GroundTruthSample> gt(rows.size());
+  std::vector<std::int64_t> t(rows.size());
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const auto& r = rows[i];
+    double v[17];
+    gt[i].t_ns = t[i] = csv::parse_int64(r.fields[0], csv, r.line, "the timestamp [ns]");
+    for (int k = 1; k < 17; ++k) {
+      v[k] = csv::parse_double(r.fields[k], csv, r.line, "column " + std::to_string(k + 1));
+    }
+    auto& g = gt[i];
+    g.position = {v[1], v[2], v[3]};
+    g.q_wxyz = {v[4], v[5], v[6], v[7]};
+    g.velocity = {v[8], v[9], v[10]};
+    g.gyro_bias = {v[11], v[12], v[13]};
+    g.accel_bias = {v[14], v[15], v[16]};
+  }
+  check_order(csv, rows, t, warnings);
+  return gt;
+}
+
+EurocSequence read_euroc(const fs::path& root, const EurocReadOptions& options) {
+  const fs::path mav0 = find_mav0(root);
+  if (mav0.empty()) {
+    throw invalid_input(root.string() + " is not a EuRoC (ASL) sequence: expected " +
+                        (root / "mav0" / options.camera / "data.csv").string() + ".");
+  }
+  EurocSequence seq;
+  seq.mav0 = mav0;
+  const fs::path parent = mav0.filename() == "mav0" ? mav0.parent_path() : mav0;
+  seq.name = fs::absolute(parent).lexically_normal().filename().string();
+  if (seq.name.empty()) seq.name = fs::absolute(parent).lexically_normal().parent_path().filename().string();
+
+  const fs::path cam = mav0 / options.camera;
+  seq.frames = read_camera_csv(cam / "data.csv", cam / "data", options.check_images, &seq.warnings);
+  if (fs::exists(cam / "sensor.yaml")) seq.camera = read_camera_yaml(cam / "sensor.yaml");
+
+  if (options.read_imu) {
+    const fs::path imu = mav0 / "imu0";
+    seq.imu = read_imu_csv(imu / "data.csv", &seq.warnings);
+    if (fs::exists(imu / "sensor.yaml")) {
+      const auto T = read_sensor_T_BS(imu / "sensor.yaml");
+      seq.imu_rotation_BS = Mat3{T[0], T[1], T[2], T[4], T[5], T[6], T[8], T[9], T[10]};
+    }
+  }
+  const fs::path gt = mav0 / "state_groundtruth_estimate0" / "data.csv";
+  if (options.read_ground_truth && fs::exists(gt)) {
+    seq.ground_truth = read_ground_truth_csv(gt, &seq.warnings);
+  }
+  return seq;
+}
+
+ImageFolder list_image_folder(const fs::path& dir, std::optional<double> rate_hz) {
+  if (!fs::is_directory(dir)) throw invalid_input("Image folder " + dir.string() + " does not exist.");
+  if (rate_hz && !(*rate_hz > 0 && std::isfinite(*rate_hz))) {
+    throw invalid_input("The frame rate for " + dir.string() + " should be a positive number of Hz.");
+  }
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    if (entry.is_regular_file() && is_image_extension(entry.path())) {
+      names.push_back(entry.path().filename().string());
+    }
+  }
+  if (names.empty()) throw invalid_input("Image folder " + dir.string() + " holds no .png or .jpg images.");
+  std::sort(names.begin(), names.end(), natural_less);
+
+  ImageFolder folder;
+  folder.frames.resize(names.size());
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    folder.frames[i] = {static_cast<std::int64_t>(i), names[i], dir / names[i]};
+  }
+  if (rate_hz) {
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      folder.frames[i].t_ns = std::llround(static_cast<double>(i) * 1e9 / *rate_hz);
+    }
+    folder.timestamps_known = true;
+    return folder;
+  }
+  // Stems that are all nanosecond timestamps (≥16 digits) carry the time themselves.
+  std::vector<std::int64_t> stamps;
+  for (const auto& name : names) {
+    const std::string stem = fs::path(name).stem().string();
+    std::int64_t t = 0;
+    const auto [end, ec] = std::from_chars(stem.data(), stem.data() + stem.size(), t);
+    if (stem.size() < 16 || ec != std::errc() || end != stem.data() + stem.size() || t < 0) {
+      return folder;
+    }
+    stamps.push_back(t);
+  }
+  if (std::set<std::int64_t>(stamps.begin(), stamps.end()).size() != stamps.size()) return folder;
+  for (std::size_t i = 0; i < names.size(); ++i) folder.frames[i].t_ns = stamps[i];
+  folder.timestamps_known = true;
+  return folder;
+}
+
+}  // namespace inertialnet

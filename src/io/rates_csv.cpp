@@ -1,0 +1,196 @@
+#include "inertialnet/rates_csv.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <set>
+
+#include "inertialnet/error.hpp"
+#include "io/csv_util.hpp"
+
+namespace fs = std::filesystem;
+
+namespace inertialnet {
+
+namespace {
+const char* const kAxes[3] = {"wx", "wy", "wz"};
+
+std::string joined(const std::vector<std::string>& names) {
+  std::string s;
+  for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;
+  return s;
+}
+
+std::vector<std::string> all_columns(const RatesTable& t) {
+  std::vector<std::string> names = {"timestamp_ns", "wx", "wy", "wz"};
+  names.insert(names.end(), t.extra_names.begin(), t.extra_names.end());
+  return names;
+}
+}  // namespace
+
+void RatesTable::validate() const {
+  if (w.size() != t_ns.size()) {
+    throw invalid_input("Rates table: " + std::to_string(t_ns.size()) + " timestamps but " +
+                        std::to_string(w.size()) + " rate rows.");
+  }
+  if (extra.size() != extra_names.size()) {
+    throw invalid_input("Rates table: " + std::to_string(extra_names.size()) +
+                        " extra column names but " + std::to_string(extra.size()) + " extra columns.");
+  }
+  std::set<std::string> seen = {"timestamp_ns", "wx", "wy", "wz"};
+  for (std::size_t c = 0; c < extra.size(); ++c) {
+    const auto& name = extra_names[c];
+    if (name.empty() || name.find_first_of(",\"\n\r") != std::string::npos) {
+      throw invalid_input("Rates table: extra column " + std::to_string(c) + " has the name \"" +
+                          name + "\"; names must be non-empty without commas, quotes or newlines.");
+    }
+    if (!seen.insert(name).second) throw invalid_input("Rates table: the column " + name + " appears twice.");
+    if (extra[c].size() != t_ns.size()) {
+      throw invalid_input("Rates table: column " + name + " has " + std::to_string(extra[c].size()) +
+                          " values for " + std::to_string(t_ns.size()) + " rows.");
+    }
+  }
+}
+
+std::vector<double> RatesTable::column(const std::string& name) const {
+  for (int k = 0; k < 3; ++k) {
+    if (name == kAxes[k]) {
+      std::vector<double> v(w.size());
+      for (std::size_t i = 0; i < w.size(); ++i) v[i] = w[i][k];
+      return v;
+    }
+  }
+  for (std::size_t c = 0; c < extra_names.size(); ++c) {
+    if (extra_names[c] == name) return extra[c];
+  }
+  throw invalid_input("Rates table has no column " + name + "; its columns are " +
+                      joined(all_columns(*this)) + ".");
+}
+
+std::vector<Vec3> RatesTable::rates(const std::string& suffix) const {
+  if (suffix.empty()) return w;
+  std::vector<double> cols[3];
+  for (int k = 0; k < 3; ++k) cols[k] = column(kAxes[k] + suffix);
+  std::vector<Vec3> out(t_ns.size());
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = {cols[0][i], cols[1][i], cols[2][i]};
+  return out;
+}
+
+RatesTable read_rates_csv(const fs::path& path) {
+  csv::LineReader reader(path, "Rates file");
+  RatesTable table;
+  std::string line;
+  bool have_header = false;
+  int axis_at[3] = {-1, -1, -1};
+  std::vector<int> extra_at;
+  std::size_t n_fields = 0;
+  std::vector<std::size_t> lines;
+
+  while (reader.next(line)) {
+    const std::size_t ln = reader.line_number();
+    if (!have_header) {
+      // A EuRoC-style "#timestamp_ns,..." header is a header, not a comment.
+      if (csv::trim(line).rfind("#timestamp_ns", 0) == 0) line = std::string(csv::trim(line).substr(1));
+      if (csv::is_blank_or_comment(line)) continue;
+      const auto fields = csv::split(line);
+      n_fields = fields.size();
+      if (fields[0] != "timestamp_ns") {
+        throw invalid_input(path.string() + " line " + std::to_string(ln) +
+                            ": expected the header timestamp_ns,wx,wy,wz[,...], found \"" + line + "\".");
+      }
+      std::set<std::string> seen;
+      for (std::size_t i = 0; i < fields.size(); ++i) {
+        const std::string name(fields[i]);
+        if (name.empty()) {
+          throw invalid_input(path.string() + " line " + std::to_string(ln) + ": column " +
+                              std::to_string(i + 1) + " of the header has no name.");
+        }
+        if (!seen.insert(name).second) {
+          throw invalid_input(path.string() + " line " + std::to_string(ln) + ": the column " +
+                              name + " appears twice in the header.");
+        }
+        if (i == 0) continue;
+        bool axis = false;
+        for (int k = 0; k < 3; ++k) {
+          if (name == kAxes[k]) {
+            axis_at[k] = static_cast<int>(i);
+            axis = true;
+          }
+        }
+        if (!axis) {
+          table.extra_names.push_back(name);
+          extra_at.push_back(static_cast<int>(i));
+        }
+      }
+      for (int k = 0; k < 3; ++k) {
+        if (axis_at[k] < 0) {
+          throw invalid_input(path.string() + " line " + std::to_string(ln) +
+                              ": the header has no column " + kAxes[k] +
+                              " (expected timestamp_ns,wx,wy,wz[,...]).");
+        }
+      }
+      table.extra.resize(extra_at.size());
+      have_header = true;
+      continue;
+    }
+    if (csv::trim(line).empty()) continue;
+    const auto fields = csv::split(line);
+    if (fields.size() != n_fields) {
+      throw invalid_input(path.string() + " line " + std::to_string(ln) + ": expected " +
+                          std::to_string(n_fields) + " fields as in the header, found " +
+                          std::to_string(fields.size()) + ".");
+    }
+    table.t_ns.push_back(csv::parse_int64(fields[0], path, ln, "timestamp_ns"));
+    Vec3 w;
+    for (int k = 0; k < 3; ++k) w[k] = csv::parse_double(fields[axis_at[k]], path, ln, kAxes[k]);
+    table.w.push_back(w);
+    for (std::size_t c = 0; c < extra_at.size(); ++c) {
+      table.extra[c].push_back(csv::parse_double(fields[extra_at[c]], path, ln, table.extra_names[c]));
+    }
+    lines.push_back(ln);
+  }
+  if (!have_header) throw invalid_input("Rates file " + path.string() + " is empty: expected the header timestamp_ns,wx,wy,wz.");
+  if (table.t_ns.empty()) throw invalid_input("Rates file " + path.string() + " has a header but no rows.");
+  csv::check_timestamps(path, table.t_ns, lines, nullptr);
+  return table;
+}
+
+void write_rates_csv(const fs::path& path, const RatesTable& table) {
+  table.validate();
+  for (std::size_t i = 0; i < table.size(); ++i) {
+    bool finite = std::isfinite(table.w[i][0]) && std::isfinite(table.w[i][1]) && std::isfinite(table.w[i][2]);
+    for (const auto& col : table.extra) finite = finite && std::isfinite(col[i]);
+    if (!finite) {
+      throw invalid_input("Rates table row " + std::to_string(i) + " (timestamp " +
+                          std::to_string(table.t_ns[i]) + ") holds a non-finite value; refusing to write " +
+                          path.string() + ".");
+    }
+    if (i > 0 && table.t_ns[i] <= table.t_ns[i - 1]) {
+      throw invalid_input("Rates table row " + std::to_string(i) + ": timestamp " +
+                          std::to_string(table.t_ns[i]) + " does not follow " +
+                          std::to_string(table.t_ns[i - 1]) + "; refusing to write " + path.string() + ".");
+    }
+  }
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) throw invalid_input("Cannot open " + path.string() + " for writing.");
+  out << "timestamp_ns,wx,wy,wz";
+  for (const auto& name : table.extra_names) out << ',' << name;
+  out << '\n';
+  char buf[48];
+  for (std::size_t i = 0; i < table.size(); ++i) {
+    out << table.t_ns[i];
+    for (int k = 0; k < 3; ++k) {
+      std::snprintf(buf, sizeof buf, ",%.9g", table.w[i][k]);
+      out << buf;
+    }
+    for (const auto& col : table.extra) {
+      std::snprintf(buf, sizeof buf, ",%.9g", col[i]);
+      out << buf;
+    }
+    out << '\n';
+  }
+  out.flush();
+  if (!out) throw runtime_error("Writing " + path.string() + " failed (disk full?).");
+}
+
+}  // namespace inertialnet

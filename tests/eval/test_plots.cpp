@@ -1,0 +1,93 @@
+// PNG plots: written, decodable, of the requested size, with both curves / the bars drawn.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "eval/synthetic_euroc.hpp"
+#include "inertialnet/error.hpp"
+#include "inertialnet/plots.hpp"
+
+using namespace inertialnet;
+namespace te = inertialnet::testing_euroc;
+
+namespace {
+
+// Pixels close to a BGR colour (anti-aliasing blends the edges; the line's core keeps it).
+int count_colour(const cv::Mat& img, cv::Vec3b bgr, int tol = 30) {
+  int n = 0;
+  for (int y = 0; y < img.rows; ++y) {
+    for (int x = 0; x < img.cols; ++x) {
+      const cv::Vec3b p = img.at<cv::Vec3b>(y, x);
+      if (std::abs(p[0] - bgr[0]) <= tol && std::abs(p[1] - bgr[1]) <= tol && std::abs(p[2] - bgr[2]) <= tol) ++n;
+    }
+  }
+  return n;
+}
+
+}  // namespace
+
+TEST(Plots, RatesPlotHasBothCurves) {
+  te::TempDir dir("plots_rates");
+  std::vector<double> t;
+  std::vector<Vec3> p, g;
+  for (int i = 0; i < 400; ++i) {
+    t.push_back(0.05 * i);
+    g.push_back({0.5 * std::sin(0.3 * i * 0.05 * 6), 0.3 * std::cos(0.05 * i), -0.2});
+    p.push_back({g.back()[0] + 0.05, g.back()[1] * 0.9, -0.1});
+  }
+  const auto png = dir.path() / "rates.png";
+  plot_rates(png, t, p, g, "test: angular rate");
+  ASSERT_TRUE(std::filesystem::exists(png));
+  EXPECT_GT(std::filesystem::file_size(png), 10000u);
+  const cv::Mat img = cv::imread(png.string(), cv::IMREAD_COLOR);
+  ASSERT_FALSE(img.empty());
+  EXPECT_EQ(img.cols, 1600);
+  EXPECT_EQ(img.rows, 1000);
+  // Prediction red (40, 40, 215), gyro blue (160, 90, 20): several hundred pixels each.
+  EXPECT_GT(count_colour(img, {40, 40, 215}), 500);
+  EXPECT_GT(count_colour(img, {160, 90, 20}), 500);
+}
+
+TEST(Plots, HistogramPlotHasBars) {
+  te::TempDir dir("plots_hist");
+  std::array<Histogram, 3> h;
+  for (int k = 0; k < 3; ++k) {
+    std::vector<double> v;
+    for (int i = 0; i < 500; ++i) v.push_back(std::sin(i * 0.37 + k) * (3 + k));
+    h[k] = make_histogram(v, 21, -10, 10);
+  }
+  const auto png = dir.path() / "hist.png";
+  PlotStyle style;
+  style.width = 1200;
+  style.height = 500;
+  plot_error_histograms(png, h, "test: error", style);
+  const cv::Mat img = cv::imread(png.string(), cv::IMREAD_COLOR);
+  ASSERT_FALSE(img.empty());
+  EXPECT_EQ(img.cols, 1200);
+  EXPECT_EQ(img.rows, 500);
+  EXPECT_GT(count_colour(img, {190, 130, 60}, 10), 5000);  // filled bars
+}
+
+TEST(Plots, UnwritablePathsAndBadInputsAreErrors) {
+  te::TempDir dir("plots_err");
+  const std::vector<double> t = {0, 1};
+  const std::vector<Vec3> v = {{0, 0, 0}, {1, 1, 1}};
+  auto invalid = [](const std::function<void()>& f) {
+    try {
+      f();
+    } catch (const Error& e) {
+      return e.kind() == ErrorKind::InvalidInput;
+    }
+    return false;
+  };
+  EXPECT_TRUE(invalid([&] { plot_rates(dir.path() / "missing" / "x.png", t, v, v, "x"); }));
+  EXPECT_TRUE(invalid([&] { plot_rates(dir.path() / "x.unknown", t, v, v, "x"); }));
+  EXPECT_TRUE(invalid([&] { plot_rates(dir.path() / "x.png", t, {v[0]}, v, "x"); }));
+  PlotStyle tiny;
+  tiny.width = 10;
+  EXPECT_TRUE(invalid([&] { plot_rates(dir.path() / "x.png", t, v, v, "x", tiny); }));
+}

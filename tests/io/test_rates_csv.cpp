@@ -1,0 +1,135 @@
+// The rates CSV (timestamp_ns,wx,wy,wz[,extra…]): round trip and errors.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <functional>
+
+#include "eval/synthetic_euroc.hpp"
+#include "inertialnet/error.hpp"
+#include "inertialnet/rates_csv.hpp"
+
+using namespace inertialnet;
+namespace te = inertialnet::testing_euroc;
+
+namespace {
+
+std::string invalid_input_message(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::InvalidInput) << e.what();
+    return e.what();
+  }
+  ADD_FAILURE() << "expected an invalid_input error, nothing was thrown";
+  return {};
+}
+
+bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+
+std::filesystem::path write_text(const te::TempDir& dir, const std::string& text) {
+  const auto p = dir.path() / "rates.csv";
+  std::ofstream(p, std::ios::binary | std::ios::trunc) << text;
+  return p;
+}
+
+}  // namespace
+
+TEST(RatesCsv, RoundTripIsExactForFloats) {
+  te::TempDir dir("rates_rt");
+  RatesTable t;
+  t.extra_names = {"wx_geometric", "wy_geometric", "wz_geometric"};
+  t.extra.resize(3);
+  for (int i = 0; i < 50; ++i) {
+    t.t_ns.push_back(te::kStartNs + 50'000'000LL * (i + 1));
+    // Float values (what the network produces) with awkward mantissas and exponents.
+    const float a = 0.1f * static_cast<float>(i) - 1.234567f, b = 1e-7f * static_cast<float>(i * i + 1);
+    const float c = -3.0e3f / static_cast<float>(i + 3);
+    t.w.push_back({a, b, c});
+    t.extra[0].push_back(static_cast<float>(a * 0.5f));
+    t.extra[1].push_back(static_cast<float>(b + 1));
+    t.extra[2].push_back(static_cast<float>(-c));
+  }
+  const auto path = dir.path() / "rates.csv";
+  write_rates_csv(path, t);
+  const RatesTable r = read_rates_csv(path);
+  ASSERT_EQ(r.size(), t.size());
+  ASSERT_EQ(r.extra_names, t.extra_names);
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    EXPECT_EQ(r.t_ns[i], t.t_ns[i]);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_EQ(static_cast<float>(r.w[i][k]), static_cast<float>(t.w[i][k]));  // %.9g round-trips float
+      EXPECT_EQ(static_cast<float>(r.extra[k][i]), static_cast<float>(t.extra[k][i]));
+    }
+  }
+  const auto geo = r.rates("_geometric");
+  EXPECT_EQ(static_cast<float>(geo[3][2]), static_cast<float>(t.extra[2][3]));
+  EXPECT_EQ(r.column("wy")[4], r.w[4][1]);
+  EXPECT_TRUE(contains(invalid_input_message([&] { r.rates("_other"); }), "no column wx_other"));
+
+  std::ifstream in(path);
+  std::string header;
+  std::getline(in, header);
+  EXPECT_EQ(header, "timestamp_ns,wx,wy,wz,wx_geometric,wy_geometric,wz_geometric");
+}
+
+TEST(RatesCsv, TolerantReading) {
+  te::TempDir dir("rates_tol");
+  // Comments, spaces after commas, CRLF, columns in another order, a '#' header, blank lines.
+  const auto p = write_text(dir,
+      "# produced by a test\r\n#timestamp_ns, wz, wy, wx, conf\r\n"
+      "100, 3, 2, 1, 0.5\r\n\r\n200,6,5,4,0.25\r\n");
+  const RatesTable r = read_rates_csv(p);
+  ASSERT_EQ(r.size(), 2u);
+  EXPECT_EQ(r.w[1][0], 4.0);
+  EXPECT_EQ(r.w[1][2], 6.0);
+  EXPECT_EQ(r.extra_names, std::vector<std::string>{"conf"});
+  EXPECT_EQ(r.extra[0][0], 0.5);
+}
+
+TEST(RatesCsv, ReadingErrors) {
+  te::TempDir dir("rates_err");
+  auto msg = [&](const std::string& text) { return invalid_input_message([&] { read_rates_csv(write_text(dir, text)); }); };
+  EXPECT_TRUE(contains(msg(""), "empty"));
+  EXPECT_TRUE(contains(msg("time,wx,wy,wz\n1,0,0,0\n"), "expected the header"));
+  EXPECT_TRUE(contains(msg("timestamp_ns,wx,wy\n1,0,0\n"), "no column wz"));
+  EXPECT_TRUE(contains(msg("timestamp_ns,wx,wy,wz,wx\n1,0,0,0,0\n"), "appears twice"));
+  EXPECT_TRUE(contains(msg("timestamp_ns,wx,wy,wz\n"), "no rows"));
+  std::string m = msg("timestamp_ns,wx,wy,wz\n1,0,0,0\n2,0,0\n");
+  EXPECT_TRUE(contains(m, "line 3")) << m;
+  EXPECT_TRUE(contains(m, "expected 4 fields")) << m;
+  m = msg("timestamp_ns,wx,wy,wz\n1,0,0,0\n2,0,abc,0\n");
+  EXPECT_TRUE(contains(m, "line 3: wy should be a number, found \"abc\"")) << m;
+  m = msg("timestamp_ns,wx,wy,wz\n1,0,0,nan\n");
+  EXPECT_TRUE(contains(m, "finite")) << m;
+  m = msg("timestamp_ns,wx,wy,wz\n1.5,0,0,0\n");
+  EXPECT_TRUE(contains(m, "timestamp_ns should be an integer")) << m;
+  m = msg("timestamp_ns,wx,wy,wz\n5,0,0,0\n4,0,0,0\n");
+  EXPECT_TRUE(contains(m, "line 3")) << m;
+  EXPECT_TRUE(contains(m, "line 2")) << m;
+  m = msg("timestamp_ns,wx,wy,wz\n5,0,0,0\n5,0,0,0\n");
+  EXPECT_TRUE(contains(m, "repeats")) << m;
+  EXPECT_TRUE(contains(invalid_input_message([&] { read_rates_csv(dir.path() / "absent.csv"); }), "does not exist"));
+}
+
+TEST(RatesCsv, WriterRefusesBadTables) {
+  te::TempDir dir("rates_w");
+  const auto p = dir.path() / "out.csv";
+  RatesTable t;
+  t.t_ns = {1, 2};
+  t.w = {{0, 0, 0}, {0, std::nan(""), 0}};
+  EXPECT_TRUE(contains(invalid_input_message([&] { write_rates_csv(p, t); }), "non-finite"));
+  t.w[1][1] = 0;
+  t.t_ns[1] = 1;
+  EXPECT_TRUE(contains(invalid_input_message([&] { write_rates_csv(p, t); }), "does not follow"));
+  t.t_ns[1] = 2;
+  t.extra_names = {"a,b"};
+  t.extra = {{0, 0}};
+  EXPECT_TRUE(contains(invalid_input_message([&] { write_rates_csv(p, t); }), "commas"));
+  t.extra_names = {"wx"};
+  EXPECT_TRUE(contains(invalid_input_message([&] { write_rates_csv(p, t); }), "appears twice"));
+  t.extra_names = {"conf"};
+  t.extra = {{0}};
+  EXPECT_TRUE(contains(invalid_input_message([&] { write_rates_csv(p, t); }), "1 values for 2 rows"));
+  EXPECT_TRUE(contains(invalid_input_message([&] { write_rates_csv(dir.path() / "no" / "dir.csv", RatesTable{}); }),
+                       "Cannot open"));
+}
