@@ -1,0 +1,201 @@
+// Loading frames into planar RGB floats: bit depths, channel layouts and broken files.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "inertialnet/error.hpp"
+#include "inertialnet/image_io.hpp"
+#include "support/testing.hpp"
+
+using namespace inertialnet;
+namespace fs = std::filesystem;
+namespace it = inertialnet::testing;
+
+namespace {
+
+std::string invalid_input_message(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::InvalidInput) << e.what();
+    return e.what();
+  }
+  ADD_FAILURE() << "expected an invalid_input error, nothing was thrown";
+  return {};
+}
+
+bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+
+std::vector<char> read_bytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::vector<char>((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+fs::path write_prefix(const fs::path& from, const fs::path& to, std::size_t bytes) {
+  const auto all = read_bytes(from);
+  std::ofstream(to, std::ios::binary | std::ios::trunc).write(all.data(), static_cast<std::streamsize>(bytes));
+  return to;
+}
+
+// A 5x3 colour image whose B, G, R values encode position and channel, so that any swap or
+// transposition shows.
+cv::Mat pattern_bgr8() {
+  cv::Mat m(3, 5, CV_8UC3);
+  for (int y = 0; y < 3; ++y) {
+    for (int x = 0; x < 5; ++x) m.at<cv::Vec3b>(y, x) = cv::Vec3b(static_cast<std::uint8_t>(10 * y + x),  // B
+                                                                  static_cast<std::uint8_t>(100 + 10 * y + x),  // G
+                                                                  static_cast<std::uint8_t>(200 + 10 * y + x));  // R
+  }
+  return m;
+}
+
+class ImageIo : public ::testing::Test {
+ protected:
+  fs::path dir = it::temporary_directory("image_io");
+};
+
+}  // namespace
+
+TEST_F(ImageIo, ColourPngBecomesPlanarRgb) {
+  ASSERT_TRUE(cv::imwrite((dir / "c.png").string(), pattern_bgr8()));
+  const HostImage img = load_rgb_image(dir / "c.png");
+  ASSERT_EQ(img.width, 5);
+  ASSERT_EQ(img.height, 3);
+  ASSERT_EQ(img.data.size(), 3u * 15u);
+  for (int y = 0; y < 3; ++y) {
+    for (int x = 0; x < 5; ++x) {
+      EXPECT_EQ(img.at(0, y, x), 200 + 10 * y + x) << x << "," << y;  // R plane first
+      EXPECT_EQ(img.at(1, y, x), 100 + 10 * y + x) << x << "," << y;
+      EXPECT_EQ(img.at(2, y, x), 10 * y + x) << x << "," << y;
+    }
+  }
+  // Planar layout: the G plane starts right after the 15 R values.
+  EXPECT_EQ(img.data[15], 100.0f);
+  EXPECT_EQ(img.data[1], 201.0f);
+}
+
+TEST_F(ImageIo, GrayscaleIsReplicatedIntoThreeChannels) {
+  cv::Mat gray(2, 4, CV_8UC1);
+  for (int i = 0; i < 8; ++i) gray.at<std::uint8_t>(i / 4, i % 4) = static_cast<std::uint8_t>(30 * i + 1);
+  ASSERT_TRUE(cv::imwrite((dir / "g.png").string(), gray));
+  const HostImage img = load_rgb_image(dir / "g.png");
+  ASSERT_EQ(img.width, 4);
+  ASSERT_EQ(img.height, 2);
+  for (int i = 0; i < 8; ++i) {
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(img.at(c, i / 4, i % 4), 30 * i + 1) << "pixel " << i << " channel " << c;
+  }
+}
+
+TEST_F(ImageIo, AlphaIsDropped) {
+  cv::Mat bgra(1, 2, CV_8UC4);
+  bgra.at<cv::Vec4b>(0, 0) = cv::Vec4b(1, 2, 3, 0);
+  bgra.at<cv::Vec4b>(0, 1) = cv::Vec4b(4, 5, 6, 128);
+  ASSERT_TRUE(cv::imwrite((dir / "a.png").string(), bgra));
+  const HostImage img = load_rgb_image(dir / "a.png");
+  ASSERT_EQ(img.data.size(), 6u);
+  EXPECT_EQ(img.data, (std::vector<float>{3, 6, 2, 5, 1, 4}));  // R plane, G plane, B plane
+}
+
+TEST_F(ImageIo, SixteenBitIsScaledTo0To255) {
+  cv::Mat m(1, 3, CV_16UC3);
+  m.at<cv::Vec3w>(0, 0) = cv::Vec3w(0, 257, 65535);
+  m.at<cv::Vec3w>(0, 1) = cv::Vec3w(257 * 100, 257 * 7, 257 * 254);
+  m.at<cv::Vec3w>(0, 2) = cv::Vec3w(1000, 128, 65534);
+  ASSERT_TRUE(cv::imwrite((dir / "w.png").string(), m));
+  const HostImage img = load_rgb_image(dir / "w.png");
+  ASSERT_EQ(img.width, 3);
+  EXPECT_EQ(img.at(0, 0, 0), 255.0f);
+  EXPECT_EQ(img.at(1, 0, 0), 1.0f);
+  EXPECT_EQ(img.at(2, 0, 0), 0.0f);
+  EXPECT_EQ(img.at(0, 0, 1), 254.0f);
+  EXPECT_EQ(img.at(1, 0, 1), 7.0f);
+  EXPECT_EQ(img.at(2, 0, 1), 100.0f);
+  // Values between the multiples of 257 keep their fraction (float32 of the exact quotient).
+  EXPECT_FLOAT_EQ(img.at(0, 0, 2), 65534.0f / 257.0f);
+  EXPECT_FLOAT_EQ(img.at(2, 0, 2), 1000.0f / 257.0f);
+
+  cv::Mat gray16(1, 2, CV_16UC1);
+  gray16.at<std::uint16_t>(0, 0) = 65535;
+  gray16.at<std::uint16_t>(0, 1) = 257 * 3;
+  ASSERT_TRUE(cv::imwrite((dir / "g16.png").string(), gray16));
+  const HostImage g = load_rgb_image(dir / "g16.png");
+  EXPECT_EQ(g.data, (std::vector<float>{255, 3, 255, 3, 255, 3}));
+}
+
+TEST_F(ImageIo, JpegLoadsAndATruncatedJpegIsRejected) {
+  cv::Mat m(48, 64, CV_8UC3, cv::Scalar(40, 120, 220));  // B, G, R
+  ASSERT_TRUE(cv::imwrite((dir / "j.jpg").string(), m));
+  const HostImage img = load_rgb_image(dir / "j.jpg");
+  ASSERT_EQ(img.width, 64);
+  ASSERT_EQ(img.height, 48);
+  // JPEG is lossy and subsamples chroma; a flat colour survives within a few levels.
+  EXPECT_NEAR(img.at(0, 20, 30), 220, 4);
+  EXPECT_NEAR(img.at(1, 20, 30), 120, 4);
+  EXPECT_NEAR(img.at(2, 20, 30), 40, 4);
+
+  // OpenCV decodes a cut JPEG into a grey-filled image with only a warning: it must not pass.
+  const auto size = fs::file_size(dir / "j.jpg");
+  for (std::size_t keep : {static_cast<std::size_t>(size / 2), static_cast<std::size_t>(size - 2)}) {
+    const auto cut = write_prefix(dir / "j.jpg", dir / ("cut" + std::to_string(keep) + ".jpg"), keep);
+    const std::string m1 = invalid_input_message([&] { load_rgb_image(cut); });
+    EXPECT_TRUE(contains(m1, cut.string()) && contains(m1, "truncated")) << m1;
+  }
+}
+
+TEST_F(ImageIo, TruncatedPngIsRejected) {
+  cv::Mat noise(64, 64, CV_8UC3);
+  cv::randu(noise, 0, 255);  // incompressible, so half the file cuts into the pixel data
+  ASSERT_TRUE(cv::imwrite((dir / "n.png").string(), noise));
+  const auto size = fs::file_size(dir / "n.png");
+  for (std::size_t keep : {static_cast<std::size_t>(size / 2), static_cast<std::size_t>(size - 12)}) {
+    const auto cut = write_prefix(dir / "n.png", dir / ("cut" + std::to_string(keep) + ".png"), keep);
+    const std::string m = invalid_input_message([&] { load_rgb_image(cut); });
+    EXPECT_TRUE(contains(m, cut.string()) && contains(m, "truncated")) << m;
+  }
+}
+
+TEST_F(ImageIo, MissingUnreadableAndForeignFilesNameTheFile) {
+  const std::string missing = invalid_input_message([&] { load_rgb_image(dir / "absent.png"); });
+  EXPECT_TRUE(contains(missing, "absent.png") && contains(missing, "does not exist")) << missing;
+
+  const std::string directory = invalid_input_message([&] { load_rgb_image(dir); });
+  EXPECT_TRUE(contains(directory, "not a regular file")) << directory;
+
+  std::ofstream(dir / "empty.png").close();
+  const std::string empty = invalid_input_message([&] { load_rgb_image(dir / "empty.png"); });
+  EXPECT_TRUE(contains(empty, "empty.png") && contains(empty, "is empty")) << empty;
+
+  std::ofstream(dir / "text.png") << "this is not an image\n";
+  const std::string text = invalid_input_message([&] { load_rgb_image(dir / "text.png"); });
+  EXPECT_TRUE(contains(text, "text.png") && contains(text, "cannot be decoded")) << text;
+
+  // A PNG whose pixel data is corrupt but complete: the structure passes, decoding must not.
+  cv::Mat noise(32, 32, CV_8UC3);
+  cv::randu(noise, 0, 255);
+  ASSERT_TRUE(cv::imwrite((dir / "n.png").string(), noise));
+  auto bytes = read_bytes(dir / "n.png");
+  for (std::size_t i = 60; i < 160 && i < bytes.size(); ++i) bytes[i] = static_cast<char>(bytes[i] ^ 0x5A);
+  std::ofstream(dir / "corrupt.png", std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  const std::string corrupt = invalid_input_message([&] { load_rgb_image(dir / "corrupt.png"); });
+  EXPECT_TRUE(contains(corrupt, "corrupt.png")) << corrupt;
+}
+
+TEST_F(ImageIo, FloatImagesAreRefused) {
+  cv::Mat f(4, 4, CV_32FC1, cv::Scalar(0.5));
+  bool written = false;
+  try {
+    written = cv::imwrite((dir / "f.tiff").string(), f);
+  } catch (const cv::Exception&) {
+  }
+  if (!written) GTEST_SKIP() << "this OpenCV build cannot write float TIFF";
+  const std::string m = invalid_input_message([&] { load_rgb_image(dir / "f.tiff"); });
+  EXPECT_TRUE(contains(m, "f.tiff") && contains(m, "32-bit float")) << m;
+}
