@@ -97,6 +97,8 @@ class Queue {
   Device& device() const noexcept { return device_; }
   cl_command_queue handle() const noexcept { return queue_.get(); }
   bool profiling() const noexcept { return profiling_; }
+  // This queue's own buffer pool (see Tensor::empty(Queue&, …)).
+  BufferPool& buffers() noexcept { return *buffers_; }
 
   // The kernel `name` of the embedded family `family` built with `defines`; created once per
   // queue and reused.
@@ -118,6 +120,7 @@ class Queue {
   Device& device_;
   bool profiling_;
   QueueHandle queue_;
+  std::unique_ptr<BufferPool> buffers_;
   std::map<std::string, std::unique_ptr<Kernel>> kernels_;
 };
 

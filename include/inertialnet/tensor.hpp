@@ -26,10 +26,19 @@ std::int64_t element_count(const Shape& shape);
 class Tensor {
  public:
   Tensor() = default;
-  // An uninitialised tensor from the device's buffer pool. Zero or negative sizes are refused.
+  // An uninitialised tensor from the device's buffer pool, for long-lived tensors (weights,
+  // planned arenas). Zero or negative sizes are refused.
   static Tensor empty(Device& device, const Shape& shape);
+  // An uninitialised tensor from `queue`'s own pool: for temporaries and results of work
+  // enqueued on that queue. When such a tensor is released while kernels using it are still
+  // pending, its buffer can only be handed out again on the same in-order queue, after them;
+  // a shared pool could give it to another queue and let two queues write one buffer.
+  static Tensor empty(Queue& queue, const Shape& shape);
   // A tensor holding `data` (row-major, element_count(shape) values); blocking upload.
   static Tensor from_host(Queue& queue, const Shape& shape, const std::vector<float>& data);
+
+  // A tensor over a whole buffer (which must hold at least element_count(shape) floats).
+  static Tensor wrap(std::shared_ptr<Buffer> buffer, const Shape& shape);
 
   const Shape& shape() const noexcept { return shape_; }
   int rank() const noexcept { return static_cast<int>(shape_.size()); }
@@ -56,6 +65,9 @@ class Tensor {
   Tensor sample(std::int64_t index) const;
   // The same elements under another shape; contiguous tensors only.
   Tensor reshaped(const Shape& shape) const;
+  // A contiguous tensor of `shape` over elements [first, first + numel) of this contiguous
+  // tensor: how planned activations are carved out of one arena.
+  Tensor region(std::size_t first, const Shape& shape) const;
 
   // Blocking transfers of all elements in logical (row-major) order.
   void upload(Queue& queue, const float* data, std::size_t count);

@@ -33,9 +33,11 @@ Queue::Queue(Device& device, bool profiling) : device_(device), profiling_(profi
   const cl_command_queue_properties properties = profiling ? CL_QUEUE_PROFILING_ENABLE : 0;
   queue_ = QueueHandle(clCreateCommandQueue(device.context(), device.id(), properties, &status));
   check_cl(status, "clCreateCommandQueue", device.site());
+  buffers_ = std::make_unique<BufferPool>(device.context(), device.info().name, device.info().max_alloc_bytes);
 }
 
 Queue::~Queue() {
+  // Pending work may still use buffers of this queue's pool: drain before they are freed.
   if (queue_) clFinish(queue_.get());
 }
 

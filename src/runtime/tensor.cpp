@@ -22,7 +22,8 @@ std::int64_t element_count(const Shape& shape) {
   return shape.empty() ? 0 : count;
 }
 
-Tensor Tensor::empty(Device& device, const Shape& shape) {
+namespace {
+Tensor allocate(BufferPool& pool, const Shape& shape) {
   if (shape.empty()) throw invalid_input("a tensor needs at least one dimension");
   for (const auto d : shape) {
     if (d <= 0) throw invalid_input("tensor shape " + to_string(shape) + " has a zero or negative size");
@@ -31,15 +32,24 @@ Tensor Tensor::empty(Device& device, const Shape& shape) {
   if (count > std::numeric_limits<int>::max()) {
     throw invalid_input("tensor shape " + to_string(shape) + " has more than 2^31 elements");
   }
+  return Tensor::wrap(pool.acquire(static_cast<std::size_t>(count) * sizeof(float)), shape);
+}
+}  // namespace
+
+Tensor Tensor::wrap(std::shared_ptr<Buffer> buffer, const Shape& shape) {
   Tensor tensor;
   tensor.shape_ = shape;
-  tensor.buffer_ = device.buffers().acquire(static_cast<std::size_t>(count) * sizeof(float));
+  tensor.buffer_ = std::move(buffer);
   tensor.batch_stride_ = tensor.sample_size();
   return tensor;
 }
 
+Tensor Tensor::empty(Device& device, const Shape& shape) { return allocate(device.buffers(), shape); }
+
+Tensor Tensor::empty(Queue& queue, const Shape& shape) { return allocate(queue.buffers(), shape); }
+
 Tensor Tensor::from_host(Queue& queue, const Shape& shape, const std::vector<float>& data) {
-  Tensor tensor = empty(queue.device(), shape);
+  Tensor tensor = empty(queue, shape);
   tensor.upload(queue, data.data(), data.size());
   return tensor;
 }
@@ -106,6 +116,20 @@ Tensor Tensor::reshaped(const Shape& shape) const {
   if (!contiguous()) throw invalid_input("cannot reshape the non-contiguous view " + to_string(shape_));
   Tensor view = *this;
   view.shape_ = shape;
+  view.batch_stride_ = view.sample_size();
+  return view;
+}
+
+Tensor Tensor::region(std::size_t first, const Shape& shape) const {
+  if (!contiguous()) throw invalid_input("cannot carve a region out of the non-contiguous view " + to_string(shape_));
+  const auto count = element_count(shape);
+  if (count <= 0 || first + static_cast<std::size_t>(count) > static_cast<std::size_t>(numel())) {
+    throw invalid_input("region " + to_string(shape) + " at element " + std::to_string(first) +
+                        " does not fit a tensor of " + std::to_string(numel()) + " elements");
+  }
+  Tensor view = *this;
+  view.shape_ = shape;
+  view.offset_ = offset_ + first;
   view.batch_stride_ = view.sample_size();
   return view;
 }
