@@ -1,0 +1,97 @@
+// Helpers shared by the host code of the memory-bound ops (elementwise, concat, pool, normalize,
+// dropout): work-group sizes, aliasing checks and the two-level (sample, batch) launch layout
+// that lets every tensor be a channel slice.
+#pragma once
+
+#include <cstddef>
+#include <initializer_list>
+#include <string>
+
+#include "inertialnet/device.hpp"
+#include "inertialnet/error.hpp"
+#include "inertialnet/tensor.hpp"
+
+namespace inertialnet::detail {
+
+// A power-of-two work-group size no larger than `wanted` nor the device's limit; reductions
+// need a power of two, and the same rule keeps the other kernels' variants few.
+inline std::size_t work_group_size(const Device& device, std::size_t wanted = 256) {
+  std::size_t limit = device.info().max_work_group_size;
+  if (limit == 0) limit = 1;
+  std::size_t size = 1;
+  while (size * 2 <= wanted && size * 2 <= limit) size *= 2;
+  return size;
+}
+
+// True when some element of `a` and some element of `b` share storage. Views are sets of
+// per-sample intervals [offset + n·batch_stride, … + sample_size), so interleaved channel slices
+// of one tensor are correctly found disjoint.
+inline bool views_overlap(const Tensor& a, const Tensor& b) {
+  if (!a.defined() || !b.defined() || a.buffer() != b.buffer()) return false;
+  const std::size_t sa = a.sample_size(), sb = b.sample_size();
+  for (std::int64_t i = 0; i < a.dim(0); ++i) {
+    const std::size_t a0 = a.offset() + static_cast<std::size_t>(i) * a.batch_stride();
+    for (std::int64_t j = 0; j < b.dim(0); ++j) {
+      const std::size_t b0 = b.offset() + static_cast<std::size_t>(j) * b.batch_stride();
+      if (a0 < b0 + sb && b0 < a0 + sa) return true;
+    }
+  }
+  return false;
+}
+
+// The same elements in the same order: the one kind of aliasing an elementwise kernel tolerates.
+inline bool same_view(const Tensor& a, const Tensor& b) {
+  return a.buffer() == b.buffer() && a.offset() == b.offset() && a.shape() == b.shape() &&
+         (a.batch_stride() == b.batch_stride() || a.dim(0) == 1);
+}
+
+inline void require_defined(const Tensor& t, const std::string& op, const std::string& role) {
+  if (!t.defined()) throw invalid_input(op + ": the " + role + " tensor is empty (no storage)");
+}
+
+inline void require_rank4(const Tensor& t, const std::string& op, const std::string& role) {
+  require_defined(t, op, role);
+  if (t.rank() != 4) {
+    throw invalid_input(op + ": the " + role + " must be an NCHW tensor (rank 4), got shape " + to_string(t.shape()));
+  }
+}
+
+// An output may be the very same view as an input (in-place update) but must not partly
+// overlap it: work-items would read elements another one already overwrote.
+inline void require_no_partial_alias(const Tensor& output, const Tensor& input, const std::string& op,
+                                     const std::string& input_role, bool in_place_allowed) {
+  if (!views_overlap(output, input)) return;
+  if (in_place_allowed && same_view(output, input)) return;
+  throw invalid_input(op + ": the output overlaps the " + input_role +
+                      (in_place_allowed ? " without being the same view (only exact in-place updates are allowed)"
+                                        : " (this op cannot run in place)"));
+}
+
+// How an elementwise kernel walks its tensors: `batch` rows of `sample` elements, row n of a
+// tensor starting at offset + n·stride. When every tensor is contiguous the batch is folded into
+// one long row (fewer, fuller work-groups for small samples).
+struct RowLayout {
+  int sample = 0;
+  int batch = 0;
+  bool folded = false;
+  int stride(const Tensor& t) const { return folded ? sample : static_cast<int>(t.batch_stride()); }
+};
+
+inline RowLayout row_layout(std::initializer_list<const Tensor*> tensors) {
+  bool all_contiguous = true;
+  const Tensor& first = **tensors.begin();
+  for (const Tensor* t : tensors) all_contiguous = all_contiguous && t->contiguous();
+  RowLayout layout;
+  if (all_contiguous) {
+    layout.sample = static_cast<int>(first.numel());
+    layout.batch = 1;
+    layout.folded = true;
+  } else {
+    layout.sample = static_cast<int>(first.sample_size());
+    layout.batch = static_cast<int>(first.dim(0));
+  }
+  for (const Tensor* t : tensors) t->offset_int();  // every view must fit 32-bit indexing
+  return layout;
+}
+
+}  // namespace inertialnet::detail

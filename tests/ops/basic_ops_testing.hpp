@@ -1,0 +1,89 @@
+// Helpers for the suites of the memory-bound ops: views that are channel slices of a larger,
+// randomly filled tensor (to check that ops read and write only their view), exact comparison
+// and invalid-input expectations.
+#pragma once
+
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "support/testing.hpp"
+
+namespace inertialnet::testing {
+
+// `view` is channels [first, first + shape[1]) of `whole` = [N, shape[1] + extra, …], which is
+// filled with random values recorded in `original`.
+struct Sliced {
+  Tensor whole;
+  Tensor view;
+  std::vector<float> original;
+  std::int64_t first = 0;
+};
+
+inline Sliced make_sliced(Queue& queue, Shape shape, std::int64_t first, std::int64_t extra, std::uint32_t seed,
+                          float lo = -1.0f, float hi = 1.0f) {
+  Sliced s;
+  Shape whole_shape = shape;
+  whole_shape[1] += extra;
+  s.original = random_vector(static_cast<std::size_t>(element_count(whole_shape)), seed, lo, hi);
+  s.whole = Tensor::from_host(queue, whole_shape, s.original);
+  s.view = s.whole.channels(first, shape[1]);
+  s.first = first;
+  return s;
+}
+
+// A contiguous tensor, or a channel slice (2 channels before, 3 after) of a larger one.
+inline Sliced make_tensor(Queue& queue, const Shape& shape, bool sliced, std::uint32_t seed, float lo = -1.0f,
+                          float hi = 1.0f) {
+  return sliced ? make_sliced(queue, shape, 2, 5, seed, lo, hi) : make_sliced(queue, shape, 0, 0, seed, lo, hi);
+}
+
+// Equal values (NaN equal to NaN), reporting the first difference.
+inline ::testing::AssertionResult exactly_equal(const std::vector<float>& actual, const std::vector<float>& expected) {
+  if (actual.size() != expected.size()) {
+    return ::testing::AssertionFailure() << "sizes differ: " << actual.size() << " vs " << expected.size();
+  }
+  for (std::size_t i = 0; i < actual.size(); ++i) {
+    const bool both_nan = std::isnan(actual[i]) && std::isnan(expected[i]);
+    if (!both_nan && actual[i] != expected[i]) {
+      return ::testing::AssertionFailure() << "first difference at index " << i << ": got " << actual[i] << ", expected "
+                                           << expected[i];
+    }
+  }
+  return ::testing::AssertionSuccess();
+}
+
+// The elements of `s.whole` outside the view still hold their original values.
+inline ::testing::AssertionResult untouched_outside(Queue& queue, const Sliced& s) {
+  const auto now = s.whole.to_host(queue);
+  const std::int64_t n = s.whole.dim(0), channels = s.whole.dim(1);
+  const std::int64_t inner = s.whole.numel() / (n * channels);
+  for (std::int64_t b = 0; b < n; ++b) {
+    for (std::int64_t c = 0; c < channels; ++c) {
+      if (c >= s.first && c < s.first + s.view.dim(1)) continue;
+      for (std::int64_t p = 0; p < inner; ++p) {
+        const auto i = static_cast<std::size_t>((b * channels + c) * inner + p);
+        if (std::memcmp(&now[i], &s.original[i], sizeof(float)) != 0) {
+          return ::testing::AssertionFailure() << "element (" << b << ", " << c << ", +" << p
+                                               << ") outside the view changed from " << s.original[i] << " to " << now[i];
+        }
+      }
+    }
+  }
+  return ::testing::AssertionSuccess();
+}
+
+// `call` throws Error(InvalidInput) whose message contains `needle`.
+template <class Call>
+void expect_invalid_input(Call&& call, const std::string& needle) {
+  try {
+    call();
+    ADD_FAILURE() << "accepted; expected an invalid_input mentioning '" << needle << "'";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::InvalidInput) << e.what();
+    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << "message: " << e.what();
+  }
+}
+
+}  // namespace inertialnet::testing
