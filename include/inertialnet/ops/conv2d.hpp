@@ -1,0 +1,52 @@
+// 2-D convolution (PyTorch Conv2d semantics, dilation 1, groups 1) through im2col + CLBlast GEMM,
+// with the bias and the activation fused into one pass after the GEMM.
+//
+// Per sample: the input is unfolded into a [ci·kh·kw, Ho·Wo] column matrix (a pooled temporary
+// of one sample's size, so memory stays bounded at any batch), then output = W · columns with W
+// the [co, ci·kh·kw] weight matrix, written straight into the output sample. 1×1 convolutions of
+// stride 1 without padding skip the unfolding: the input sample already is the column matrix.
+//
+// Tensors are NCHW; input and output may be views (channel slices of a larger tensor, whose
+// batch stride exceeds one sample): the output is written only inside its view, so producers
+// fill FlowNet's concatenations in place. Input and output must not overlap.
+#pragma once
+
+#include <cstddef>
+
+#include "inertialnet/ops/activation.hpp"
+#include "inertialnet/queue.hpp"
+#include "inertialnet/tensor.hpp"
+
+namespace inertialnet {
+
+struct Conv2dOptions {
+  int stride = 1;
+  int padding = 0;  // zeros on every side
+  ActivationSpec activation{};
+  // Largest unfolded-column temporary, in floats; 0 is the default budget (32 Mi floats, or less
+  // where the device's largest allocation is smaller). Above it, a sample is processed a range
+  // of output pixels at a time.
+  std::size_t max_column_floats = 0;
+};
+
+// The output shape [N, co, Ho, Wo] of `input` [N, ci, H, W] convolved with `weight`
+// [co, ci, kh, kw]: Ho = (H + 2·padding − kh) / stride + 1. Throws invalid_input when the
+// shapes do not fit together or the output would be empty.
+Shape conv2d_output_shape(const Shape& input, const Shape& weight, int stride, int padding);
+
+// output = activation(conv(input, weight) + bias). `bias` is [co], or an undefined Tensor for
+// none. `output` must have exactly conv2d_output_shape(...); it is written, not accumulated.
+void conv2d(Queue& queue, const Tensor& input, const Tensor& weight, const Tensor& bias, const Tensor& output,
+            const Conv2dOptions& options);
+
+// The same into a new tensor.
+Tensor conv2d(Queue& queue, const Tensor& input, const Tensor& weight, const Tensor& bias,
+              const Conv2dOptions& options);
+
+// The epilogue of the GEMM-based ops, in place: x[n, c, …] = activation(x[n, c, …] + bias[c])
+// for every channel c of dimension 1 (for a rank-2 tensor [N, F] the features are the
+// channels). `bias` may be undefined (activation only); with neither, nothing is enqueued.
+// `x` may be a channel slice.
+void add_bias_activation(Queue& queue, const Tensor& x, const Tensor& bias, const ActivationSpec& activation);
+
+}  // namespace inertialnet

@@ -1,0 +1,41 @@
+// 2-D transposed convolution (PyTorch ConvTranspose2d semantics, output_padding 0, dilation 1,
+// groups 1): FlowNet's 4×4 / stride 2 / padding 1 up-convolutions, any kernel, stride, padding.
+//
+// Per sample: columns = Wᵀ · X, a GEMM of the [ci, co·kh·kw] weight matrix (transposed) with the
+// [ci, H·W] input, then col2im gathers, for every output pixel, the column entries that land on
+// it (no atomics, deterministic), adds the bias and applies the activation in the same pass.
+// The columns are a pooled temporary of one sample's size.
+//
+// Input and output may be channel slices of larger tensors; they must not overlap.
+#pragma once
+
+#include <cstddef>
+
+#include "inertialnet/ops/activation.hpp"
+#include "inertialnet/queue.hpp"
+#include "inertialnet/tensor.hpp"
+
+namespace inertialnet {
+
+struct ConvTranspose2dOptions {
+  int stride = 2;
+  int padding = 1;
+  ActivationSpec activation{};
+  // Largest column temporary, in floats; 0 is the default budget (32 Mi floats, or less where
+  // the device's largest allocation is smaller). Above it, a sample is processed a block of
+  // output channels at a time.
+  std::size_t max_column_floats = 0;
+};
+
+// [N, co, Ho, Wo] for `input` [N, ci, H, W] and `weight` [ci, co, kh, kw]:
+// Ho = (H − 1)·stride − 2·padding + kh. Throws invalid_input when the shapes do not fit.
+Shape conv_transpose2d_output_shape(const Shape& input, const Shape& weight, int stride, int padding);
+
+// output = activation(conv_transpose(input, weight) + bias); `bias` is [co] or undefined.
+void conv_transpose2d(Queue& queue, const Tensor& input, const Tensor& weight, const Tensor& bias,
+                      const Tensor& output, const ConvTranspose2dOptions& options);
+
+Tensor conv_transpose2d(Queue& queue, const Tensor& input, const Tensor& weight, const Tensor& bias,
+                        const ConvTranspose2dOptions& options);
+
+}  // namespace inertialnet

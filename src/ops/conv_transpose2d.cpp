@@ -1,0 +1,147 @@
+#include "inertialnet/ops/conv_transpose2d.hpp"
+
+#include <algorithm>
+#include <cstdint>
+#include <string>
+
+#include "inertialnet/device.hpp"
+#include "inertialnet/ops/gemm.hpp"
+
+namespace inertialnet {
+
+namespace {
+
+// The GEMM's columns ([co·kh·kw, H·W] per sample) are a pooled temporary; at 512×384 the largest
+// is FlowNetFusion deconv0's 16·16 × 192·256 ≈ 12.6 M floats. Beyond this budget (or the device's
+// largest allocation) a sample is processed a block of output channels at a time.
+constexpr std::size_t kColumnBudgetFloats = std::size_t(32) << 20;
+
+std::size_t column_budget(const Device& device, std::size_t requested) {
+  const std::size_t max_alloc = static_cast<std::size_t>(device.info().max_alloc_bytes / sizeof(float));
+  const std::size_t budget = requested ? requested : kColumnBudgetFloats;
+  return max_alloc ? std::min(budget, max_alloc) : budget;
+}
+
+std::size_t group_width(const Device& device) {
+  const std::size_t max = device.info().max_work_group_size;
+  return max ? std::min<std::size_t>(64, max) : 1;
+}
+
+void require_defined(const Tensor& t, const char* what) {
+  if (!t.defined()) throw invalid_input(std::string("conv_transpose2d: the ") + what + " tensor is undefined (empty)");
+}
+
+}  // namespace
+
+Shape conv_transpose2d_output_shape(const Shape& input, const Shape& weight, int stride, int padding) {
+  if (input.size() != 4) {
+    throw invalid_input("conv_transpose2d: the input must be NCHW (rank 4), got shape " + to_string(input));
+  }
+  if (weight.size() != 4) {
+    throw invalid_input("conv_transpose2d: the weight must be [ci, co, kh, kw] (rank 4), got shape " +
+                        to_string(weight));
+  }
+  for (const auto d : input) {
+    if (d <= 0) {
+      throw invalid_input("conv_transpose2d: the input shape " + to_string(input) + " has a zero or negative size");
+    }
+  }
+  for (const auto d : weight) {
+    if (d <= 0) {
+      throw invalid_input("conv_transpose2d: the weight shape " + to_string(weight) + " has a zero or negative size");
+    }
+  }
+  if (stride < 1) throw invalid_input("conv_transpose2d: the stride must be at least 1, got " + std::to_string(stride));
+  if (padding < 0) {
+    throw invalid_input("conv_transpose2d: the padding must not be negative, got " + std::to_string(padding));
+  }
+  if (input[1] != weight[0]) {
+    throw invalid_input("conv_transpose2d: the input has " + std::to_string(input[1]) + " channels (shape " +
+                        to_string(input) + ") but the weight " + to_string(weight) + " expects " +
+                        std::to_string(weight[0]) + " (ConvTranspose2d weights are [ci, co, kh, kw])");
+  }
+  const std::int64_t out_h = (input[2] - 1) * stride - 2 * std::int64_t{padding} + weight[2];
+  const std::int64_t out_w = (input[3] - 1) * stride - 2 * std::int64_t{padding} + weight[3];
+  if (out_h <= 0 || out_w <= 0) {
+    throw invalid_input("conv_transpose2d: the input " + to_string(input) + " with weight " + to_string(weight) +
+                        ", stride " + std::to_string(stride) + " and padding " + std::to_string(padding) +
+                        " gives an empty output");
+  }
+  return {input[0], weight[1], out_h, out_w};
+}
+
+void conv_transpose2d(Queue& queue, const Tensor& input, const Tensor& weight, const Tensor& bias,
+                      const Tensor& output, const ConvTranspose2dOptions& options) {
+  require_defined(input, "input");
+  require_defined(weight, "weight");
+  require_defined(output, "output");
+  const Shape expected = conv_transpose2d_output_shape(input.shape(), weight.shape(), options.stride, options.padding);
+  if (!weight.contiguous()) {
+    throw invalid_input("conv_transpose2d: the weight " + to_string(weight.shape()) + " must be contiguous");
+  }
+  if (bias.defined() && (bias.rank() != 1 || bias.dim(0) != weight.dim(1))) {
+    throw invalid_input("conv_transpose2d: the bias has shape " + to_string(bias.shape()) + ", expected [" +
+                        std::to_string(weight.dim(1)) + "] for the weight " + to_string(weight.shape()));
+  }
+  if (output.shape() != expected) {
+    throw invalid_input("conv_transpose2d: the output has shape " + to_string(output.shape()) + " but the input " +
+                        to_string(input.shape()) + " with weight " + to_string(weight.shape()) + " (stride " +
+                        std::to_string(options.stride) + ", padding " + std::to_string(options.padding) +
+                        ") gives " + to_string(expected));
+  }
+
+  Device& device = queue.device();
+  const auto in_channels = static_cast<std::size_t>(weight.dim(0));
+  const auto out_channels = static_cast<std::size_t>(weight.dim(1));
+  const auto kh = static_cast<std::size_t>(weight.dim(2)), kw = static_cast<std::size_t>(weight.dim(3));
+  const std::size_t taps = kh * kw;
+  const std::size_t in_pixels = static_cast<std::size_t>(input.h() * input.w());
+  const std::size_t out_pixels = static_cast<std::size_t>(expected[2] * expected[3]);
+
+  const std::size_t block =
+      std::clamp<std::size_t>(column_budget(device, options.max_column_floats) / (taps * in_pixels), 1, out_channels);
+  const Tensor columns =
+      Tensor::empty(queue, {static_cast<std::int64_t>(block * taps), static_cast<std::int64_t>(in_pixels)});
+  const bool has_bias = bias.defined();
+  // col2im addresses the bias of a channel block through a [1, co] view of it.
+  const Tensor bias_row = has_bias ? bias.reshaped({1, static_cast<std::int64_t>(out_channels)}) : Tensor();
+  Kernel& gather = queue.kernel(
+      "col2im", "col2im",
+      "-DKH=" + std::to_string(kh) + " -DKW=" + std::to_string(kw) + " -DSTRIDE=" + std::to_string(options.stride) +
+          " -DPAD=" + std::to_string(options.padding) + " -DHAS_BIAS=" + (has_bias ? "1 " : "0 ") +
+          activation_defines(options.activation));
+  const Range local(group_width(device), 1);
+
+  for (std::int64_t n = 0; n < input.n(); ++n) {
+    const Tensor in_n = input.sample(n);
+    const Tensor out_n = output.sample(n);
+    for (std::size_t first = 0; first < out_channels; first += block) {
+      const std::size_t count = std::min(block, out_channels - first);
+      // columns[count·taps, H·W] = Wᵀ · X: W is stored [ci, co·taps], so the block's rows of Wᵀ
+      // are columns [first·taps, (first + count)·taps) of W.
+      gemm(queue, Transpose::Yes, Transpose::No, count * taps, in_pixels, in_channels, 1.0f,
+           MatrixView::of(weight, out_channels * taps, first * taps), MatrixView::of(in_n, in_pixels), 0.0f,
+           MatrixView::of(columns, in_pixels));
+      const auto first_channel = static_cast<std::int64_t>(first);
+      const auto channel_count = static_cast<std::int64_t>(count);
+      const Tensor out_block = out_n.channels(first_channel, channel_count);
+      // Without a bias the kernel never reads its bias argument; any valid buffer will do.
+      const Tensor bias_block = has_bias ? bias_row.channels(first_channel, channel_count) : out_block;
+      gather.set_args(columns, out_block, bias_block, static_cast<int>(count), static_cast<int>(input.h()),
+                      static_cast<int>(input.w()), static_cast<int>(expected[2]), static_cast<int>(expected[3]));
+      queue.launch(gather, Range(out_pixels, count), local);
+    }
+  }
+}
+
+Tensor conv_transpose2d(Queue& queue, const Tensor& input, const Tensor& weight, const Tensor& bias,
+                        const ConvTranspose2dOptions& options) {
+  require_defined(input, "input");
+  require_defined(weight, "weight");
+  Tensor output = Tensor::empty(queue, conv_transpose2d_output_shape(input.shape(), weight.shape(),
+                                                                               options.stride, options.padding));
+  conv_transpose2d(queue, input, weight, bias, output, options);
+  return output;
+}
+
+}  // namespace inertialnet

@@ -1,0 +1,236 @@
+// conv2d (im2col + CLBlast GEMM + fused bias/activation) against the direct convolution of
+// tests/reference/conv.cpp: every FlowNet2 convolution shape at a 64×64 input, odd sizes,
+// batches, channel-slice inputs and outputs, the InertialNet head's convolutions, bad shapes.
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <ostream>
+#include <string>
+
+#include "inertialnet/ops/conv2d.hpp"
+#include "reference/conv.hpp"
+#include "support/testing.hpp"
+
+namespace inertialnet {
+namespace {
+
+struct ConvCase {
+  const char* name;
+  int ci, co, h, w, k, stride, padding;
+  bool bias;
+  ActivationSpec activation;
+};
+void PrintTo(const ConvCase& c, std::ostream* os) { *os << c.name; }
+
+// Where the op's tensors sit inside wider tensors: `*_before` / `*_after` extra channels around
+// the input and the output (0 everywhere: plain contiguous tensors).
+struct Placement {
+  int batch = 1;
+  int in_before = 0, in_after = 0;
+  int out_before = 0, out_after = 0;
+  std::size_t max_column_floats = 0;
+};
+
+constexpr float kSentinel = 123.25f;  // fills the wide output around the slice; must survive
+
+// FlowNet's layer kinds (MODEL_SPEC): conv = k×k, stride s, padding (k−1)/2, bias, LeakyReLU(0.1);
+// iconv = 3×3 stride 1 no activation; pred = 3×3 → 2 channels, no activation.
+ConvCase conv(const char* name, int ci, int co, int size, int k, int s = 1) {
+  return {name, ci, co, size, size, k, s, (k - 1) / 2, true, ActivationSpec::leaky_relu(0.1f)};
+}
+ConvCase iconv(const char* name, int ci, int co, int size) {
+  return {name, ci, co, size, size, 3, 1, 1, true, ActivationSpec::none()};
+}
+ConvCase pred(const char* name, int ci, int size) { return {name, ci, 2, size, size, 3, 1, 1, true, ActivationSpec::none()}; }
+
+void expect_conv_matches(const ConvCase& c, const Placement& p) {
+  SCOPED_TRACE(c.name);
+  Queue& queue = testing::test_queue();
+  reference::ConvShape s{p.batch, c.ci, c.h, c.w, c.co, c.k, c.k, c.stride, c.padding};
+  const int oh = s.conv_out_h(), ow = s.conv_out_w();
+  const std::size_t in_plane = static_cast<std::size_t>(c.h) * c.w, out_plane = static_cast<std::size_t>(oh) * ow;
+  const int in_total = p.in_before + c.ci + p.in_after, out_total = p.out_before + c.co + p.out_after;
+
+  const auto input = testing::random_vector(static_cast<std::size_t>(p.batch) * c.ci * in_plane, 101);
+  const auto weight = testing::random_vector(static_cast<std::size_t>(c.co) * c.ci * c.k * c.k, 102);
+  const auto bias = c.bias ? testing::random_vector(static_cast<std::size_t>(c.co), 103) : std::vector<float>{};
+  const auto expected = reference::conv2d(s, input, weight, bias, c.activation);
+
+  // The input inside a wider tensor whose other channels hold unrelated values.
+  auto wide_input = testing::random_vector(static_cast<std::size_t>(p.batch) * in_total * in_plane, 104);
+  for (int n = 0; n < p.batch; ++n) {
+    std::copy_n(input.begin() + static_cast<std::ptrdiff_t>(n * c.ci * in_plane), c.ci * in_plane,
+                wide_input.begin() + static_cast<std::ptrdiff_t>((n * in_total + p.in_before) * in_plane));
+  }
+  Tensor in_wide = Tensor::from_host(queue, {p.batch, in_total, c.h, c.w}, wide_input);
+  Tensor out_wide =
+      Tensor::from_host(queue, {p.batch, out_total, oh, ow},
+                        std::vector<float>(static_cast<std::size_t>(p.batch) * out_total * out_plane, kSentinel));
+  Tensor w = Tensor::from_host(queue, {c.co, c.ci, c.k, c.k}, weight);
+  Tensor b = c.bias ? Tensor::from_host(queue, {c.co}, bias) : Tensor();
+  Conv2dOptions options{c.stride, c.padding, c.activation, p.max_column_floats};
+  conv2d(queue, in_wide.channels(p.in_before, c.ci), w, b, out_wide.channels(p.out_before, c.co), options);
+
+  const auto got_wide = out_wide.to_host(queue);
+  std::vector<float> got;
+  std::size_t clobbered = 0;
+  for (int n = 0; n < p.batch; ++n) {
+    for (int ch = 0; ch < out_total; ++ch) {
+      const bool inside = ch >= p.out_before && ch < p.out_before + c.co;
+      const auto first = got_wide.begin() + static_cast<std::ptrdiff_t>((n * out_total + ch) * out_plane);
+      const auto last = first + static_cast<std::ptrdiff_t>(out_plane);
+      if (inside) {
+        got.insert(got.end(), first, last);
+      } else {
+        clobbered += static_cast<std::size_t>(std::count_if(first, last, [](float v) { return v != kSentinel; }));
+      }
+    }
+  }
+  EXPECT_EQ(clobbered, 0u) << "elements outside the output slice were written";
+  // float32 accumulation of K = ci·k·k products of magnitude ≲ 1 against a double reference:
+  // the error grows with the reduction length, so the absolute floor is sqrt(K) (the typical
+  // output magnitude) and 1e-5 relative to that leaves ~10× margin over K·eps at K ≈ 10^4.
+  const double floor = std::sqrt(static_cast<double>(c.ci) * c.k * c.k);
+  EXPECT_TRUE(testing::all_close(got, expected, 1e-5, floor));
+}
+
+class FlowNetConvShapes : public ::testing::TestWithParam<ConvCase> {};
+
+TEST_P(FlowNetConvShapes, MatchTheReference) { expect_conv_matches(GetParam(), Placement{}); }
+
+// Every FlowNet2 convolution at a 64×64 network input (FlowNetC/S/SD at 1/2…1/64 resolution,
+// FlowNetFusion at full, 1/2 and 1/4 resolution).
+INSTANTIATE_TEST_SUITE_P(
+    FlowNet2, FlowNetConvShapes,
+    ::testing::Values(
+        // FlowNetC
+        conv("flownetc_conv1", 3, 64, 64, 7, 2), conv("flownetc_conv2", 64, 128, 32, 5, 2),
+        conv("flownetc_conv3", 128, 256, 16, 5, 2), conv("flownetc_conv_redir", 256, 32, 8, 1),
+        conv("flownetc_conv3_1", 473, 256, 8, 3), conv("flownetc_conv4", 256, 512, 8, 3, 2),
+        conv("flownetc_conv4_1", 512, 512, 4, 3), conv("flownetc_conv5", 512, 512, 4, 3, 2),
+        conv("flownetc_conv5_1", 512, 512, 2, 3), conv("flownetc_conv6", 512, 1024, 2, 3, 2),
+        conv("flownetc_conv6_1", 1024, 1024, 1, 3), pred("flownetc_predict_flow6", 1024, 1),
+        pred("flownetc_predict_flow5", 1026, 2), pred("flownetc_predict_flow4", 770, 4),
+        pred("flownetc_predict_flow3", 386, 8), pred("flownetc_predict_flow2", 194, 16),
+        // FlowNetS (FlowNet2 feeds it 12 channels; conv2… as FlowNetC's; conv3_1 is 256→256)
+        conv("flownets_conv1", 12, 64, 64, 7, 2), conv("flownets_conv3_1", 256, 256, 8, 3),
+        // FlowNetSD
+        conv("flownetsd_conv0", 6, 64, 64, 3), conv("flownetsd_conv1", 64, 64, 64, 3, 2),
+        conv("flownetsd_conv1_1", 64, 128, 32, 3), conv("flownetsd_conv2", 128, 128, 32, 3, 2),
+        conv("flownetsd_conv2_1", 128, 128, 16, 3), conv("flownetsd_conv3", 128, 256, 16, 3, 2),
+        iconv("flownetsd_inter_conv5", 1026, 512, 2), iconv("flownetsd_inter_conv4", 770, 256, 4),
+        iconv("flownetsd_inter_conv3", 386, 128, 8), iconv("flownetsd_inter_conv2", 194, 64, 16),
+        pred("flownetsd_predict_flow5", 512, 2), pred("flownetsd_predict_flow4", 256, 4),
+        pred("flownetsd_predict_flow3", 128, 8), pred("flownetsd_predict_flow2", 64, 16),
+        // FlowNetFusion
+        conv("fusion_conv0", 11, 64, 64, 3), conv("fusion_conv1", 64, 64, 64, 3, 2),
+        conv("fusion_conv1_1", 64, 128, 32, 3), conv("fusion_conv2", 128, 128, 32, 3, 2),
+        conv("fusion_conv2_1", 128, 128, 16, 3), pred("fusion_predict_flow2", 128, 16),
+        iconv("fusion_inter_conv1", 162, 32, 32), pred("fusion_predict_flow1", 32, 32),
+        iconv("fusion_inter_conv0", 82, 16, 64), pred("fusion_predict_flow0", 16, 64)),
+    [](const ::testing::TestParamInfo<ConvCase>& info) { return std::string(info.param.name); });
+
+TEST(Conv2d, OddSizesBatchThree) {
+  // 37×23 is not a multiple of the work-group width; strides and paddings that leave remainders.
+  expect_conv_matches({"k3s1", 5, 7, 37, 23, 3, 1, 1, true, ActivationSpec::leaky_relu(0.1f)}, {3});
+  expect_conv_matches({"k5s2", 5, 7, 37, 23, 5, 2, 2, false, ActivationSpec::none()}, {3});
+  expect_conv_matches({"k7s3p0", 4, 9, 37, 23, 7, 3, 0, true, ActivationSpec::relu()}, {3});
+  expect_conv_matches({"k2s2p0", 3, 4, 37, 23, 2, 2, 0, true, ActivationSpec::none()}, {1});
+  expect_conv_matches({"k1s2", 6, 5, 37, 23, 1, 2, 0, true, ActivationSpec::leaky_relu(0.2f)}, {3});
+  expect_conv_matches({"k1s1_direct", 6, 5, 37, 23, 1, 1, 0, false, ActivationSpec::relu()}, {3});
+}
+
+TEST(Conv2d, WritesIntoAChannelSliceAndReadsFromOne) {
+  const Placement p{3, 2, 3, 5, 4, 0};
+  // im2col path, 1×1 direct path, and an output at the very start / end of the wide tensor.
+  expect_conv_matches({"slice_k3", 6, 10, 37, 23, 3, 1, 1, true, ActivationSpec::leaky_relu(0.1f)}, p);
+  expect_conv_matches({"slice_k1", 6, 10, 37, 23, 1, 1, 0, true, ActivationSpec::leaky_relu(0.1f)}, p);
+  expect_conv_matches({"slice_k5s2_nobias", 6, 10, 37, 23, 5, 2, 2, false, ActivationSpec::none()}, p);
+  expect_conv_matches({"slice_first", 3, 4, 16, 16, 3, 1, 1, true, ActivationSpec::none()}, {3, 0, 1, 0, 7});
+  expect_conv_matches({"slice_last", 3, 4, 16, 16, 3, 1, 1, true, ActivationSpec::none()}, {3, 1, 0, 7, 0});
+}
+
+TEST(Conv2d, SmallColumnBudgetProcessesPixelRanges) {
+  // A budget of 100 columns splits 37×23 outputs into 9 ranges, the last one partial.
+  Placement p{3, 1, 1, 2, 2, 5 * 3 * 3 * 100};
+  expect_conv_matches({"chunked", 5, 7, 37, 23, 3, 1, 1, true, ActivationSpec::leaky_relu(0.1f)}, p);
+  p.max_column_floats = 1;  // one pixel at a time
+  expect_conv_matches({"one_pixel", 2, 3, 5, 4, 3, 2, 1, true, ActivationSpec::relu()}, p);
+}
+
+TEST(Conv2d, InertialNetHeadShapes) {
+  // Head at a 24×32 flow: conv1 2→16, pool, conv2 16→32, pool, conv3 1×1 32→8 (all ReLU).
+  for (int batch : {1, 3}) {
+    expect_conv_matches({"head_conv1", 2, 16, 24, 32, 3, 1, 1, true, ActivationSpec::relu()}, {batch});
+    expect_conv_matches({"head_conv2", 16, 32, 12, 16, 3, 1, 1, true, ActivationSpec::relu()}, {batch});
+    expect_conv_matches({"head_conv3", 32, 8, 6, 8, 1, 1, 0, true, ActivationSpec::relu()}, {batch});
+  }
+}
+
+TEST(Conv2d, ConvenienceOverloadAllocatesTheOutput) {
+  Queue& queue = testing::test_queue();
+  const reference::ConvShape s{2, 3, 9, 11, 4, 3, 3, 2, 1};
+  const auto input = testing::random_vector(2 * 3 * 9 * 11, 7);
+  const auto weight = testing::random_vector(4 * 3 * 3 * 3, 8);
+  const auto bias = testing::random_vector(4, 9);
+  const auto leaky = ActivationSpec::leaky_relu(0.1f);
+  Tensor out = conv2d(queue, Tensor::from_host(queue, {2, 3, 9, 11}, input),
+                      Tensor::from_host(queue, {4, 3, 3, 3}, weight), Tensor::from_host(queue, {4}, bias),
+                      Conv2dOptions{2, 1, leaky});
+  EXPECT_EQ(out.shape(), (Shape{2, 4, 5, 6}));
+  EXPECT_EQ(conv2d_output_shape({2, 3, 9, 11}, {4, 3, 3, 3}, 2, 1), (Shape{2, 4, 5, 6}));
+  // Tolerance reasoned as in expect_conv_matches, K = 27.
+  EXPECT_TRUE(testing::all_close(out.to_host(queue), reference::conv2d(s, input, weight, bias, leaky), 1e-5,
+                                 std::sqrt(27.0)));
+}
+
+void expect_invalid(const std::function<void()>& call, const std::string& needle) {
+  try {
+    call();
+    ADD_FAILURE() << "accepted; expected an error mentioning '" << needle << "'";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::InvalidInput) << e.what();
+    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+  }
+}
+
+TEST(Conv2d, BadShapesAreInvalidInput) {
+  Queue& queue = testing::test_queue();
+  Device& device = testing::test_device();
+  const Tensor input = Tensor::empty(device, {1, 4, 8, 8});
+  const Tensor weight = Tensor::empty(device, {8, 4, 3, 3});
+  const Tensor bias = Tensor::empty(device, {8});
+  const Tensor output = Tensor::empty(device, {1, 8, 8, 8});
+  const Conv2dOptions same{1, 1, ActivationSpec::none()};
+  // The valid call, so each failure below is caused by the one thing it changes.
+  EXPECT_NO_THROW(conv2d(queue, input, weight, bias, output, same));
+
+  expect_invalid([&] { conv2d(queue, Tensor::empty(device, {1, 5, 8, 8}), weight, bias, output, same); },
+                 "input has 5 channels");
+  expect_invalid([&] { conv2d(queue, input, Tensor::empty(device, {8, 4, 9}), bias, output, same); },
+                 "weight must be [co, ci, kh, kw]");
+  expect_invalid([&] { conv2d(queue, Tensor::empty(device, {4, 8, 8}), weight, bias, output, same); }, "NCHW");
+  expect_invalid([&] { conv2d(queue, input, weight, Tensor::empty(device, {7}), output, same); },
+                 "bias has shape [7], expected [8]");
+  expect_invalid([&] { conv2d(queue, input, weight, Tensor::empty(device, {8, 1}), output, same); }, "bias has shape");
+  expect_invalid([&] { conv2d(queue, input, weight, bias, Tensor::empty(device, {1, 8, 6, 6}), same); },
+                 "output has shape [1, 8, 6, 6]");
+  expect_invalid([&] { conv2d(queue, input, weight, bias, Tensor::empty(device, {2, 8, 8, 8}), same); },
+                 "gives [1, 8, 8, 8]");
+  // Zero sizes: an undefined tensor, a kernel larger than the padded input, a zero stride.
+  expect_invalid([&] { conv2d(queue, Tensor(), weight, bias, output, same); }, "input tensor is undefined");
+  expect_invalid([&] { conv2d(queue, input, weight, bias, Tensor(), same); }, "output tensor is undefined");
+  expect_invalid(
+      [&] {
+        conv2d(queue, Tensor::empty(device, {1, 4, 2, 8}), Tensor::empty(device, {8, 4, 5, 5}), bias, output, {});
+      },
+      "does not fit");
+  expect_invalid([&] { conv2d(queue, input, weight, bias, output, Conv2dOptions{0, 1, {}}); },
+                 "stride must be at least 1");
+  expect_invalid([&] { conv2d(queue, input, weight, bias, output, Conv2dOptions{1, -1, {}}); },
+                 "padding must not be negative");
+  expect_invalid([&] { conv2d_output_shape({1, 4, 0, 8}, {8, 4, 3, 3}, 1, 1); }, "zero or negative size");
+}
+
+}  // namespace
+}  // namespace inertialnet

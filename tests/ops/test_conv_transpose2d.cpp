@@ -1,0 +1,194 @@
+// conv_transpose2d (CLBlast GEMM + gather col2im with fused bias/activation) against the scatter
+// definition of tests/reference/conv.cpp: every FlowNet2 up-convolution at a 64×64 input, other
+// kernels/strides/paddings, odd sizes, batches, channel slices, channel blocks, bad shapes.
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <ostream>
+#include <string>
+
+#include "inertialnet/ops/conv_transpose2d.hpp"
+#include "reference/conv.hpp"
+#include "support/testing.hpp"
+
+namespace inertialnet {
+namespace {
+
+struct DeconvCase {
+  const char* name;
+  int ci, co, h, w, k, stride, padding;
+  bool bias;
+  ActivationSpec activation;
+};
+void PrintTo(const DeconvCase& c, std::ostream* os) { *os << c.name; }
+
+struct Placement {
+  int batch = 1;
+  int in_before = 0, in_after = 0;
+  int out_before = 0, out_after = 0;
+  std::size_t max_column_floats = 0;
+};
+
+constexpr float kSentinel = -77.5f;  // fills the wide output around the slice; must survive
+
+// MODEL_SPEC: deconv = ConvTranspose2d(4, 2, 1) + bias + LeakyReLU(0.1); up = ConvTranspose2d(2→2,
+// 4, 2, 1) without activation, with a bias in FlowNetC/SD/Fusion and without in FlowNetS.
+DeconvCase deconv(const char* name, int ci, int co, int size) {
+  return {name, ci, co, size, size, 4, 2, 1, true, ActivationSpec::leaky_relu(0.1f)};
+}
+DeconvCase up(const char* name, int size, bool bias) { return {name, 2, 2, size, size, 4, 2, 1, bias, ActivationSpec::none()}; }
+
+void expect_deconv_matches(const DeconvCase& c, const Placement& p) {
+  SCOPED_TRACE(c.name);
+  Queue& queue = testing::test_queue();
+  reference::ConvShape s{p.batch, c.ci, c.h, c.w, c.co, c.k, c.k, c.stride, c.padding};
+  const int oh = s.deconv_out_h(), ow = s.deconv_out_w();
+  const std::size_t in_plane = static_cast<std::size_t>(c.h) * c.w, out_plane = static_cast<std::size_t>(oh) * ow;
+  const int in_total = p.in_before + c.ci + p.in_after, out_total = p.out_before + c.co + p.out_after;
+
+  const auto input = testing::random_vector(static_cast<std::size_t>(p.batch) * c.ci * in_plane, 201);
+  const auto weight = testing::random_vector(static_cast<std::size_t>(c.ci) * c.co * c.k * c.k, 202);
+  const auto bias = c.bias ? testing::random_vector(static_cast<std::size_t>(c.co), 203) : std::vector<float>{};
+  const auto expected = reference::conv_transpose2d(s, input, weight, bias, c.activation);
+
+  auto wide_input = testing::random_vector(static_cast<std::size_t>(p.batch) * in_total * in_plane, 204);
+  for (int n = 0; n < p.batch; ++n) {
+    std::copy_n(input.begin() + static_cast<std::ptrdiff_t>(n * c.ci * in_plane), c.ci * in_plane,
+                wide_input.begin() + static_cast<std::ptrdiff_t>((n * in_total + p.in_before) * in_plane));
+  }
+  Tensor in_wide = Tensor::from_host(queue, {p.batch, in_total, c.h, c.w}, wide_input);
+  Tensor out_wide =
+      Tensor::from_host(queue, {p.batch, out_total, oh, ow},
+                        std::vector<float>(static_cast<std::size_t>(p.batch) * out_total * out_plane, kSentinel));
+  Tensor w = Tensor::from_host(queue, {c.ci, c.co, c.k, c.k}, weight);
+  Tensor b = c.bias ? Tensor::from_host(queue, {c.co}, bias) : Tensor();
+  ConvTranspose2dOptions options{c.stride, c.padding, c.activation, p.max_column_floats};
+  conv_transpose2d(queue, in_wide.channels(p.in_before, c.ci), w, b, out_wide.channels(p.out_before, c.co), options);
+
+  const auto got_wide = out_wide.to_host(queue);
+  std::vector<float> got;
+  std::size_t clobbered = 0;
+  for (int n = 0; n < p.batch; ++n) {
+    for (int ch = 0; ch < out_total; ++ch) {
+      const bool inside = ch >= p.out_before && ch < p.out_before + c.co;
+      const auto first = got_wide.begin() + static_cast<std::ptrdiff_t>((n * out_total + ch) * out_plane);
+      const auto last = first + static_cast<std::ptrdiff_t>(out_plane);
+      if (inside) {
+        got.insert(got.end(), first, last);
+      } else {
+        clobbered += static_cast<std::size_t>(std::count_if(first, last, [](float v) { return v != kSentinel; }));
+      }
+    }
+  }
+  EXPECT_EQ(clobbered, 0u) << "elements outside the output slice were written";
+  // Each output sums at most ci·ceil(k/s)² float32 products of magnitude ≲ 1 (ci per GEMM
+  // entry, then the taps that land on the pixel): as for conv2d, an absolute floor of sqrt(K)
+  // for that reduction length K and 1e-5 relative to it.
+  const int taps = (c.k + c.stride - 1) / c.stride;
+  const double floor = std::sqrt(static_cast<double>(c.ci) * taps * taps);
+  EXPECT_TRUE(testing::all_close(got, expected, 1e-5, floor));
+}
+
+class FlowNetDeconvShapes : public ::testing::TestWithParam<DeconvCase> {};
+
+TEST_P(FlowNetDeconvShapes, MatchTheReference) { expect_deconv_matches(GetParam(), Placement{}); }
+
+// FlowNet2's up-convolutions at a 64×64 network input. FlowNetC, FlowNetS and FlowNetSD share the
+// decoder shapes (FlowNetC: 1/64 → 1/4 resolution); the up layers differ only in their bias.
+INSTANTIATE_TEST_SUITE_P(
+    FlowNet2, FlowNetDeconvShapes,
+    ::testing::Values(deconv("flownetc_deconv5", 1024, 512, 1), deconv("flownetc_deconv4", 1026, 256, 2),
+                      deconv("flownetc_deconv3", 770, 128, 4), deconv("flownetc_deconv2", 386, 64, 8),
+                      up("flownetc_upsampled_flow6_to_5", 1, true), up("flownetc_upsampled_flow5_to_4", 2, true),
+                      up("flownetc_upsampled_flow4_to_3", 4, true), up("flownetc_upsampled_flow3_to_2", 8, true),
+                      up("flownets_upsampled_flow6_to_5", 1, false), up("flownets_upsampled_flow3_to_2", 8, false),
+                      deconv("fusion_deconv1", 128, 32, 16), deconv("fusion_deconv0", 162, 16, 32),
+                      up("fusion_upsampled_flow2_to_1", 16, true), up("fusion_upsampled_flow1_to_0", 32, true)),
+    [](const ::testing::TestParamInfo<DeconvCase>& info) { return std::string(info.param.name); });
+
+TEST(ConvTranspose2d, OtherKernelsStridesAndPaddingsBatchThree) {
+  // 37×23 inputs; kernels smaller than, equal to and larger than the stride; paddings that crop.
+  expect_deconv_matches({"k4s2p1", 5, 7, 37, 23, 4, 2, 1, true, ActivationSpec::leaky_relu(0.1f)}, {3});
+  expect_deconv_matches({"k3s1p0", 5, 7, 37, 23, 3, 1, 0, false, ActivationSpec::none()}, {3});
+  expect_deconv_matches({"k3s1p1", 4, 6, 37, 23, 3, 1, 1, true, ActivationSpec::relu()}, {3});
+  expect_deconv_matches({"k5s3p2", 4, 6, 37, 23, 5, 3, 2, true, ActivationSpec::leaky_relu(0.2f)}, {3});
+  expect_deconv_matches({"k2s2p0", 3, 5, 37, 23, 2, 2, 0, true, ActivationSpec::none()}, {1});
+  expect_deconv_matches({"k1s3p0", 3, 5, 37, 23, 1, 3, 0, true, ActivationSpec::none()}, {1});
+  expect_deconv_matches({"k4s2p1_single_pixel", 9, 3, 1, 1, 4, 2, 1, true, ActivationSpec::none()}, {3});
+}
+
+TEST(ConvTranspose2d, WritesIntoAChannelSliceAndReadsFromOne) {
+  // FlowNet writes deconv outputs into the middle of its concatenations: [conv, deconv, up].
+  expect_deconv_matches({"slice", 6, 10, 37, 23, 4, 2, 1, true, ActivationSpec::leaky_relu(0.1f)}, {3, 2, 3, 5, 4});
+  expect_deconv_matches({"slice_up_last", 2, 2, 8, 8, 4, 2, 1, false, ActivationSpec::none()}, {3, 1, 0, 9, 0});
+  expect_deconv_matches({"slice_first", 4, 3, 8, 8, 4, 2, 1, true, ActivationSpec::none()}, {3, 0, 2, 0, 6});
+}
+
+TEST(ConvTranspose2d, SmallColumnBudgetProcessesChannelBlocks) {
+  // 16 taps × 37·23 pixels × 3 channels per block: co = 8 is done as 3 + 3 + 2 channels.
+  expect_deconv_matches({"blocks", 5, 8, 37, 23, 4, 2, 1, true, ActivationSpec::leaky_relu(0.1f)},
+                        {3, 1, 1, 2, 2, 16 * 37 * 23 * 3});
+  expect_deconv_matches({"one_channel_blocks", 5, 4, 7, 6, 4, 2, 1, false, ActivationSpec::relu()}, {2, 0, 0, 1, 1, 1});
+}
+
+TEST(ConvTranspose2d, ConvenienceOverloadAllocatesTheOutput) {
+  Queue& queue = testing::test_queue();
+  const reference::ConvShape s{2, 3, 5, 7, 4, 4, 4, 2, 1};
+  const auto input = testing::random_vector(2 * 3 * 5 * 7, 17);
+  const auto weight = testing::random_vector(3 * 4 * 4 * 4, 18);
+  Tensor out = conv_transpose2d(queue, Tensor::from_host(queue, {2, 3, 5, 7}, input),
+                                Tensor::from_host(queue, {3, 4, 4, 4}, weight), Tensor(), ConvTranspose2dOptions{});
+  EXPECT_EQ(out.shape(), (Shape{2, 4, 10, 14}));
+  EXPECT_EQ(conv_transpose2d_output_shape({2, 3, 5, 7}, {3, 4, 4, 4}, 2, 1), (Shape{2, 4, 10, 14}));
+  // Reduction of at most 3·2·2 = 12 products; tolerance as in expect_deconv_matches.
+  EXPECT_TRUE(testing::all_close(out.to_host(queue), reference::conv_transpose2d(s, input, weight, {}, {}), 1e-5,
+                                 std::sqrt(12.0)));
+}
+
+void expect_invalid(const std::function<void()>& call, const std::string& needle) {
+  try {
+    call();
+    ADD_FAILURE() << "accepted; expected an error mentioning '" << needle << "'";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::InvalidInput) << e.what();
+    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+  }
+}
+
+TEST(ConvTranspose2d, BadShapesAreInvalidInput) {
+  Queue& queue = testing::test_queue();
+  Device& device = testing::test_device();
+  const Tensor input = Tensor::empty(device, {1, 6, 4, 4});
+  const Tensor weight = Tensor::empty(device, {6, 3, 4, 4});  // [ci, co, k, k]
+  const Tensor bias = Tensor::empty(device, {3});
+  const Tensor output = Tensor::empty(device, {1, 3, 8, 8});
+  const ConvTranspose2dOptions flownet{};
+  EXPECT_NO_THROW(conv_transpose2d(queue, input, weight, bias, output, flownet));
+
+  // A Conv2d-layout weight [co, ci, k, k] is the likely mistake.
+  expect_invalid([&] { conv_transpose2d(queue, input, Tensor::empty(device, {3, 6, 4, 4}), bias, output, flownet); },
+                 "input has 6 channels");
+  expect_invalid([&] { conv_transpose2d(queue, input, Tensor::empty(device, {6, 3, 16}), bias, output, flownet); },
+                 "weight must be [ci, co, kh, kw]");
+  expect_invalid([&] { conv_transpose2d(queue, input, weight, Tensor::empty(device, {6}), output, flownet); },
+                 "bias has shape [6], expected [3]");
+  expect_invalid([&] { conv_transpose2d(queue, input, weight, bias, Tensor::empty(device, {1, 3, 9, 9}), flownet); },
+                 "output has shape [1, 3, 9, 9]");
+  expect_invalid([&] { conv_transpose2d(queue, input, weight, bias, Tensor::empty(device, {1, 6, 8, 8}), flownet); },
+                 "gives [1, 3, 8, 8]");
+  expect_invalid([&] { conv_transpose2d(queue, Tensor(), weight, bias, output, flownet); }, "input tensor is undefined");
+  expect_invalid([&] { conv_transpose2d(queue, input, weight, bias, Tensor(), flownet); }, "output tensor is undefined");
+  // (1 − 1)·2 − 2·1 + 1 = −1: an empty output.
+  expect_invalid(
+      [&] {
+        conv_transpose2d(queue, Tensor::empty(device, {1, 6, 1, 1}), Tensor::empty(device, {6, 3, 1, 1}), bias, output,
+                         flownet);
+      },
+      "empty output");
+  expect_invalid([&] { conv_transpose2d(queue, input, weight, bias, output, ConvTranspose2dOptions{0, 1, {}}); },
+                 "stride must be at least 1");
+  expect_invalid([&] { conv_transpose2d_output_shape({1, 6, 4, 0}, {6, 3, 4, 4}, 2, 1); }, "zero or negative size");
+}
+
+}  // namespace
+}  // namespace inertialnet
