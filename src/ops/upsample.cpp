@@ -1,0 +1,120 @@
+#include "inertialnet/ops/upsample.hpp"
+
+#include <algorithm>
+#include <string>
+
+#include "inertialnet/device.hpp"
+
+namespace inertialnet {
+
+namespace {
+
+// Whether two views of the same buffer share an element (per-sample intervals, so channel
+// slices of one concatenation that interleave across the batch are told apart).
+bool views_overlap(const Tensor& a, const Tensor& b) {
+  if (a.buffer() != b.buffer()) return false;
+  for (std::int64_t i = 0; i < a.dim(0); ++i) {
+    const std::size_t a0 = a.offset() + static_cast<std::size_t>(i) * a.batch_stride(), a1 = a0 + a.sample_size();
+    for (std::int64_t j = 0; j < b.dim(0); ++j) {
+      const std::size_t b0 = b.offset() + static_cast<std::size_t>(j) * b.batch_stride(), b1 = b0 + b.sample_size();
+      if (a0 < b1 && b0 < a1) return true;
+    }
+  }
+  return false;
+}
+
+void check_nchw(const Tensor& t, const std::string& what) {
+  if (!t.defined()) throw invalid_input(what + " is an undefined tensor");
+  if (t.rank() != 4) throw invalid_input(what + " must be NCHW, got shape " + to_string(t.shape()));
+}
+
+void check_size(std::int64_t height, std::int64_t width, const std::string& what) {
+  if (height <= 0 || width <= 0) {
+    throw invalid_input(what + ": the target size " + std::to_string(height) + "×" + std::to_string(width) +
+                        " is empty");
+  }
+}
+
+// Resamples input into output with out = value · (channel 1 ? scale1 : scale0).
+void resample(Queue& queue, const Tensor& input, const Tensor& output, Interpolation mode, float scale0,
+              float scale1, const std::string& what) {
+  check_nchw(input, what + " input");
+  check_nchw(output, what + " output");
+  if (output.n() != input.n() || output.c() != input.c()) {
+    throw invalid_input(what + ": the output of shape " + to_string(output.shape()) +
+                        " must have the batch and channels of the input of shape " + to_string(input.shape()));
+  }
+  if (views_overlap(output, input)) throw invalid_input(what + ": the output overlaps the input");
+
+  const int in_h = static_cast<int>(input.h()), in_w = static_cast<int>(input.w());
+  const int out_h = static_cast<int>(output.h()), out_w = static_cast<int>(output.w());
+  // in/out in float32, as PyTorch's area_pixel_compute_scale; exactly 1/f for a factor f.
+  const float ratio_y = static_cast<float>(in_h) / static_cast<float>(out_h);
+  const float ratio_x = static_cast<float>(in_w) / static_cast<float>(out_w);
+  Kernel& kernel =
+      queue.kernel("upsample", mode == Interpolation::Bilinear ? "upsample_bilinear" : "upsample_nearest");
+  kernel.set_args(input, static_cast<int>(input.batch_stride()), output, static_cast<int>(output.batch_stride()),
+                  static_cast<int>(input.c()), in_h, in_w, out_h, out_w, ratio_y, ratio_x, scale0, scale1);
+  const std::size_t local =
+      std::max<std::size_t>(1, std::min<std::size_t>(64, queue.device().info().max_work_group_size));
+  queue.launch(kernel, Range(static_cast<std::size_t>(out_w), static_cast<std::size_t>(out_h),
+                             static_cast<std::size_t>(input.n() * input.c())),
+               Range(local, 1, 1));
+}
+
+const char* name(Interpolation mode) { return mode == Interpolation::Bilinear ? "bilinear" : "nearest"; }
+
+}  // namespace
+
+Shape upsample_output_shape(const Shape& input, int factor) {
+  if (input.size() != 4) throw invalid_input("upsample input must be NCHW, got shape " + to_string(input));
+  for (const auto d : input) {
+    if (d <= 0) throw invalid_input("upsample input shape " + to_string(input) + " has an empty dimension");
+  }
+  if (factor < 1) throw invalid_input("upsample factor " + std::to_string(factor) + " must be at least 1");
+  return {input[0], input[1], input[2] * factor, input[3] * factor};
+}
+
+void resize(Queue& queue, const Tensor& input, const Tensor& output, Interpolation mode, float scale) {
+  resample(queue, input, output, mode, scale, scale, std::string(name(mode)) + " resize");
+}
+
+Tensor resize(Queue& queue, const Tensor& input, std::int64_t height, std::int64_t width, Interpolation mode,
+              float scale) {
+  const std::string what = std::string(name(mode)) + " resize";
+  check_nchw(input, what + " input");
+  check_size(height, width, what);
+  Tensor output = Tensor::empty(queue, {input.n(), input.c(), height, width});
+  resample(queue, input, output, mode, scale, scale, what);
+  return output;
+}
+
+Tensor upsample(Queue& queue, const Tensor& input, int factor, Interpolation mode, float scale) {
+  check_nchw(input, std::string(name(mode)) + " upsample input");
+  Tensor output = Tensor::empty(queue, upsample_output_shape(input.shape(), factor));
+  resample(queue, input, output, mode, scale, scale, std::string(name(mode)) + " upsample ×" + std::to_string(factor));
+  return output;
+}
+
+void resize_flow(Queue& queue, const Tensor& flow, const Tensor& output, float scale) {
+  check_nchw(flow, "flow resize input");
+  check_nchw(output, "flow resize output");
+  if (flow.c() != 2) {
+    throw invalid_input("flow resize: the flow must have 2 channels (u, v), got shape " + to_string(flow.shape()));
+  }
+  // Vectors measured in input pixels become output pixels: u · W'/W, v · H'/H.
+  const double su = static_cast<double>(output.w()) / static_cast<double>(flow.w()) * scale;
+  const double sv = static_cast<double>(output.h()) / static_cast<double>(flow.h()) * scale;
+  resample(queue, flow, output, Interpolation::Bilinear, static_cast<float>(su), static_cast<float>(sv),
+           "flow resize");
+}
+
+Tensor resize_flow(Queue& queue, const Tensor& flow, std::int64_t height, std::int64_t width, float scale) {
+  check_nchw(flow, "flow resize input");
+  check_size(height, width, "flow resize");
+  Tensor output = Tensor::empty(queue, {flow.n(), flow.c(), height, width});
+  resize_flow(queue, flow, output, scale);
+  return output;
+}
+
+}  // namespace inertialnet

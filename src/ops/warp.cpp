@@ -1,0 +1,80 @@
+#include "inertialnet/ops/warp.hpp"
+
+#include <algorithm>
+#include <string>
+
+#include "inertialnet/device.hpp"
+
+namespace inertialnet {
+
+namespace {
+
+// Whether two views of the same buffer share an element (per-sample intervals, so channel
+// slices of one concatenation that interleave across the batch are told apart).
+bool views_overlap(const Tensor& a, const Tensor& b) {
+  if (a.buffer() != b.buffer()) return false;
+  for (std::int64_t i = 0; i < a.dim(0); ++i) {
+    const std::size_t a0 = a.offset() + static_cast<std::size_t>(i) * a.batch_stride(), a1 = a0 + a.sample_size();
+    for (std::int64_t j = 0; j < b.dim(0); ++j) {
+      const std::size_t b0 = b.offset() + static_cast<std::size_t>(j) * b.batch_stride(), b1 = b0 + b.sample_size();
+      if (a0 < b1 && b0 < a1) return true;
+    }
+  }
+  return false;
+}
+
+void check_defined(const Tensor& t, const char* name) {
+  if (!t.defined()) throw invalid_input(std::string("warp ") + name + " is an undefined tensor");
+}
+
+}  // namespace
+
+Shape warp_output_shape(const Shape& image, const Shape& flow) {
+  if (image.size() != 4) throw invalid_input("warp image must be NCHW, got shape " + to_string(image));
+  for (const auto d : image) {
+    if (d <= 0) throw invalid_input("warp image shape " + to_string(image) + " has an empty dimension");
+  }
+  if (flow.size() != 4) throw invalid_input("warp flow must be [N, 2, H, W], got shape " + to_string(flow));
+  if (flow[1] != 2) {
+    throw invalid_input("warp flow must have 2 channels (u, v), got shape " + to_string(flow));
+  }
+  if (flow[0] != image[0] || flow[2] != image[2] || flow[3] != image[3]) {
+    throw invalid_input("warp flow of shape " + to_string(flow) + " does not match the image of shape " +
+                        to_string(image) + " (batch, height and width must be equal)");
+  }
+  return image;
+}
+
+void warp(Queue& queue, const Tensor& image, const Tensor& flow, const Tensor& output) {
+  check_defined(image, "image");
+  check_defined(flow, "flow");
+  check_defined(output, "output");
+  const Shape expected = warp_output_shape(image.shape(), flow.shape());
+  if (output.shape() != expected) {
+    throw invalid_input("warp output must have the image's shape " + to_string(expected) + ", got " +
+                        to_string(output.shape()));
+  }
+  if (views_overlap(output, image) || views_overlap(output, flow)) {
+    throw invalid_input("warp output overlaps its image or flow; it must be a separate tensor");
+  }
+  const int height = static_cast<int>(image.h()), width = static_cast<int>(image.w());
+  Kernel& kernel = queue.kernel("warp", "warp_bilinear");
+  kernel.set_args(image, static_cast<int>(image.batch_stride()), flow, static_cast<int>(flow.batch_stride()), output,
+                  static_cast<int>(output.batch_stride()), static_cast<int>(image.c()), height, width);
+  // Rows of up to 64 pixels per group: contiguous flow reads, vectorisable on CPUs.
+  const std::size_t local =
+      std::max<std::size_t>(1, std::min<std::size_t>(64, queue.device().info().max_work_group_size));
+  queue.launch(kernel, Range(static_cast<std::size_t>(width), static_cast<std::size_t>(height),
+                             static_cast<std::size_t>(image.n())),
+               Range(local, 1, 1));
+}
+
+Tensor warp(Queue& queue, const Tensor& image, const Tensor& flow) {
+  check_defined(image, "image");
+  check_defined(flow, "flow");
+  Tensor output = Tensor::empty(queue, warp_output_shape(image.shape(), flow.shape()));
+  warp(queue, image, flow, output);
+  return output;
+}
+
+}  // namespace inertialnet
