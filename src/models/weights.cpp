@@ -1,0 +1,149 @@
+#include "inertialnet/models/weights.hpp"
+
+#include <filesystem>
+#include <set>
+#include <sstream>
+
+#include "inertialnet/error.hpp"
+#include "inertialnet/models/synthetic_weights.hpp"
+#include "inertialnet/queue.hpp"
+#include "inertialnet/safetensors.hpp"
+
+namespace inertialnet {
+
+namespace {
+
+std::string list(const std::vector<std::string>& items, std::size_t most = 8) {
+  std::ostringstream out;
+  for (std::size_t i = 0; i < items.size() && i < most; ++i) out << (i ? ", " : "") << items[i];
+  if (items.size() > most) out << ", … " << items.size() - most << " more";
+  return out.str();
+}
+
+bool is_head_name(const std::string& name) { return name.rfind("head.", 0) == 0; }
+
+}  // namespace
+
+void WeightSet::add(Device& device, const std::string& name, const Shape& shape, const std::vector<float>& data,
+                    const std::string& source) {
+  if (tensors_.count(name)) {
+    throw invalid_input("tensor '" + name + "' is in both " + source_of_.at(name) + " and " + source +
+                        "; weight files given together must hold disjoint tensors");
+  }
+  tensors_.emplace(name, Tensor::from_host(device.queue(), shape, data));
+  shapes_.emplace(name, shape);
+  source_of_.emplace(name, source);
+}
+
+WeightSet WeightSet::load(Device& device, const std::vector<std::string>& paths) {
+  if (paths.empty()) throw invalid_input("no weight file given");
+  WeightSet set;
+  for (const auto& path : paths) {
+    const SafetensorsFile file(path);
+    const std::string source = std::filesystem::path(path).filename().string();
+    set.source_names_.push_back(source);
+    const auto& meta = file.metadata();
+    if (auto synthetic = meta.find(kMetadataSynthetic); synthetic != meta.end() && synthetic->second == "true") {
+      const auto model = meta.count(kMetadataModel) ? meta.at(kMetadataModel) : std::string("model");
+      const auto seed = meta.count(kMetadataSeed) ? meta.at(kMetadataSeed) : std::string("?");
+      set.synthetic_sources_.push_back(source + " (synthetic " + model + ", seed " + seed + ")");
+    }
+    if (auto model = meta.find(kMetadataModel); model != meta.end()) {
+      try {
+        set.models_.push_back(model_kind_from_string(model->second));
+      } catch (const Error& e) {
+        throw invalid_input(path + ": metadata " + kMetadataModel + ": " + e.what());
+      }
+    }
+    if (auto head = meta.find(kMetadataHead); head != meta.end()) {
+      try {
+        set.head_config_ = head_config_from_json(head->second);
+      } catch (const Error& e) {
+        throw invalid_input(path + ": metadata " + kMetadataHead + " is not a valid head configuration: " + e.what());
+      }
+      set.has_head_config_ = true;
+    }
+    for (const auto& name : file.names()) {
+      const auto& shape = file.shape(name);
+      set.add(device, name, Shape(shape.begin(), shape.end()), file.to_float32(name), source);
+    }
+  }
+  device.queue().finish();
+  return set;
+}
+
+WeightSet WeightSet::synthetic(Device& device, ModelKind kind, std::uint64_t seed, const HeadConfig& head) {
+  WeightSet set;
+  const std::string source = std::string("synthetic ") + to_string(kind) + ", seed " + std::to_string(seed);
+  set.source_names_.push_back(source);
+  set.synthetic_sources_.push_back(source);
+  set.models_.push_back(kind);
+  if (kind == ModelKind::InertialNetHead) {
+    set.head_config_ = head;
+    set.has_head_config_ = true;
+  }
+  std::vector<float> data;
+  for (const auto& spec : model_parameters(kind, head)) {
+    data.resize(static_cast<std::size_t>(spec.numel()));
+    fill_synthetic_tensor(spec, seed, data.data());
+    set.add(device, spec.name, Shape(spec.shape.begin(), spec.shape.end()), data, source);
+  }
+  device.queue().finish();
+  return set;
+}
+
+const Tensor& WeightSet::get(const std::string& name) const {
+  const auto found = tensors_.find(name);
+  if (found == tensors_.end()) throw invalid_input("weights " + sources() + " hold no tensor '" + name + "'");
+  return found->second;
+}
+
+void WeightSet::check(const std::string& model, const std::vector<ParameterSpec>& parameters) const {
+  const bool head_model = !parameters.empty() && is_head_name(parameters.front().name);
+  std::vector<std::string> missing, mismatched, unexpected;
+  std::set<std::string> expected;
+  for (const auto& spec : parameters) {
+    expected.insert(spec.name);
+    const auto found = shapes_.find(spec.name);
+    const Shape want(spec.shape.begin(), spec.shape.end());
+    if (found == shapes_.end()) {
+      missing.push_back(spec.name);
+    } else if (found->second != want) {
+      mismatched.push_back(spec.name + ": file " + to_string(found->second) + ", model " + to_string(want));
+    }
+  }
+  for (const auto& [name, shape] : shapes_) {
+    if (is_head_name(name) == head_model && !expected.count(name)) unexpected.push_back(name);
+  }
+  if (missing.empty() && mismatched.empty() && unexpected.empty()) return;
+  std::ostringstream message;
+  message << "weights " << sources() << " do not fit " << model << ":";
+  const char* separator = " ";
+  if (!missing.empty()) {
+    message << separator << "missing " << missing.size() << " tensors (" << list(missing) << ")";
+    separator = "; ";
+  }
+  if (!unexpected.empty()) {
+    message << separator << unexpected.size() << " unexpected (" << list(unexpected) << ")";
+    separator = "; ";
+  }
+  if (!mismatched.empty()) message << separator << mismatched.size() << " with wrong shape (" << list(mismatched) << ")";
+  if (missing.size() == parameters.size()) {
+    message << ". Is this a weight file of another model? Convert checkpoints with tools/convert_checkpoint.py";
+  }
+  throw invalid_input(message.str());
+}
+
+std::string WeightSet::sources() const {
+  std::string out;
+  for (std::size_t i = 0; i < source_names_.size(); ++i) out += (i ? ", " : "") + source_names_[i];
+  return out.empty() ? std::string("(none)") : out;
+}
+
+std::size_t WeightSet::bytes() const {
+  std::size_t total = 0;
+  for (const auto& [name, tensor] : tensors_) total += static_cast<std::size_t>(tensor.numel()) * sizeof(float);
+  return total;
+}
+
+}  // namespace inertialnet

@@ -1,0 +1,72 @@
+// The InertialNet head against the PyTorch reference fixtures (tools/reference/head.py):
+// default hyper-parameters at two sizes (one odd, so the pools floor) and a custom
+// configuration, all with synthetic weights of seed 1 and the configuration from the fixture.
+#include <cstdlib>
+#include <filesystem>
+
+#include "inertialnet/models/inertialnet_head.hpp"
+#include "inertialnet/safetensors.hpp"
+#include "support/testing.hpp"
+
+namespace inertialnet {
+namespace {
+
+std::string fixture(const std::string& name) {
+  const char* root = std::getenv("INERTIALNET_TEST_DATA");
+  return (std::filesystem::path(root ? root : "tests/data") / "fixtures" / name).string();
+}
+
+class HeadFixture : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(HeadFixture, MatchesThePyTorchReference) {
+  Queue& queue = testing::test_queue();
+  const SafetensorsFile file(fixture(GetParam()));
+  const HeadConfig config = head_config_from_json(file.metadata().at(kMetadataHead));
+  const WeightSet weights = WeightSet::synthetic(testing::test_device(), ModelKind::InertialNetHead, 1, config);
+  InertialNetHead head(testing::test_device(), weights);
+  const auto& s = file.shape("flow");
+  const Tensor flow = Tensor::from_host(queue, Shape(s.begin(), s.end()), file.to_float32("flow"));
+  const auto omega = head.compute(queue, flow).to_host(queue);
+  // GEMM-based layers against a float64 reference: fc1 reduces over thousands of terms.
+  EXPECT_TRUE(testing::all_close(head.features().to_host(queue), file.to_float32("features"), 1e-4, 1e-3));
+  EXPECT_TRUE(testing::all_close(omega, file.to_float32("omega"), 1e-4, 1e-4));
+}
+
+INSTANTIATE_TEST_SUITE_P(Configurations, HeadFixture,
+                         ::testing::Values("head_32x24.safetensors", "head_38x30.safetensors",
+                                           "head_custom_38x30.safetensors"));
+
+TEST(Head, AFlowOfAnotherSizeIsAClearError) {
+  HeadConfig config;
+  config.input_height = 24;
+  config.input_width = 32;
+  const WeightSet weights = WeightSet::synthetic(testing::test_device(), ModelKind::InertialNetHead, 1, config);
+  InertialNetHead head(testing::test_device(), weights);
+  const Tensor flow = Tensor::empty(testing::test_device(), {1, 2, 30, 38});
+  try {
+    head.compute(testing::test_queue(), flow);
+    FAIL() << "a 38×30 flow accepted by a 32×24 head";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::InvalidInput);
+    EXPECT_NE(std::string(e.what()).find("32×24"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Head, WeightsOfAnotherSizeAreRefused) {
+  HeadConfig small;
+  small.input_height = 24;
+  small.input_width = 32;
+  HeadConfig other = small;
+  other.input_width = 64;  // fc1 twice as wide
+  const WeightSet weights = WeightSet::synthetic(testing::test_device(), ModelKind::InertialNetHead, 1, small);
+  try {
+    InertialNetHead head(testing::test_device(), weights, other);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("head.fc1.weight"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("wrong shape"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace inertialnet
