@@ -26,7 +26,7 @@
 namespace inertialnet {
 
 enum class DiskCacheMode {
-  Auto,  // per platform: off where the driver caches better itself (see program_cache.cpp)
+  Auto,  // per platform: on, unless a driver is measured to cache better itself (program_cache.cpp)
   On,
   Off,
 };
