@@ -13,6 +13,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,26 @@ struct RatesTable {
 };
 
 RatesTable read_rates_csv(const std::filesystem::path& path);
+
+// Writes rows as they come, each flushed, so a file cut short (Ctrl-C, an error) is still a
+// valid CSV of the rows so far. Refuses non-finite values and timestamps that do not increase.
+class RatesCsvWriter {
+ public:
+  RatesCsvWriter(const std::filesystem::path& path, const std::vector<std::string>& extra_names = {});
+  ~RatesCsvWriter();
+  RatesCsvWriter(const RatesCsvWriter&) = delete;
+  RatesCsvWriter& operator=(const RatesCsvWriter&) = delete;
+  void write(std::int64_t t_ns, const Vec3& w, const std::vector<double>& extra = {});
+  std::size_t rows() const { return rows_; }
+
+ private:
+  std::filesystem::path path_;
+  std::size_t extra_count_;
+  struct Stream;
+  std::unique_ptr<Stream> out_;
+  std::size_t rows_ = 0;
+  std::int64_t last_t_ns_ = 0;
+};
 void write_rates_csv(const std::filesystem::path& path, const RatesTable& table);
 
 }  // namespace inertialnet

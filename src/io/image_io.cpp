@@ -11,6 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "inertialnet/error.hpp"
+#include "io/image_mat.hpp"
 
 namespace fs = std::filesystem;
 
@@ -152,9 +153,13 @@ HostImage load_rgb_image(const fs::path& path) {
     throw invalid_input("The image " + quoted(path) +
                         " cannot be decoded: it is not in a format OpenCV reads, or it is corrupt.");
   }
+  return host_image_from_mat(image, quoted(path));
+}
+
+HostImage host_image_from_mat(const cv::Mat& image, const std::string& what) {
   const int channels = image.channels();
   if (channels < 1 || channels > 4) {
-    throw invalid_input("The image " + quoted(path) + " has " + std::to_string(channels) +
+    throw invalid_input(what + " has " + std::to_string(channels) +
                         " channels; 1 (gray), 2 (gray + alpha), 3 (colour) or 4 (colour + alpha) are supported.");
   }
 
@@ -168,7 +173,7 @@ HostImage load_rgb_image(const fs::path& path) {
     // 16-bit frames are brought to the network's 0..255 range: 65535 / 257 = 255 exactly.
     to_planar_rgb<std::uint16_t>(image, 257.0f, out);
   } else {
-    throw invalid_input("The image " + quoted(path) + " has " + depth_name(image.depth()) +
+    throw invalid_input(what + " has " + depth_name(image.depth()) +
                         " samples; only 8-bit and 16-bit unsigned images are supported.");
   }
   return out;

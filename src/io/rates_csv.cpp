@@ -155,42 +155,63 @@ RatesTable read_rates_csv(const fs::path& path) {
   return table;
 }
 
+struct RatesCsvWriter::Stream {
+  std::ofstream file;
+};
+
+RatesCsvWriter::RatesCsvWriter(const fs::path& path, const std::vector<std::string>& extra_names)
+    : path_(path), extra_count_(extra_names.size()), out_(std::make_unique<Stream>()) {
+  out_->file.open(path, std::ios::binary | std::ios::trunc);
+  if (!out_->file) {
+    throw invalid_input("Cannot open " + path.string() + " for writing.");
+  }
+  out_->file << "timestamp_ns,wx,wy,wz";
+  for (const auto& name : extra_names) out_->file << ',' << name;
+  out_->file << '\n' << std::flush;
+}
+
+RatesCsvWriter::~RatesCsvWriter() = default;
+
+void RatesCsvWriter::write(std::int64_t t_ns, const Vec3& w, const std::vector<double>& extra) {
+  if (extra.size() != extra_count_) {
+    throw invalid_input("Rates row for timestamp " + std::to_string(t_ns) + " has " + std::to_string(extra.size()) +
+                        " extra values, the header " + std::to_string(extra_count_) + ".");
+  }
+  bool finite = std::isfinite(w[0]) && std::isfinite(w[1]) && std::isfinite(w[2]);
+  for (const double v : extra) finite = finite && std::isfinite(v);
+  if (!finite) {
+    throw invalid_input("Rates row " + std::to_string(rows_) + " (timestamp " + std::to_string(t_ns) +
+                        ") holds a non-finite value; refusing to write " + path_.string() + ".");
+  }
+  if (rows_ > 0 && t_ns <= last_t_ns_) {
+    throw invalid_input("Rates row " + std::to_string(rows_) + ": timestamp " + std::to_string(t_ns) +
+                        " does not follow " + std::to_string(last_t_ns_) + "; refusing to write " + path_.string() +
+                        ".");
+  }
+  char buf[48];
+  out_->file << t_ns;
+  for (int k = 0; k < 3; ++k) {
+    std::snprintf(buf, sizeof buf, ",%.9g", w[k]);
+    out_->file << buf;
+  }
+  for (const double v : extra) {
+    std::snprintf(buf, sizeof buf, ",%.9g", v);
+    out_->file << buf;
+  }
+  out_->file << '\n' << std::flush;
+  if (!out_->file) throw runtime_error("Writing " + path_.string() + " failed (disk full?).");
+  ++rows_;
+  last_t_ns_ = t_ns;
+}
+
 void write_rates_csv(const fs::path& path, const RatesTable& table) {
   table.validate();
+  RatesCsvWriter writer(path, table.extra_names);
+  std::vector<double> extra(table.extra.size());
   for (std::size_t i = 0; i < table.size(); ++i) {
-    bool finite = std::isfinite(table.w[i][0]) && std::isfinite(table.w[i][1]) && std::isfinite(table.w[i][2]);
-    for (const auto& col : table.extra) finite = finite && std::isfinite(col[i]);
-    if (!finite) {
-      throw invalid_input("Rates table row " + std::to_string(i) + " (timestamp " +
-                          std::to_string(table.t_ns[i]) + ") holds a non-finite value; refusing to write " +
-                          path.string() + ".");
-    }
-    if (i > 0 && table.t_ns[i] <= table.t_ns[i - 1]) {
-      throw invalid_input("Rates table row " + std::to_string(i) + ": timestamp " +
-                          std::to_string(table.t_ns[i]) + " does not follow " +
-                          std::to_string(table.t_ns[i - 1]) + "; refusing to write " + path.string() + ".");
-    }
+    for (std::size_t c = 0; c < extra.size(); ++c) extra[c] = table.extra[c][i];
+    writer.write(table.t_ns[i], table.w[i], extra);
   }
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) throw invalid_input("Cannot open " + path.string() + " for writing.");
-  out << "timestamp_ns,wx,wy,wz";
-  for (const auto& name : table.extra_names) out << ',' << name;
-  out << '\n';
-  char buf[48];
-  for (std::size_t i = 0; i < table.size(); ++i) {
-    out << table.t_ns[i];
-    for (int k = 0; k < 3; ++k) {
-      std::snprintf(buf, sizeof buf, ",%.9g", table.w[i][k]);
-      out << buf;
-    }
-    for (const auto& col : table.extra) {
-      std::snprintf(buf, sizeof buf, ",%.9g", col[i]);
-      out << buf;
-    }
-    out << '\n';
-  }
-  out.flush();
-  if (!out) throw runtime_error("Writing " + path.string() + " failed (disk full?).");
 }
 
 }  // namespace inertialnet
