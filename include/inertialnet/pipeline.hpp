@@ -1,0 +1,87 @@
+// The host scheduler: angular rates for every frame pair of a sequence, with several pairs in
+// flight.
+//
+//   decode pool ──▶ frame cache ──▶ lanes (per device: own queue + own network instances)
+//                                       upload → flow → head(s) → download
+//                                  ──▶ reorder buffer ──▶ sink (in pair order, calling thread)
+//
+// Each frame is decoded once although it belongs to two pairs. Lanes on one device run on
+// separate in-order queues, so one pair's transfers overlap another's compute; lanes on several
+// devices (--device all) share the work. Everything is bounded by a window of pairs, so memory
+// stays flat on any sequence length. An error in any stage, or the cancel flag (SIGINT), stops
+// every stage; results already emitted stay emitted, and the error is rethrown to the caller.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "inertialnet/device.hpp"
+#include "inertialnet/flow_io.hpp"
+#include "inertialnet/frame_source.hpp"
+
+namespace inertialnet {
+
+struct Frame {
+  std::size_t index = 0;
+  std::int64_t t_ns = 0;
+  HostImage image;
+};
+
+// What one pair (frames k−1 → k) yields.
+struct PairResult {
+  std::size_t index = 0;   // k ≥ 1
+  std::int64_t t0_ns = 0;  // frame k−1
+  std::int64_t t1_ns = 0;  // frame k: the timestamp the rates CSV carries
+  // Angular rates by estimator ("inertialnet", "geometric"), camera frame, rad/s, in the
+  // order the processor adds them.
+  std::vector<std::pair<std::string, std::array<double, 3>>> rates;
+  std::optional<FlowField> flow;          // when the processor was asked to keep it
+  std::map<std::string, double> seconds;  // time per stage ("upload", "flow", "head", …)
+  std::string device;                     // where it ran
+};
+
+// Turns one frame pair into rates. One instance per lane; called from that lane's thread only.
+// `stop` turns true when the pipeline is stopping: long computations poll it between layers
+// (the networks do) and give up by throwing, so cancellation does not wait for a whole pair.
+class PairProcessor {
+ public:
+  virtual ~PairProcessor() = default;
+  virtual void process(const Frame& previous, const Frame& current, PairResult& result,
+                       const std::atomic<bool>& stop) = 0;
+};
+
+// Makes the processor of lane `lane` on `device` (called on the lane's thread).
+using ProcessorFactory = std::function<std::unique_ptr<PairProcessor>(Device& device, int lane)>;
+
+struct PipelineOptions {
+  int lanes_per_device = 2;  // pairs in flight per device
+  int decode_threads = 2;
+  int window = 0;            // pairs between the oldest unfinished and the newest started; 0: 4 × lanes
+  const std::atomic<bool>* cancel = nullptr;  // set by a signal handler to stop
+  std::size_t max_pairs = 0;  // 0: every pair
+};
+
+struct PipelineStats {
+  std::size_t pairs = 0;
+  double seconds = 0;                       // wall time
+  double decode_seconds = 0;                // summed over decode threads
+  std::map<std::string, double> stage_seconds;  // summed over lanes
+  std::map<std::string, std::size_t> pairs_per_device;
+  bool cancelled = false;
+  double pairs_per_second() const { return seconds > 0 ? static_cast<double>(pairs) / seconds : 0; }
+};
+
+// Runs every pair of `source` through processors made by `factory` on `devices`, handing
+// results to `sink` in pair order on the calling thread. Returns when all pairs are done or
+// when cancelled (stats.cancelled); rethrows the first error of any stage after stopping all.
+PipelineStats run_pipeline(FrameSource& source, const std::vector<Device*>& devices, const ProcessorFactory& factory,
+                           const std::function<void(const PairResult&)>& sink, const PipelineOptions& options = {});
+
+}  // namespace inertialnet
