@@ -17,5 +17,10 @@ struct GlobalOptions {
 using Command = std::function<int()>;
 
 Command register_devices(CLI::App& app, const GlobalOptions& global);
+Command register_weights(CLI::App& app, const GlobalOptions& global);
+Command register_flow(CLI::App& app, const GlobalOptions& global);
+Command register_predict(CLI::App& app, const GlobalOptions& global);
+Command register_eval(CLI::App& app, const GlobalOptions& global);
+Command register_synth(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace inertialnet::cli

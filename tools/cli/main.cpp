@@ -26,6 +26,26 @@ int main(int argc, char** argv) {
     CLI::App* sub = app.add_subcommand("devices", "list the OpenCL platforms and devices");
     commands[sub] = cli::register_devices(*sub, global);
   }
+  {
+    CLI::App* sub = app.add_subcommand("flow", "optical flow between two images (FlowNet2 family)");
+    commands[sub] = cli::register_flow(*sub, global);
+  }
+  {
+    CLI::App* sub = app.add_subcommand("predict", "angular rates for every frame pair of a sequence");
+    commands[sub] = cli::register_predict(*sub, global);
+  }
+  {
+    CLI::App* sub = app.add_subcommand("eval", "the paper's metrics for a rates CSV against a EuRoC sequence");
+    commands[sub] = cli::register_eval(*sub, global);
+  }
+  {
+    CLI::App* sub = app.add_subcommand("synth", "render a EuRoC-layout sequence from a known camera motion");
+    commands[sub] = cli::register_synth(*sub, global);
+  }
+  {
+    CLI::App* sub = app.add_subcommand("weights", "write synthetic weights, or describe a weight file");
+    commands[sub] = cli::register_weights(*sub, global);
+  }
 
   try {
     app.parse(argc, argv);

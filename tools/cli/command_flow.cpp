@@ -1,0 +1,76 @@
+// `inertialnet flow IMG1 IMG2 --weights W`: one optical-flow field, as Middlebury .flo and/or a
+// colour-wheel PNG.
+#include <chrono>
+#include <cmath>
+#include <iostream>
+#include <memory>
+
+#include "commands.hpp"
+#include "common.hpp"
+#include "inertialnet/error.hpp"
+#include "inertialnet/flow_io.hpp"
+#include "inertialnet/image_io.hpp"
+#include "inertialnet/models/flownet.hpp"
+
+namespace inertialnet::cli {
+
+namespace {
+struct FlowOptions {
+  std::string image1, image2;
+  std::vector<std::string> weights;
+  std::string model;
+  std::string flo, png;
+};
+
+ModelKind flow_model(const WeightSet& weights, const std::string& requested) {
+  if (!requested.empty()) return model_kind_from_string(requested);
+  for (const ModelKind kind : weights.models()) {
+    if (kind != ModelKind::InertialNetHead) return kind;
+  }
+  throw invalid_input("weights " + weights.sources() +
+                      " do not say which FlowNet model they hold (metadata inertialnet.model); pass --model");
+}
+}  // namespace
+
+Command register_flow(CLI::App& app, const GlobalOptions& global) {
+  auto o = std::make_shared<FlowOptions>();
+  app.add_option("image1", o->image1, "first frame")->required()->check(CLI::ExistingFile);
+  app.add_option("image2", o->image2, "second frame (same size)")->required()->check(CLI::ExistingFile);
+  app.add_option("-w,--weights", o->weights, "FlowNet2-family weights (safetensors); repeatable")->required();
+  app.add_option("--model", o->model, "FlowNet2, FlowNet2-C, -S, -SD, -CS or -CSS (default: from the weights)");
+  app.add_option("-o,--output", o->flo, "write the flow as Middlebury .flo");
+  app.add_option("--png", o->png, "write the flow as a colour-wheel PNG");
+  return [o, &global]() {
+    const HostImage first = load_rgb_image(o->image1);
+    const HostImage second = load_rgb_image(o->image2);
+    if (first.width != second.width || first.height != second.height) {
+      throw invalid_input("the frames differ in size: " + o->image1 + " is " + std::to_string(first.width) + "x" +
+                          std::to_string(first.height) + ", " + o->image2 + " is " + std::to_string(second.width) +
+                          "x" + std::to_string(second.height));
+    }
+    auto device = open_device(global);
+    const WeightSet weights = WeightSet::load(*device, o->weights);
+    warn_if_synthetic(weights);
+    FlowNet net(*device, flow_model(weights, o->model), weights);
+
+    Queue& queue = device->queue();
+    const Shape shape{1, 3, first.height, first.width};
+    const Tensor frame1 = Tensor::from_host(queue, shape, first.data);
+    const Tensor frame2 = Tensor::from_host(queue, shape, second.data);
+    const auto start = std::chrono::steady_clock::now();
+    const auto flow = FlowField::from_planar(first.width, first.height, net.compute(queue, frame1, frame2).to_host(queue));
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+    double sum = 0;
+    for (std::size_t i = 0; i < flow.pixel_count(); ++i) sum += std::hypot(flow.u[i], flow.v[i]);
+    std::cout << to_string(net.kind()) << " on " << device->info().name << ": " << first.width << "x" << first.height
+              << " flow in " << seconds << " s, mean |flow| " << sum / static_cast<double>(flow.pixel_count())
+              << " px, max " << max_flow_magnitude(flow) << " px\n";
+    if (!o->flo.empty()) write_flo(o->flo, flow);
+    if (!o->png.empty()) write_flow_png(o->png, flow);
+    if (o->flo.empty() && o->png.empty()) std::cout << "(no output file: add -o out.flo and/or --png out.png)\n";
+    return 0;
+  };
+}
+
+}  // namespace inertialnet::cli

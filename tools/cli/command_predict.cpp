@@ -1,0 +1,147 @@
+// `inertialnet predict SEQ`: angular rates for every frame pair of a sequence, through the
+// pipelined scheduler, as a rates CSV (timestamp_ns,wx,wy,wz; rad/s; stamped with t_k).
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+
+#include "commands.hpp"
+#include "common.hpp"
+#include "inertialnet/device_selection.hpp"
+#include "inertialnet/error.hpp"
+#include "inertialnet/flow_io.hpp"
+#include "inertialnet/frame_source.hpp"
+#include "inertialnet/pipeline.hpp"
+#include "inertialnet/processors.hpp"
+#include "inertialnet/rates_csv.hpp"
+#include "progress.hpp"
+
+namespace inertialnet::cli {
+
+namespace {
+
+std::atomic<bool> interrupted{false};
+extern "C" void on_interrupt(int) { interrupted = true; }
+
+struct PredictOptions {
+  std::string sequence;
+  std::vector<std::string> weights;
+  std::string model;
+  std::string output;
+  std::string save_flow;
+  double rate_hz = 0;
+  int lanes = 2;
+  int decode_threads = 2;
+  std::size_t max_pairs = 0;
+  bool stats = false;
+};
+
+ModelKind flow_model_of(const WeightSet& weights, const std::string& requested) {
+  if (!requested.empty()) return model_kind_from_string(requested);
+  for (const ModelKind kind : weights.models()) {
+    if (kind != ModelKind::InertialNetHead) return kind;
+  }
+  return ModelKind::FlowNet2;
+}
+
+}  // namespace
+
+Command register_predict(CLI::App& app, const GlobalOptions& global) {
+  auto o = std::make_shared<PredictOptions>();
+  app.add_option("sequence", o->sequence, "EuRoC folder, image folder or video")->required();
+  app.add_option("-w,--weights", o->weights,
+                 "weights (safetensors) holding FlowNet2 and the InertialNet head; repeat for several files");
+  app.add_option("--model", o->model, "flow network: FlowNet2 (default), FlowNet2-C, -S, -SD, -CS, -CSS");
+  app.add_option("-o,--output", o->output, "rates CSV to write (default: standard output)");
+  app.add_option("--save-flow", o->save_flow, "write each pair's flow as <timestamp>.flo into this folder");
+  app.add_option("--rate", o->rate_hz, "frame rate for image folders and videos without timestamps (Hz)");
+  app.add_option("--lanes", o->lanes, "frame pairs in flight per device")->capture_default_str()->check(CLI::Range(1, 16));
+  app.add_option("--decode-threads", o->decode_threads, "image decoding threads")->capture_default_str()->check(CLI::Range(1, 64));
+  app.add_option("--max-pairs", o->max_pairs, "stop after this many pairs");
+  app.add_flag("--stats", o->stats, "print time per stage and pairs per second");
+  return [o, &global]() {
+    if (o->weights.empty()) {
+      throw invalid_input(
+          "predict needs weights: --weights FILE with the FlowNet2 and InertialNet head tensors (safetensors). "
+          "Convert a flownet2-pytorch checkpoint with `python3 tools/convert_checkpoint.py FlowNet2_checkpoint.pth.tar "
+          "flownet2.safetensors` (and the head the same way), or write synthetic weights for a trial run with "
+          "`inertialnet weights --synthetic FlowNet2 -o flownet2.safetensors` and `inertialnet weights --synthetic "
+          "InertialNetHead --size WxH -o head.safetensors`");
+    }
+    auto source = open_frame_source(o->sequence, o->rate_hz > 0 ? std::optional<double>(o->rate_hz) : std::nullopt);
+
+    // Devices and their weights (one set per device).
+    const auto infos = select_devices(device_spec_or_environment(global.device), discover_devices());
+    std::vector<std::unique_ptr<Device>> devices;
+    std::vector<std::unique_ptr<WeightSet>> weight_sets;
+    std::map<const Device*, const WeightSet*> weights_of;
+    std::vector<Device*> device_list;
+    for (const auto& info : infos) {
+      DeviceOptions options;
+      if (global.no_cache) options.program_cache = DiskCacheMode::Off;
+      devices.push_back(std::make_unique<Device>(info, options));
+      weight_sets.push_back(std::make_unique<WeightSet>(WeightSet::load(*devices.back(), o->weights)));
+      weights_of[devices.back().get()] = weight_sets.back().get();
+      device_list.push_back(devices.back().get());
+    }
+    warn_if_synthetic(*weight_sets.front());
+    LearnedProcessorOptions processor;
+    processor.flow_model = flow_model_of(*weight_sets.front(), o->model);
+    processor.keep_flow = !o->save_flow.empty();
+    if (!o->save_flow.empty()) std::filesystem::create_directories(o->save_flow);
+
+    std::unique_ptr<RatesCsvWriter> file_writer;
+    if (!o->output.empty()) file_writer = std::make_unique<RatesCsvWriter>(o->output);
+    const std::size_t pairs = o->max_pairs ? std::min(o->max_pairs, source->size() - 1) : source->size() - 1;
+    std::cerr << "inertialnet: " << source->description() << ", " << pairs << " pairs, "
+              << to_string(processor.flow_model) << " + InertialNet head on " << device_list.size() << " device"
+              << (device_list.size() > 1 ? "s" : "") << " (" << infos.front().name << (infos.size() > 1 ? ", …" : "")
+              << ")\n";
+    if (!file_writer) std::cout << "timestamp_ns,wx,wy,wz\n";
+
+    Progress progress("predict", pairs);
+    std::size_t done = 0;
+    auto sink = [&](const PairResult& r) {
+      const auto& w = r.rates.front().second;
+      if (file_writer) {
+        file_writer->write(r.t1_ns, {w[0], w[1], w[2]});
+      } else {
+        std::printf("%lld,%.9g,%.9g,%.9g\n", static_cast<long long>(r.t1_ns), w[0], w[1], w[2]);
+        std::fflush(stdout);
+      }
+      if (r.flow) write_flo(std::filesystem::path(o->save_flow) / (std::to_string(r.t1_ns) + ".flo"), *r.flow);
+      progress.update(++done);
+    };
+
+    PipelineOptions options;
+    options.lanes_per_device = o->lanes;
+    options.decode_threads = o->decode_threads;
+    options.max_pairs = o->max_pairs;
+    options.cancel = &interrupted;
+    std::signal(SIGINT, on_interrupt);
+    std::signal(SIGTERM, on_interrupt);
+    const PipelineStats stats = run_pipeline(*source, device_list, learned_processor(weights_of, processor), sink, options);
+    std::signal(SIGINT, SIG_DFL);
+    std::signal(SIGTERM, SIG_DFL);
+
+    if (o->stats) {
+      std::cerr << "pairs: " << stats.pairs << " in " << stats.seconds << " s = " << stats.pairs_per_second()
+                << " pairs/s\n"
+                << "decode: " << stats.decode_seconds << " s (summed over threads)\n";
+      for (const auto& [stage, seconds] : stats.stage_seconds) {
+        std::cerr << stage << ": " << seconds << " s (summed over lanes), " << seconds / std::max<std::size_t>(stats.pairs, 1)
+                  << " s per pair\n";
+      }
+      for (const auto& [device, count] : stats.pairs_per_device) std::cerr << device << ": " << count << " pairs\n";
+    }
+    if (stats.cancelled) {
+      std::cerr << "inertialnet: interrupted after " << stats.pairs << " of " << pairs
+                << " pairs; the rates written so far are complete rows\n";
+      return 1;
+    }
+    return 0;
+  };
+}
+
+}  // namespace inertialnet::cli

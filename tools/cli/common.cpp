@@ -1,0 +1,35 @@
+#include "common.hpp"
+
+#include <iostream>
+#include <regex>
+
+#include "inertialnet/device_selection.hpp"
+#include "inertialnet/error.hpp"
+
+namespace inertialnet::cli {
+
+std::unique_ptr<Device> open_device(const GlobalOptions& global) {
+  const DeviceInfo info = select_device(device_spec_or_environment(global.device), discover_devices());
+  DeviceOptions options;
+  if (global.no_cache) options.program_cache = DiskCacheMode::Off;
+  return std::make_unique<Device>(info, options);
+}
+
+std::pair<std::int64_t, std::int64_t> parse_size(const std::string& text) {
+  static const std::regex pattern("^([0-9]{1,5})[xX×]([0-9]{1,5})$");
+  std::smatch m;
+  if (!std::regex_match(text, m, pattern) || std::stoll(m[1]) == 0 || std::stoll(m[2]) == 0) {
+    throw invalid_input("size '" + text + "' is not of the form WIDTHxHEIGHT (e.g. 752x480)");
+  }
+  return {std::stoll(m[1]), std::stoll(m[2])};
+}
+
+void warn_if_synthetic(const WeightSet& weights) {
+  if (!weights.synthetic()) return;
+  std::string sources;
+  for (const auto& s : weights.synthetic_sources()) sources += (sources.empty() ? "" : ", ") + s;
+  std::cerr << "inertialnet: note: synthetic weights (" << sources
+            << "): the output exercises the network but is not a measurement\n";
+}
+
+}  // namespace inertialnet::cli
