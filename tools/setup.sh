@@ -9,7 +9,7 @@ packages=(
   build-essential cmake pkg-config
   opencl-headers ocl-icd-opencl-dev pocl-opencl-icd clinfo
   libclblast-dev
-  libopencv-dev libeigen3-dev
+  libopencv-dev libeigen3-dev libopengv-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev
 )

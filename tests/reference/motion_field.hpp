@@ -1,0 +1,21 @@
+// Plain C++ reference of the geometric head's reductions (kernels_cl/motion_field.cl), in
+// double, one sample at a time, written from the definitions in
+// include/inertialnet/models/geometric_head.hpp.
+#pragma once
+
+#include <vector>
+
+#include "inertialnet/flow_io.hpp"
+#include "inertialnet/models/geometric_head.hpp"
+
+namespace inertialnet::reference {
+
+// `map` is normalized_coordinate_map() of a camera of the flow's size (x plane, then y plane).
+MotionFieldMoments motion_field_moments(const FlowField& flow, const std::vector<float>& map,
+                                        const MotionFieldParams& params);
+
+// The usable grid samples, in grid order.
+std::vector<NormalizedCorrespondence> motion_field_correspondences(const FlowField& flow, const std::vector<float>& map,
+                                                                   int stride);
+
+}  // namespace inertialnet::reference
