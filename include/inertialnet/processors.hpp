@@ -1,23 +1,45 @@
 // The pair processors the pipeline runs: what turns two frames into angular rates.
+//
+// Flow comes from FlowNet2 (or a lighter family member, on the device) or from OpenCV's DIS
+// optical flow (classical, weight-free; through OpenCV's T-API, so on OpenCL where OpenCV can).
+// Rates come from the InertialNet head (learned) and/or the geometric head (weight-free,
+// include/inertialnet/models/geometric_head.hpp), named "inertialnet" and "geometric".
 #pragma once
 
 #include <map>
+#include <optional>
 
+#include "inertialnet/models/geometric_head.hpp"
 #include "inertialnet/models/parameters.hpp"
 #include "inertialnet/models/weights.hpp"
 #include "inertialnet/pipeline.hpp"
+#include "inertialnet/vec3.hpp"
 
 namespace inertialnet {
 
-struct LearnedProcessorOptions {
-  ModelKind flow_model = ModelKind::FlowNet2;
+enum class FlowMethod { FlowNet, DIS };
+std::string to_string(FlowMethod method);           // "flownet2", "dis"
+FlowMethod parse_flow_method(const std::string& text);  // invalid_input listing the choices
+
+struct RatesProcessorOptions {
+  FlowMethod flow = FlowMethod::FlowNet;
+  ModelKind flow_model = ModelKind::FlowNet2;  // with FlowMethod::FlowNet
+  bool inertialnet_head = true;
+  bool geometric_head = false;
+  GeometricHeadOptions geometric;
+  std::optional<CameraIntrinsics> camera;  // required by the geometric head
+  // The geometric head measures ω in the camera frame; with the camera-to-body rotation given
+  // (EuRoC's cam0 T_BS), its rates are reported in the body (IMU) frame like the gyro and the
+  // InertialNet head, ω_B = R_BS·ω_C.
+  std::optional<Mat3> camera_to_body;
   bool keep_flow = false;  // download the dense flow into PairResult::flow (--save-flow)
 };
 
-// FlowNet2 (or a lighter family member) → InertialNet head, rates named "inertialnet". Each lane
-// gets its own queue and network instances over its device's weights (`weights` holds one set
-// per device, loaded beforehand; they must outlive the pipeline).
-ProcessorFactory learned_processor(const std::map<const Device*, const WeightSet*>& weights,
-                                   const LearnedProcessorOptions& options);
+// Each lane gets its own queue and model instances. `weights` holds one set per device, loaded
+// beforehand (needed by FlowNet and the InertialNet head; may be empty otherwise); they must
+// outlive the pipeline. Throws invalid_input for contradictory options (no head, a geometric
+// head without a camera, FlowNet without weights).
+ProcessorFactory rates_processor(const std::map<const Device*, const WeightSet*>& weights,
+                                 const RatesProcessorOptions& options);
 
 }  // namespace inertialnet

@@ -70,8 +70,20 @@ if(NOT EXISTS "${WORK}/plot.png" OR NOT EXISTS "${WORK}/plot_hist.png")
 endif()
 
 # Bad input: readable message, exit code 2.
-run(2 ${CLI} predict seq)
-expect_match("predict needs weights")
+run(2 ${CLI} predict seq --head inertialnet)
+expect_match("need weights")
+
+# Without weights: DIS flow + the geometric head, said in one line; both heads side by side.
+run(0 ${CLI} predict seq -o geometric.csv)
+expect_match("no weights given: weight-free DIS optical flow \\+ geometric head")
+run(0 ${CLI} eval geometric.csv seq)
+expect_match("frames evaluated: 5")
+run(0 ${CLI} predict seq -w c.safetensors -w head.safetensors --head both -o both.csv)
+file(STRINGS "${WORK}/both.csv" both_rows)
+list(GET both_rows 0 both_header)
+if(NOT both_header STREQUAL "timestamp_ns,wx,wy,wz,wx_geometric,wy_geometric,wz_geometric")
+  message(FATAL_ERROR "both.csv header is '${both_header}'")
+endif()
 run(2 ${CLI} predict nosuch -w c.safetensors -w head.safetensors)
 expect_match("does not exist")
 run(2 ${CLI} predict seq -w head.safetensors)

@@ -96,11 +96,11 @@ PipelineRun pipelined(const std::vector<Device*>& devices, FrameSource& source, 
     sets.push_back(std::make_unique<WeightSet>(WeightSet::load(*d, fixture().weight_files)));
     weights[d] = sets.back().get();
   }
-  LearnedProcessorOptions processor;
+  RatesProcessorOptions processor;
   processor.flow_model = ModelKind::FlowNet2C;
   PipelineRun run;
   run.stats = run_pipeline(
-      source, devices, learned_processor(weights, processor),
+      source, devices, rates_processor(weights, processor),
       [&](const PairResult& r) {
         EXPECT_EQ(r.index, run.rates.size() + 1) << "results out of order";
         run.rates.push_back(r.rates.at(0).second);
@@ -151,12 +151,12 @@ TEST(Pipeline, CancellationLeavesAValidPartialCsv) {
   {
     RatesCsvWriter writer(csv);
     auto source = open_frame_source(fixture().sequence);
-    LearnedProcessorOptions processor;
+    RatesProcessorOptions processor;
     processor.flow_model = ModelKind::FlowNet2C;
     PipelineOptions options;
     options.cancel = &cancel;
     const PipelineStats stats = run_pipeline(
-        *source, {&device}, learned_processor({{&device, &weights}}, processor),
+        *source, {&device}, rates_processor({{&device, &weights}}, processor),
         [&](const PairResult& r) {
           const auto& w = r.rates[0].second;
           writer.write(r.t1_ns, {w[0], w[1], w[2]});
@@ -187,9 +187,9 @@ TEST(Pipeline, ABadFrameStopsEveryStageWithItsMessage) {
   std::size_t emitted = 0;
   try {
     const WeightSet weights = WeightSet::load(device, fixture().weight_files);
-    LearnedProcessorOptions processor;
+    RatesProcessorOptions processor;
     processor.flow_model = ModelKind::FlowNet2C;
-    run_pipeline(*source, {&device}, learned_processor({{&device, &weights}}, processor),
+    run_pipeline(*source, {&device}, rates_processor({{&device, &weights}}, processor),
                  [&](const PairResult&) { ++emitted; });
     FAIL() << "a truncated frame went through";
   } catch (const Error& e) {

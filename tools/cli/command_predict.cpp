@@ -28,6 +28,10 @@ struct PredictOptions {
   std::string sequence;
   std::vector<std::string> weights;
   std::string model;
+  std::string flow;   // "" = flownet2 with weights, dis without
+  std::string head;   // "" = inertialnet with weights, geometric without
+  std::string solver = "motion-field";
+  double fx = 0, fy = 0, cx = 0, cy = 0;
   std::string output;
   std::string save_flow;
   double rate_hz = 0;
@@ -45,14 +49,28 @@ ModelKind flow_model_of(const WeightSet& weights, const std::string& requested) 
   return ModelKind::FlowNet2;
 }
 
+const char* kNoWeightsHelp =
+    "Convert a flownet2-pytorch checkpoint with `python3 tools/convert_checkpoint.py FlowNet2_checkpoint.pth.tar "
+    "flownet2.safetensors` (and the head the same way), or write synthetic weights for a trial run with "
+    "`inertialnet weights --synthetic FlowNet2 -o flownet2.safetensors` and `inertialnet weights --synthetic "
+    "InertialNetHead --size WxH -o head.safetensors`";
+
 }  // namespace
 
 Command register_predict(CLI::App& app, const GlobalOptions& global) {
   auto o = std::make_shared<PredictOptions>();
   app.add_option("sequence", o->sequence, "EuRoC folder, image folder or video")->required();
   app.add_option("-w,--weights", o->weights,
-                 "weights (safetensors) holding FlowNet2 and the InertialNet head; repeat for several files");
+                 "weights (safetensors) holding FlowNet2 and/or the InertialNet head; repeat for several files");
   app.add_option("--model", o->model, "flow network: FlowNet2 (default), FlowNet2-C, -S, -SD, -CS, -CSS");
+  app.add_option("--flow", o->flow, "flownet2 (default with weights) or dis (OpenCV DIS; default without weights)");
+  app.add_option("--head", o->head,
+                 "inertialnet (default with weights), geometric (default without), or both");
+  app.add_option("--solver", o->solver, "geometric head: motion-field (default) or opengv")->capture_default_str();
+  app.add_option("--fx", o->fx, "focal length x (px), when the sequence has no sensor.yaml");
+  app.add_option("--fy", o->fy, "focal length y (px)");
+  app.add_option("--cx", o->cx, "principal point x (px)");
+  app.add_option("--cy", o->cy, "principal point y (px)");
   app.add_option("-o,--output", o->output, "rates CSV to write (default: standard output)");
   app.add_option("--save-flow", o->save_flow, "write each pair's flow as <timestamp>.flo into this folder");
   app.add_option("--rate", o->rate_hz, "frame rate for image folders and videos without timestamps (Hz)");
@@ -61,15 +79,48 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
   app.add_option("--max-pairs", o->max_pairs, "stop after this many pairs");
   app.add_flag("--stats", o->stats, "print time per stage and pairs per second");
   return [o, &global]() {
-    if (o->weights.empty()) {
-      throw invalid_input(
-          "predict needs weights: --weights FILE with the FlowNet2 and InertialNet head tensors (safetensors). "
-          "Convert a flownet2-pytorch checkpoint with `python3 tools/convert_checkpoint.py FlowNet2_checkpoint.pth.tar "
-          "flownet2.safetensors` (and the head the same way), or write synthetic weights for a trial run with "
-          "`inertialnet weights --synthetic FlowNet2 -o flownet2.safetensors` and `inertialnet weights --synthetic "
-          "InertialNetHead --size WxH -o head.safetensors`");
+    const bool have_weights = !o->weights.empty();
+    RatesProcessorOptions processor;
+    processor.flow = parse_flow_method(o->flow.empty() ? (have_weights ? "flownet2" : "dis") : o->flow);
+    const std::string head = o->head.empty() ? (have_weights ? "inertialnet" : "geometric") : o->head;
+    if (head != "inertialnet" && head != "geometric" && head != "both") {
+      throw invalid_input("unknown head '" + head + "'; expected inertialnet, geometric or both");
+    }
+    processor.inertialnet_head = head != "geometric";
+    processor.geometric_head = head != "inertialnet";
+    if (!have_weights && (processor.flow == FlowMethod::FlowNet || processor.inertialnet_head)) {
+      throw invalid_input(std::string("--flow flownet2 and --head inertialnet need weights: --weights FILE with the "
+                                      "FlowNet2 and InertialNet head tensors (safetensors). ") + kNoWeightsHelp +
+                          ". Without weights, predict runs DIS flow + the geometric head.");
+    }
+    if (o->solver == "opengv") {
+      processor.geometric.solver = GeometricSolver::OpenGV;
+    } else if (o->solver != "motion-field") {
+      throw invalid_input("unknown solver '" + o->solver + "'; expected motion-field or opengv");
     }
     auto source = open_frame_source(o->sequence, o->rate_hz > 0 ? std::optional<double>(o->rate_hz) : std::nullopt);
+    if (processor.geometric_head) {
+      const bool given = o->fx > 0 || o->fy > 0;
+      if (given) {
+        CameraIntrinsics camera;
+        const HostImage first = source->decode(0);
+        camera.width = first.width;
+        camera.height = first.height;
+        camera.fx = o->fx;
+        camera.fy = o->fy > 0 ? o->fy : o->fx;
+        camera.cx = o->cx > 0 ? o->cx : (first.width - 1) / 2.0;
+        camera.cy = o->cy > 0 ? o->cy : (first.height - 1) / 2.0;
+        camera.validate();
+        processor.camera = camera;
+      } else if (const auto calibration = source->calibration()) {
+        processor.camera = CameraIntrinsics::from_calibration(*calibration);
+        processor.camera_to_body = calibration->rotation_BS();
+      } else {
+        throw invalid_input("the geometric head needs the camera: " + source->description() +
+                            " has no cam0/sensor.yaml; give --fx (and --fy --cx --cy)");
+      }
+    }
+    processor.keep_flow = !o->save_flow.empty();
 
     // Devices and their weights (one set per device).
     const auto infos = select_devices(device_spec_or_environment(global.device), discover_devices());
@@ -81,33 +132,58 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
       DeviceOptions options;
       if (global.no_cache) options.program_cache = DiskCacheMode::Off;
       devices.push_back(std::make_unique<Device>(info, options));
-      weight_sets.push_back(std::make_unique<WeightSet>(WeightSet::load(*devices.back(), o->weights)));
-      weights_of[devices.back().get()] = weight_sets.back().get();
+      if (have_weights) {
+        weight_sets.push_back(std::make_unique<WeightSet>(WeightSet::load(*devices.back(), o->weights)));
+        weights_of[devices.back().get()] = weight_sets.back().get();
+      }
       device_list.push_back(devices.back().get());
     }
-    warn_if_synthetic(*weight_sets.front());
-    LearnedProcessorOptions processor;
-    processor.flow_model = flow_model_of(*weight_sets.front(), o->model);
-    processor.keep_flow = !o->save_flow.empty();
+    if (have_weights) {
+      warn_if_synthetic(*weight_sets.front());
+      processor.flow_model = flow_model_of(*weight_sets.front(), o->model);
+    }
+    const auto factory = rates_processor(weights_of, processor);
     if (!o->save_flow.empty()) std::filesystem::create_directories(o->save_flow);
 
-    std::unique_ptr<RatesCsvWriter> file_writer;
-    if (!o->output.empty()) file_writer = std::make_unique<RatesCsvWriter>(o->output);
+    std::string method = (processor.flow == FlowMethod::DIS ? std::string("DIS flow") : to_string(processor.flow_model));
+    method += processor.inertialnet_head && processor.geometric_head ? " + InertialNet and geometric heads"
+              : processor.inertialnet_head                           ? " + InertialNet head"
+                                                                     : " + geometric head";
     const std::size_t pairs = o->max_pairs ? std::min(o->max_pairs, source->size() - 1) : source->size() - 1;
-    std::cerr << "inertialnet: " << source->description() << ", " << pairs << " pairs, "
-              << to_string(processor.flow_model) << " + InertialNet head on " << device_list.size() << " device"
-              << (device_list.size() > 1 ? "s" : "") << " (" << infos.front().name << (infos.size() > 1 ? ", …" : "")
-              << ")\n";
-    if (!file_writer) std::cout << "timestamp_ns,wx,wy,wz\n";
+    if (!have_weights) {
+      std::cerr << "inertialnet: no weights given: weight-free DIS optical flow + geometric head\n";
+    }
+    std::cerr << "inertialnet: " << source->description() << ", " << pairs << " pairs, " << method << " on "
+              << device_list.size() << " device" << (device_list.size() > 1 ? "s" : "") << " (" << infos.front().name
+              << (infos.size() > 1 ? ", …" : "") << ")";
+    if (processor.geometric_head) {
+      std::cerr << "; geometric rates in the " << (processor.camera_to_body ? "body (IMU) frame" : "camera frame");
+    }
+    std::cerr << "\n";
+
+    // Columns: the first estimator is wx,wy,wz; a second one adds wx_<name>,wy_<name>,wz_<name>.
+    std::vector<std::string> extra;
+    if (processor.inertialnet_head && processor.geometric_head) extra = {"wx_geometric", "wy_geometric", "wz_geometric"};
+    std::unique_ptr<RatesCsvWriter> file_writer;
+    if (!o->output.empty()) file_writer = std::make_unique<RatesCsvWriter>(o->output, extra);
+    if (!file_writer) {
+      std::cout << "timestamp_ns,wx,wy,wz";
+      for (const auto& e : extra) std::cout << "," << e;
+      std::cout << "\n";
+    }
 
     Progress progress("predict", pairs);
     std::size_t done = 0;
     auto sink = [&](const PairResult& r) {
       const auto& w = r.rates.front().second;
+      std::vector<double> more;
+      for (std::size_t i = 1; i < r.rates.size(); ++i) more.insert(more.end(), r.rates[i].second.begin(), r.rates[i].second.end());
       if (file_writer) {
-        file_writer->write(r.t1_ns, {w[0], w[1], w[2]});
+        file_writer->write(r.t1_ns, {w[0], w[1], w[2]}, more);
       } else {
-        std::printf("%lld,%.9g,%.9g,%.9g\n", static_cast<long long>(r.t1_ns), w[0], w[1], w[2]);
+        std::printf("%lld,%.9g,%.9g,%.9g", static_cast<long long>(r.t1_ns), w[0], w[1], w[2]);
+        for (const double v : more) std::printf(",%.9g", v);
+        std::printf("\n");
         std::fflush(stdout);
       }
       if (r.flow) write_flo(std::filesystem::path(o->save_flow) / (std::to_string(r.t1_ns) + ".flo"), *r.flow);
@@ -121,7 +197,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
     options.cancel = &interrupted;
     std::signal(SIGINT, on_interrupt);
     std::signal(SIGTERM, on_interrupt);
-    const PipelineStats stats = run_pipeline(*source, device_list, learned_processor(weights_of, processor), sink, options);
+    const PipelineStats stats = run_pipeline(*source, device_list, factory, sink, options);
     std::signal(SIGINT, SIG_DFL);
     std::signal(SIGTERM, SIG_DFL);
 

@@ -1,0 +1,136 @@
+#include <chrono>
+#include <opencv2/core.hpp>
+#include <opencv2/video/tracking.hpp>
+
+#include "inertialnet/error.hpp"
+#include "inertialnet/models/flownet.hpp"
+#include "inertialnet/models/inertialnet_head.hpp"
+#include "inertialnet/processors.hpp"
+#include "inertialnet/queue.hpp"
+
+namespace inertialnet {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// 8-bit luminance (BT.601) of a planar RGB frame; a replicated gray frame comes back exactly.
+cv::Mat gray8(const HostImage& image) {
+  cv::Mat gray(image.height, image.width, CV_8UC1);
+  const std::size_t plane = image.plane_size();
+  for (int y = 0; y < image.height; ++y) {
+    auto* row = gray.ptr<std::uint8_t>(y);
+    for (int x = 0; x < image.width; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(image.width) + static_cast<std::size_t>(x);
+      const float v = 0.299f * image.data[i] + 0.587f * image.data[plane + i] + 0.114f * image.data[2 * plane + i];
+      row[x] = cv::saturate_cast<std::uint8_t>(v);
+    }
+  }
+  return gray;
+}
+
+Vec3 to_body(const std::optional<Mat3>& r, const Vec3& w) {
+  if (!r) return w;
+  const Mat3& m = *r;
+  return {m[0] * w[0] + m[1] * w[1] + m[2] * w[2], m[3] * w[0] + m[4] * w[1] + m[5] * w[2],
+          m[6] * w[0] + m[7] * w[1] + m[8] * w[2]};
+}
+
+class RatesProcessor : public PairProcessor {
+ public:
+  RatesProcessor(Device& device, const WeightSet* weights, const RatesProcessorOptions& options)
+      : options_(options), queue_(device.create_queue()) {
+    if (options.flow == FlowMethod::FlowNet) flownet_ = std::make_unique<FlowNet>(device, options.flow_model, *weights);
+    if (options.flow == FlowMethod::DIS) dis_ = cv::DISOpticalFlow::create(cv::DISOpticalFlow::PRESET_MEDIUM);
+    if (options.inertialnet_head) head_ = std::make_unique<InertialNetHead>(device, *weights);
+    if (options.geometric_head) geometric_ = std::make_unique<GeometricHead>(device, *options.camera, options.geometric);
+  }
+
+  void process(const Frame& previous, const Frame& current, PairResult& result,
+               const std::atomic<bool>& stop) override {
+    Queue& q = *queue_;
+    const int width = current.image.width, height = current.image.height;
+    auto t = Clock::now();
+    Tensor flow;
+    if (flownet_) {
+      const Shape shape{1, 3, height, width};
+      const Tensor frame1 = Tensor::from_host(q, shape, previous.image.data);
+      const Tensor frame2 = Tensor::from_host(q, shape, current.image.data);
+      t = lap(result, "upload", t);
+      flow = flownet_->compute(q, frame1, frame2, &stop);
+      q.finish();
+    } else {
+      // T-API: UMat lets OpenCV run DIS through its own OpenCL path where it has one.
+      cv::UMat a, b, uv;
+      gray8(previous.image).copyTo(a);
+      gray8(current.image).copyTo(b);
+      dis_->calc(a, b, uv);
+      cv::Mat planes[2];
+      cv::split(uv.getMat(cv::ACCESS_READ), planes);
+      std::vector<float> data(2 * static_cast<std::size_t>(width) * static_cast<std::size_t>(height));
+      std::copy(planes[0].begin<float>(), planes[0].end<float>(), data.begin());
+      std::copy(planes[1].begin<float>(), planes[1].end<float>(), data.begin() + static_cast<std::ptrdiff_t>(data.size() / 2));
+      flow = Tensor::from_host(q, {1, 2, height, width}, data);
+    }
+    t = lap(result, "flow", t);
+    if (head_) {
+      const auto omega = head_->compute(q, flow, &stop).to_host(q);
+      result.rates.push_back({"inertialnet", {omega[0], omega[1], omega[2]}});
+      t = lap(result, "inertialnet_head", t);
+    }
+    if (geometric_) {
+      const double dt = static_cast<double>(current.t_ns - previous.t_ns) * 1e-9;
+      const RotationEstimate estimate = geometric_->estimate(q, flow, dt);
+      const Vec3 w = to_body(options_.camera_to_body, estimate.omega);
+      result.rates.push_back({"geometric", {w[0], w[1], w[2]}});
+      t = lap(result, "geometric_head", t);
+    }
+    if (options_.keep_flow) {
+      result.flow = FlowField::from_planar(width, height, flow.to_host(q));
+      lap(result, "download", t);
+    }
+  }
+
+ private:
+  static Clock::time_point lap(PairResult& result, const char* stage, Clock::time_point start) {
+    const auto now = Clock::now();
+    result.seconds[stage] += std::chrono::duration<double>(now - start).count();
+    return now;
+  }
+
+  RatesProcessorOptions options_;
+  std::unique_ptr<Queue> queue_;
+  std::unique_ptr<FlowNet> flownet_;
+  cv::Ptr<cv::DISOpticalFlow> dis_;
+  std::unique_ptr<InertialNetHead> head_;
+  std::unique_ptr<GeometricHead> geometric_;
+};
+
+}  // namespace
+
+std::string to_string(FlowMethod method) { return method == FlowMethod::DIS ? "dis" : "flownet2"; }
+
+FlowMethod parse_flow_method(const std::string& text) {
+  if (text == "flownet2" || text == "flownet") return FlowMethod::FlowNet;
+  if (text == "dis") return FlowMethod::DIS;
+  throw invalid_input("unknown flow method '" + text + "'; expected flownet2 or dis");
+}
+
+ProcessorFactory rates_processor(const std::map<const Device*, const WeightSet*>& weights,
+                                 const RatesProcessorOptions& options) {
+  if (!options.inertialnet_head && !options.geometric_head) throw invalid_input("no head selected: nothing to predict");
+  if (options.geometric_head && !options.camera) {
+    throw invalid_input("the geometric head needs the camera intrinsics (a EuRoC sequence's cam0/sensor.yaml, or "
+                        "--fx --fy --cx --cy)");
+  }
+  const bool needs_weights = options.flow == FlowMethod::FlowNet || options.inertialnet_head;
+  return [weights, options, needs_weights](Device& device, int) -> std::unique_ptr<PairProcessor> {
+    const auto found = weights.find(&device);
+    if (needs_weights && found == weights.end()) {
+      throw invalid_input("no weights were loaded for device " + device.info().name);
+    }
+    return std::make_unique<RatesProcessor>(device, found == weights.end() ? nullptr : found->second, options);
+  };
+}
+
+}  // namespace inertialnet
