@@ -4,7 +4,9 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <cstdio>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <sstream>
 
@@ -29,6 +31,39 @@ std::vector<float> random_vector(std::size_t count, std::uint32_t seed, float lo
   return values;
 }
 
+namespace {
+
+// The largest errors each test suite saw through compare(), printed when the program ends, so
+// a CI log shows how close every op came to its reference, not only that it passed.
+struct LargestErrors : ::testing::Environment {
+  std::map<std::string, Difference> by_suite;
+  void TearDown() override {
+    for (const auto& [suite, d] : by_suite) {
+      std::printf("[ largest  ] %s: relative error %.3g, absolute %.3g\n", suite.c_str(), d.max_rel, d.max_abs);
+    }
+  }
+};
+
+LargestErrors& largest_errors() {
+  static LargestErrors* errors = [] {
+    auto* e = new LargestErrors;  // owned by googletest
+    ::testing::AddGlobalTestEnvironment(e);
+    return e;
+  }();
+  return *errors;
+}
+[[maybe_unused]] const bool registered = (largest_errors(), true);
+
+void record(const Difference& d) {
+  const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
+  if (!test) return;
+  Difference& worst = largest_errors().by_suite[test->test_suite_name()];
+  worst.max_rel = std::max(worst.max_rel, d.max_rel);
+  worst.max_abs = std::max(worst.max_abs, d.max_abs);
+}
+
+}  // namespace
+
 Difference compare(const std::vector<float>& actual, const std::vector<float>& expected, double floor) {
   Difference d;
   for (std::size_t i = 0; i < actual.size() && i < expected.size(); ++i) {
@@ -40,6 +75,7 @@ Difference compare(const std::vector<float>& actual, const std::vector<float>& e
     }
     if (abs > d.max_abs) d.max_abs = abs;
   }
+  record(d);
   return d;
 }
 
