@@ -61,6 +61,10 @@ class Tensor {
 
   // Channels [first, first + count) of every sample: a view sharing this tensor's buffer.
   Tensor channels(std::int64_t first, std::int64_t count) const;
+  // True when some element of this view and some element of `other` share storage. Views are
+  // sets of per-sample intervals, so interleaved channel slices of one tensor are disjoint.
+  bool overlaps(const Tensor& other) const;
+
   // Sample `index` of the batch as a batch of one.
   Tensor sample(std::int64_t index) const;
   // The same elements under another shape; contiguous tensors only.

@@ -1,7 +1,7 @@
 #include "inertialnet/ops/concat.hpp"
 
 #include "inertialnet/ops/elementwise.hpp"
-#include "ops/basic_ops_detail.hpp"
+#include "ops/op_support.hpp"
 
 namespace inertialnet {
 namespace {
@@ -64,7 +64,7 @@ void concat_channels(Queue& queue, const std::vector<Tensor>& inputs, const Tens
     const Tensor part = output.channels(first, inputs[i].dim(1));
     // An input may already sit in its own slot (produced in place); any other overlap with the
     // output would be overwritten before or while it is read.
-    if (!detail::same_view(part, inputs[i]) && detail::views_overlap(output, inputs[i])) {
+    if (!detail::same_view(part, inputs[i]) && output.overlaps(inputs[i])) {
       throw invalid_input(op + ": input " + std::to_string(i) + " overlaps the output outside its own slot");
     }
     first += inputs[i].dim(1);

@@ -6,28 +6,11 @@
 
 #include "inertialnet/device.hpp"
 #include "inertialnet/ops/gemm.hpp"
+#include "ops/op_support.hpp"
 
 namespace inertialnet {
 
 namespace {
-
-// The unfolded columns of one sample are a pooled temporary. At 512×384 the largest FlowNet2
-// layers need ≈ 29 M floats (FlowNetS conv1: 12·7·7 × 192·256; FlowNetSD conv1_1: 64·9 × 256·192);
-// larger inputs are unfolded in ranges of output pixels so the temporary never exceeds this
-// budget (or the device's largest allocation), whatever the resolution or the batch.
-constexpr std::size_t kColumnBudgetFloats = std::size_t(32) << 20;
-
-std::size_t column_budget(const Device& device, std::size_t requested) {
-  const std::size_t max_alloc = static_cast<std::size_t>(device.info().max_alloc_bytes / sizeof(float));
-  const std::size_t budget = requested ? requested : kColumnBudgetFloats;
-  return max_alloc ? std::min(budget, max_alloc) : budget;
-}
-
-// Work-group width for the 1-D-in-pixels kernels: 64 where the device allows it.
-std::size_t group_width(const Device& device) {
-  const std::size_t max = device.info().max_work_group_size;
-  return max ? std::min<std::size_t>(64, max) : 1;
-}
 
 std::string kernel_defines(int kh, int kw, int stride, int padding) {
   return "-DKH=" + std::to_string(kh) + " -DKW=" + std::to_string(kw) + " -DSTRIDE=" + std::to_string(stride) +
@@ -103,12 +86,12 @@ void conv2d(Queue& queue, const Tensor& input, const Tensor& weight, const Tenso
            MatrixView::of(input.sample(n), pixels), 0.0f, MatrixView::of(output.sample(n), pixels));
     }
   } else {
-    const std::size_t chunk = std::clamp<std::size_t>(column_budget(device, options.max_column_floats) / reduction, 1, pixels);
+    const std::size_t chunk = std::clamp<std::size_t>(detail::column_budget(device, options.max_column_floats) / reduction, 1, pixels);
     const Tensor columns = Tensor::empty(queue, {static_cast<std::int64_t>(reduction), static_cast<std::int64_t>(chunk)});
     Kernel& unfold = queue.kernel("im2col", "im2col",
                                   kernel_defines(static_cast<int>(kh), static_cast<int>(kw), options.stride,
                                                  options.padding));
-    const Range local(group_width(device), 1);
+    const Range local(detail::work_group_size(device, 64), 1);
     for (std::int64_t n = 0; n < batch; ++n) {
       const Tensor in_n = input.sample(n);
       const Tensor out_n = output.sample(n);
@@ -154,7 +137,7 @@ void add_bias_activation(Queue& queue, const Tensor& x, const Tensor& bias, cons
   const Tensor& bias_arg = has_bias ? bias : x;
   kernel.set_args(x, static_cast<int>(x.batch_stride()), static_cast<int>(x.dim(0)), static_cast<int>(x.dim(1)),
                   static_cast<int>(plane), bias_arg);
-  queue.launch(kernel, Range(sample, static_cast<std::size_t>(x.dim(0))), Range(group_width(queue.device()), 1));
+  queue.launch(kernel, Range(sample, static_cast<std::size_t>(x.dim(0))), Range(detail::work_group_size(queue.device(), 64), 1));
 }
 
 }  // namespace inertialnet

@@ -6,26 +6,11 @@
 
 #include "inertialnet/device.hpp"
 #include "inertialnet/ops/gemm.hpp"
+#include "ops/op_support.hpp"
 
 namespace inertialnet {
 
 namespace {
-
-// The GEMM's columns ([co·kh·kw, H·W] per sample) are a pooled temporary; at 512×384 the largest
-// is FlowNetFusion deconv0's 16·16 × 192·256 ≈ 12.6 M floats. Beyond this budget (or the device's
-// largest allocation) a sample is processed a block of output channels at a time.
-constexpr std::size_t kColumnBudgetFloats = std::size_t(32) << 20;
-
-std::size_t column_budget(const Device& device, std::size_t requested) {
-  const std::size_t max_alloc = static_cast<std::size_t>(device.info().max_alloc_bytes / sizeof(float));
-  const std::size_t budget = requested ? requested : kColumnBudgetFloats;
-  return max_alloc ? std::min(budget, max_alloc) : budget;
-}
-
-std::size_t group_width(const Device& device) {
-  const std::size_t max = device.info().max_work_group_size;
-  return max ? std::min<std::size_t>(64, max) : 1;
-}
 
 void require_defined(const Tensor& t, const char* what) {
   if (!t.defined()) throw invalid_input(std::string("conv_transpose2d: the ") + what + " tensor is undefined (empty)");
@@ -99,7 +84,7 @@ void conv_transpose2d(Queue& queue, const Tensor& input, const Tensor& weight, c
   const std::size_t out_pixels = static_cast<std::size_t>(expected[2] * expected[3]);
 
   const std::size_t block =
-      std::clamp<std::size_t>(column_budget(device, options.max_column_floats) / (taps * in_pixels), 1, out_channels);
+      std::clamp<std::size_t>(detail::column_budget(device, options.max_column_floats) / (taps * in_pixels), 1, out_channels);
   const Tensor columns =
       Tensor::empty(queue, {static_cast<std::int64_t>(block * taps), static_cast<std::int64_t>(in_pixels)});
   const bool has_bias = bias.defined();
@@ -110,7 +95,7 @@ void conv_transpose2d(Queue& queue, const Tensor& input, const Tensor& weight, c
       "-DKH=" + std::to_string(kh) + " -DKW=" + std::to_string(kw) + " -DSTRIDE=" + std::to_string(options.stride) +
           " -DPAD=" + std::to_string(options.padding) + " -DHAS_BIAS=" + (has_bias ? "1 " : "0 ") +
           activation_defines(options.activation));
-  const Range local(group_width(device), 1);
+  const Range local(detail::work_group_size(device, 64), 1);
 
   for (std::int64_t n = 0; n < input.n(); ++n) {
     const Tensor in_n = input.sample(n);

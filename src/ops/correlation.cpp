@@ -4,6 +4,7 @@
 #include <string>
 
 #include "inertialnet/device.hpp"
+#include "ops/op_support.hpp"
 
 namespace inertialnet {
 
@@ -41,20 +42,6 @@ void check_params(const CorrelationParams& p) {
 std::int64_t output_extent(std::int64_t size, const CorrelationParams& p) {
   const std::int64_t span = size + 2 * p.pad - 2 * (p.max_displacement + p.kernel_radius());
   return span <= 0 ? 0 : (span + p.stride1 - 1) / p.stride1;  // ceil(span / stride1)
-}
-
-// Whether two views of the same buffer share an element (per-sample intervals, so channel
-// slices of one concatenation that interleave across the batch are told apart).
-bool views_overlap(const Tensor& a, const Tensor& b) {
-  if (a.buffer() != b.buffer()) return false;
-  for (std::int64_t i = 0; i < a.dim(0); ++i) {
-    const std::size_t a0 = a.offset() + static_cast<std::size_t>(i) * a.batch_stride(), a1 = a0 + a.sample_size();
-    for (std::int64_t j = 0; j < b.dim(0); ++j) {
-      const std::size_t b0 = b.offset() + static_cast<std::size_t>(j) * b.batch_stride(), b1 = b0 + b.sample_size();
-      if (a0 < b1 && b0 < a1) return true;
-    }
-  }
-  return false;
 }
 
 void check_tensor(const Tensor& t, const char* name) {
@@ -100,7 +87,7 @@ void correlation(Queue& queue, const Tensor& input1, const Tensor& input2, const
     throw invalid_input(describe(params) + " of inputs " + to_string(input1.shape()) + " needs an output of shape " +
                         to_string(expected) + ", got " + to_string(output.shape()));
   }
-  if (views_overlap(output, input1) || views_overlap(output, input2)) {
+  if (output.overlaps(input1) || output.overlaps(input2)) {
     throw invalid_input("correlation output overlaps one of its inputs");
   }
 

@@ -4,7 +4,7 @@
 
 #include "inertialnet/device.hpp"
 #include "inertialnet/ops/elementwise.hpp"
-#include "ops/basic_ops_detail.hpp"
+#include "ops/op_support.hpp"
 
 namespace inertialnet {
 namespace {

@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "inertialnet/device.hpp"
-#include "ops/basic_ops_detail.hpp"
+#include "ops/op_support.hpp"
 
 namespace inertialnet {
 namespace {

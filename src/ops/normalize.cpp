@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "inertialnet/device.hpp"
-#include "ops/basic_ops_detail.hpp"
+#include "ops/op_support.hpp"
 
 namespace inertialnet {
 namespace {
@@ -73,7 +73,7 @@ void frame_channel_means(Queue& queue, const Tensor& frame1, const Tensor& frame
     throw invalid_input(kOp + ": the means tensor has shape " + to_string(means.shape()) + ", expected " +
                         to_string(expected) + " for frames " + to_string(frame1.shape()));
   }
-  if (detail::views_overlap(means, frame1) || detail::views_overlap(means, frame2)) {
+  if (means.overlaps(frame1) || means.overlaps(frame2)) {
     throw invalid_input(kOp + ": the means tensor overlaps a frame");
   }
   means.offset_int();
@@ -96,7 +96,7 @@ void normalize_frames(Queue& queue, const Tensor& frame1, const Tensor& frame2, 
   const Tensor first_half = output.channels(0, channels);
   const Tensor second_half = output.channels(channels, channels);
   auto check_alias = [&](const Tensor& frame, const std::string& role, const Tensor& slot) {
-    if (detail::views_overlap(output, frame) && !detail::same_view(frame, slot)) {
+    if (output.overlaps(frame) && !detail::same_view(frame, slot)) {
       throw invalid_input(kOp + ": the output overlaps the " + role +
                           " (in place, the frames must be exactly the two channel halves of the output)");
     }

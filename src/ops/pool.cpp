@@ -1,7 +1,7 @@
 #include "inertialnet/ops/pool.hpp"
 
 #include "inertialnet/device.hpp"
-#include "ops/basic_ops_detail.hpp"
+#include "ops/op_support.hpp"
 
 namespace inertialnet {
 

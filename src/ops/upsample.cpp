@@ -4,24 +4,11 @@
 #include <string>
 
 #include "inertialnet/device.hpp"
+#include "ops/op_support.hpp"
 
 namespace inertialnet {
 
 namespace {
-
-// Whether two views of the same buffer share an element (per-sample intervals, so channel
-// slices of one concatenation that interleave across the batch are told apart).
-bool views_overlap(const Tensor& a, const Tensor& b) {
-  if (a.buffer() != b.buffer()) return false;
-  for (std::int64_t i = 0; i < a.dim(0); ++i) {
-    const std::size_t a0 = a.offset() + static_cast<std::size_t>(i) * a.batch_stride(), a1 = a0 + a.sample_size();
-    for (std::int64_t j = 0; j < b.dim(0); ++j) {
-      const std::size_t b0 = b.offset() + static_cast<std::size_t>(j) * b.batch_stride(), b1 = b0 + b.sample_size();
-      if (a0 < b1 && b0 < a1) return true;
-    }
-  }
-  return false;
-}
 
 void check_nchw(const Tensor& t, const std::string& what) {
   if (!t.defined()) throw invalid_input(what + " is an undefined tensor");
@@ -44,7 +31,7 @@ void resample(Queue& queue, const Tensor& input, const Tensor& output, Interpola
     throw invalid_input(what + ": the output of shape " + to_string(output.shape()) +
                         " must have the batch and channels of the input of shape " + to_string(input.shape()));
   }
-  if (views_overlap(output, input)) throw invalid_input(what + ": the output overlaps the input");
+  if (output.overlaps(input)) throw invalid_input(what + ": the output overlaps the input");
 
   const int in_h = static_cast<int>(input.h()), in_w = static_cast<int>(input.w());
   const int out_h = static_cast<int>(output.h()), out_w = static_cast<int>(output.w());
@@ -56,7 +43,7 @@ void resample(Queue& queue, const Tensor& input, const Tensor& output, Interpola
   kernel.set_args(input, static_cast<int>(input.batch_stride()), output, static_cast<int>(output.batch_stride()),
                   static_cast<int>(input.c()), in_h, in_w, out_h, out_w, ratio_y, ratio_x, scale0, scale1);
   const std::size_t local =
-      std::max<std::size_t>(1, std::min<std::size_t>(64, queue.device().info().max_work_group_size));
+      detail::work_group_size(queue.device(), 64);
   queue.launch(kernel, Range(static_cast<std::size_t>(out_w), static_cast<std::size_t>(out_h),
                              static_cast<std::size_t>(input.n() * input.c())),
                Range(local, 1, 1));

@@ -4,24 +4,11 @@
 #include <string>
 
 #include "inertialnet/device.hpp"
+#include "ops/op_support.hpp"
 
 namespace inertialnet {
 
 namespace {
-
-// Whether two views of the same buffer share an element (per-sample intervals, so channel
-// slices of one concatenation that interleave across the batch are told apart).
-bool views_overlap(const Tensor& a, const Tensor& b) {
-  if (a.buffer() != b.buffer()) return false;
-  for (std::int64_t i = 0; i < a.dim(0); ++i) {
-    const std::size_t a0 = a.offset() + static_cast<std::size_t>(i) * a.batch_stride(), a1 = a0 + a.sample_size();
-    for (std::int64_t j = 0; j < b.dim(0); ++j) {
-      const std::size_t b0 = b.offset() + static_cast<std::size_t>(j) * b.batch_stride(), b1 = b0 + b.sample_size();
-      if (a0 < b1 && b0 < a1) return true;
-    }
-  }
-  return false;
-}
 
 void check_defined(const Tensor& t, const char* name) {
   if (!t.defined()) throw invalid_input(std::string("warp ") + name + " is an undefined tensor");
@@ -54,7 +41,7 @@ void warp(Queue& queue, const Tensor& image, const Tensor& flow, const Tensor& o
     throw invalid_input("warp output must have the image's shape " + to_string(expected) + ", got " +
                         to_string(output.shape()));
   }
-  if (views_overlap(output, image) || views_overlap(output, flow)) {
+  if (output.overlaps(image) || output.overlaps(flow)) {
     throw invalid_input("warp output overlaps its image or flow; it must be a separate tensor");
   }
   const int height = static_cast<int>(image.h()), width = static_cast<int>(image.w());
@@ -63,7 +50,7 @@ void warp(Queue& queue, const Tensor& image, const Tensor& flow, const Tensor& o
                   static_cast<int>(output.batch_stride()), static_cast<int>(image.c()), height, width);
   // Rows of up to 64 pixels per group: contiguous flow reads, vectorisable on CPUs.
   const std::size_t local =
-      std::max<std::size_t>(1, std::min<std::size_t>(64, queue.device().info().max_work_group_size));
+      detail::work_group_size(queue.device(), 64);
   queue.launch(kernel, Range(static_cast<std::size_t>(width), static_cast<std::size_t>(height),
                              static_cast<std::size_t>(image.n())),
                Range(local, 1, 1));

@@ -98,6 +98,19 @@ Tensor Tensor::channels(std::int64_t first, std::int64_t count) const {
   return view;
 }
 
+bool Tensor::overlaps(const Tensor& other) const {
+  if (!defined() || !other.defined() || buffer() != other.buffer()) return false;
+  const std::size_t sa = sample_size(), sb = other.sample_size();
+  for (std::int64_t i = 0; i < dim(0); ++i) {
+    const std::size_t a0 = offset_ + static_cast<std::size_t>(i) * batch_stride_;
+    for (std::int64_t j = 0; j < other.dim(0); ++j) {
+      const std::size_t b0 = other.offset_ + static_cast<std::size_t>(j) * other.batch_stride_;
+      if (a0 < b0 + sb && b0 < a0 + sa) return true;
+    }
+  }
+  return false;
+}
+
 Tensor Tensor::sample(std::int64_t index) const {
   if (index < 0 || index >= dim(0)) {
     throw invalid_input("sample " + std::to_string(index) + " is outside a batch of " + std::to_string(dim(0)));

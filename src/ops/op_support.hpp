@@ -1,8 +1,9 @@
-// Helpers shared by the host code of the memory-bound ops (elementwise, concat, pool, normalize,
-// dropout): work-group sizes, aliasing checks and the two-level (sample, batch) launch layout
-// that lets every tensor be a channel slice.
+// Helpers shared by the host code of the ops: work-group sizes, the GEMM ops' column budget,
+// aliasing checks and the two-level (sample, batch) launch layout that lets every tensor be a
+// channel slice.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <initializer_list>
 #include <string>
@@ -23,20 +24,15 @@ inline std::size_t work_group_size(const Device& device, std::size_t wanted = 25
   return size;
 }
 
-// True when some element of `a` and some element of `b` share storage. Views are sets of
-// per-sample intervals [offset + n·batch_stride, … + sample_size), so interleaved channel slices
-// of one tensor are correctly found disjoint.
-inline bool views_overlap(const Tensor& a, const Tensor& b) {
-  if (!a.defined() || !b.defined() || a.buffer() != b.buffer()) return false;
-  const std::size_t sa = a.sample_size(), sb = b.sample_size();
-  for (std::int64_t i = 0; i < a.dim(0); ++i) {
-    const std::size_t a0 = a.offset() + static_cast<std::size_t>(i) * a.batch_stride();
-    for (std::int64_t j = 0; j < b.dim(0); ++j) {
-      const std::size_t b0 = b.offset() + static_cast<std::size_t>(j) * b.batch_stride();
-      if (a0 < b0 + sb && b0 < a0 + sa) return true;
-    }
-  }
-  return false;
+// The unfolded columns of the GEMM-based ops (im2col for conv2d, Wᵀ·X for conv_transpose2d) are
+// a pooled temporary of at most this many floats, or the device's largest allocation, or
+// `requested` when given; larger problems are processed in ranges. At 512×384 the largest
+// FlowNet2 layers need ≈ 29 M floats (FlowNetS conv1: 12·7·7 × 192·256).
+inline std::size_t column_budget(const Device& device, std::size_t requested) {
+  constexpr std::size_t kDefaultFloats = std::size_t(32) << 20;
+  const std::size_t max_alloc = static_cast<std::size_t>(device.info().max_alloc_bytes / sizeof(float));
+  const std::size_t budget = requested ? requested : kDefaultFloats;
+  return max_alloc ? std::min(budget, max_alloc) : budget;
 }
 
 // The same elements in the same order: the one kind of aliasing an elementwise kernel tolerates.
@@ -60,7 +56,7 @@ inline void require_rank4(const Tensor& t, const std::string& op, const std::str
 // overlap it: work-items would read elements another one already overwrote.
 inline void require_no_partial_alias(const Tensor& output, const Tensor& input, const std::string& op,
                                      const std::string& input_role, bool in_place_allowed) {
-  if (!views_overlap(output, input)) return;
+  if (!output.overlaps(input)) return;
   if (in_place_allowed && same_view(output, input)) return;
   throw invalid_input(op + ": the output overlaps the " + input_role +
                       (in_place_allowed ? " without being the same view (only exact in-place updates are allowed)"
