@@ -1,5 +1,5 @@
 // Natural cubic spline against analytic signals.
-#include <gtest/gtest.h>
+#include "support/testing.hpp"
 
 #include <cmath>
 #include <functional>
@@ -23,15 +23,6 @@ CubicSpline sample(double a, double b, std::size_t n, double (*f)(double)) {
   return CubicSpline(x, y);
 }
 
-void expect_invalid(const std::function<void()>& f, const std::string& part) {
-  try {
-    f();
-    ADD_FAILURE() << "expected invalid_input containing \"" << part << "\"";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.kind(), ErrorKind::InvalidInput);
-    EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
-  }
-}
 
 }  // namespace
 
@@ -131,16 +122,16 @@ TEST(CubicSpline, IntegralIsExactForEachPiece) {
 
 TEST(CubicSpline, RejectsBadInputAndNeverExtrapolates) {
   const CubicSpline s({0.0, 1.0, 2.0}, {0.0, 1.0, 0.0});
-  expect_invalid([&] { s(2.0 + 1e-12); }, "does not extrapolate");
-  expect_invalid([&] { s(-0.001); }, "outside the data range");
-  expect_invalid([&] { s.integral(0.5, 2.5); }, "outside the data range");
-  expect_invalid([&] { s.integral(1.5, 0.5); }, "reversed");
-  expect_invalid([&] { s.mean(1.0, 1.0); }, "a < b");
-  expect_invalid([] { CubicSpline({0.0, 1.0, 1.0}, {0.0, 1.0, 2.0}); }, "x[2]");
-  expect_invalid([] { CubicSpline({0.0, 2.0, 1.0}, {0.0, 1.0, 2.0}); }, "strictly increase");
-  expect_invalid([] { CubicSpline({0.0}, {0.0}); }, "at least 2");
-  expect_invalid([] { CubicSpline({0.0, 1.0}, {0.0}); }, "y values");
-  expect_invalid([] { CubicSpline({0.0, 1.0}, {0.0, std::nan("")}); }, "not finite");
+  inertialnet::testing::expect_invalid_input([&] { s(2.0 + 1e-12); }, "does not extrapolate");
+  inertialnet::testing::expect_invalid_input([&] { s(-0.001); }, "outside the data range");
+  inertialnet::testing::expect_invalid_input([&] { s.integral(0.5, 2.5); }, "outside the data range");
+  inertialnet::testing::expect_invalid_input([&] { s.integral(1.5, 0.5); }, "reversed");
+  inertialnet::testing::expect_invalid_input([&] { s.mean(1.0, 1.0); }, "a < b");
+  inertialnet::testing::expect_invalid_input([] { CubicSpline({0.0, 1.0, 1.0}, {0.0, 1.0, 2.0}); }, "x[2]");
+  inertialnet::testing::expect_invalid_input([] { CubicSpline({0.0, 2.0, 1.0}, {0.0, 1.0, 2.0}); }, "strictly increase");
+  inertialnet::testing::expect_invalid_input([] { CubicSpline({0.0}, {0.0}); }, "at least 2");
+  inertialnet::testing::expect_invalid_input([] { CubicSpline({0.0, 1.0}, {0.0}); }, "y values");
+  inertialnet::testing::expect_invalid_input([] { CubicSpline({0.0, 1.0}, {0.0, std::nan("")}); }, "not finite");
   EXPECT_DOUBLE_EQ(s(2.0), 0.0);  // the end itself is inside
 }
 

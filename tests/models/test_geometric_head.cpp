@@ -150,15 +150,6 @@ GeometricHeadOptions quarter_options() {
                                        << ": worst axis error " << worst << " > " << bound_deg_s << " deg/s";
 }
 
-void expect_invalid(const std::function<void()>& call, const std::string& needle) {
-  try {
-    call();
-    ADD_FAILURE() << "accepted; expected an error mentioning \"" << needle << "\"";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.kind(), ErrorKind::InvalidInput) << e.what();
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
-}
 
 // Rates with distinct magnitudes ≥ 10 deg/s on every axis, up to 60 deg/s.
 const std::vector<Vec3> kRates = {
@@ -239,17 +230,17 @@ TEST(CameraIntrinsics, FromEurocCalibration) {
   ASSERT_EQ(k.coefficients.size(), 4u);
 
   c.distortion_model = "omni";
-  expect_invalid([&] { CameraIntrinsics::from_calibration(c); }, "distortion model 'omni' is not supported");
+  testing::expect_invalid_input([&] { CameraIntrinsics::from_calibration(c); }, "distortion model 'omni' is not supported");
   c.distortion_model = "equidistant";
   c.distortion = {0.1, 0.2};
-  expect_invalid([&] { CameraIntrinsics::from_calibration(c); }, "takes 4 distortion coefficients, got 2");
+  testing::expect_invalid_input([&] { CameraIntrinsics::from_calibration(c); }, "takes 4 distortion coefficients, got 2");
   c.distortion_model = "none";
   c.distortion = {};
   c.intrinsics[0] = -1;
-  expect_invalid([&] { CameraIntrinsics::from_calibration(c); }, "focal lengths must be positive");
+  testing::expect_invalid_input([&] { CameraIntrinsics::from_calibration(c); }, "focal lengths must be positive");
   c.intrinsics[0] = 458;
   c.camera_model = "omni";
-  expect_invalid([&] { CameraIntrinsics::from_calibration(c); }, "camera model 'omni' is not supported");
+  testing::expect_invalid_input([&] { CameraIntrinsics::from_calibration(c); }, "camera model 'omni' is not supported");
 }
 
 // --- the reductions against the reference ----------------------------------------------------
@@ -520,36 +511,36 @@ TEST(GeometricHead, BadInputIsInvalidInput) {
   const CameraIntrinsics k = quarter_euroc();
   GeometricHead head(device, k, quarter_options());
   const Tensor good = Tensor::empty(device, {1, 2, 120, 188});
-  expect_invalid([&] { head.estimate(queue, Tensor::empty(device, {1, 3, 120, 188}), 0.05); },
+  testing::expect_invalid_input([&] { head.estimate(queue, Tensor::empty(device, {1, 3, 120, 188}), 0.05); },
                  "the flow must be [1, 2, 120, 188]");
-  expect_invalid([&] { head.estimate(queue, Tensor::empty(device, {1, 2, 121, 188}), 0.05); }, "got [1, 2, 121, 188]");
-  expect_invalid([&] { head.estimate(queue, Tensor::empty(device, {2, 2, 120, 188}), 0.05); }, "got [2, 2, 120, 188]");
-  expect_invalid([&] { head.estimate(queue, good, 0.0); }, "dt must be a positive number");
-  expect_invalid([&] { head.estimate(queue, good, std::nan("")); }, "dt must be a positive number");
-  expect_invalid([&] { head.estimate(queue, FlowField(100, 120), 0.05); }, "the flow is 100×120 but the camera is 188×120");
+  testing::expect_invalid_input([&] { head.estimate(queue, Tensor::empty(device, {1, 2, 121, 188}), 0.05); }, "got [1, 2, 121, 188]");
+  testing::expect_invalid_input([&] { head.estimate(queue, Tensor::empty(device, {2, 2, 120, 188}), 0.05); }, "got [2, 2, 120, 188]");
+  testing::expect_invalid_input([&] { head.estimate(queue, good, 0.0); }, "dt must be a positive number");
+  testing::expect_invalid_input([&] { head.estimate(queue, good, std::nan("")); }, "dt must be a positive number");
+  testing::expect_invalid_input([&] { head.estimate(queue, FlowField(100, 120), 0.05); }, "the flow is 100×120 but the camera is 188×120");
 
   FlowField unknown(188, 120);
   std::fill(unknown.u.begin(), unknown.u.end(), kUnknownFlowValue);
-  expect_invalid([&] { head.estimate(queue, unknown, 0.05); }, "only 0 flow vectors of the sample grid are usable");
+  testing::expect_invalid_input([&] { head.estimate(queue, unknown, 0.05); }, "only 0 flow vectors of the sample grid are usable");
   FlowField outside(188, 120);
   std::fill(outside.u.begin(), outside.u.end(), 500.0f);
-  expect_invalid([&] { head.estimate(queue, outside, 0.05); }, "are usable");
+  testing::expect_invalid_input([&] { head.estimate(queue, outside, 0.05); }, "are usable");
 
   GeometricHeadOptions bad = quarter_options();
   bad.stride = 0;
-  expect_invalid([&] { GeometricHead h(device, k, bad); }, "stride must be at least 1");
+  testing::expect_invalid_input([&] { GeometricHead h(device, k, bad); }, "stride must be at least 1");
   bad = quarter_options();
   bad.robust_scale_px = -1;
-  expect_invalid([&] { head.set_options(bad); }, "robust scale must be a positive number");
+  testing::expect_invalid_input([&] { head.set_options(bad); }, "robust scale must be a positive number");
   CameraIntrinsics tiny = k;
   tiny.width = 1;
-  expect_invalid([&] { GeometricHead h(device, tiny); }, "too small");
+  testing::expect_invalid_input([&] { GeometricHead h(device, tiny); }, "too small");
 
   GeometricHeadOptions o = quarter_options();
   o.solver = GeometricSolver::OpenGV;
   head.set_options(o);
-  expect_invalid([&] { head.estimate(queue, outside, 0.05); }, "at least 10 are needed");
-  expect_invalid([&] { solve_opengv({}, 0.05, 100, o); }, "at least 10 are needed");
+  testing::expect_invalid_input([&] { head.estimate(queue, outside, 0.05); }, "at least 10 are needed");
+  testing::expect_invalid_input([&] { solve_opengv({}, 0.05, 100, o); }, "at least 10 are needed");
 }
 
 }  // namespace

@@ -74,16 +74,4 @@ inline ::testing::AssertionResult untouched_outside(Queue& queue, const Sliced& 
   return ::testing::AssertionSuccess();
 }
 
-// `call` throws Error(InvalidInput) whose message contains `needle`.
-template <class Call>
-void expect_invalid_input(Call&& call, const std::string& needle) {
-  try {
-    call();
-    ADD_FAILURE() << "accepted; expected an invalid_input mentioning '" << needle << "'";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.kind(), ErrorKind::InvalidInput) << e.what();
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << "message: " << e.what();
-  }
-}
-
 }  // namespace inertialnet::testing

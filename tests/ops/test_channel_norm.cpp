@@ -11,18 +11,10 @@ namespace inertialnet {
 namespace {
 
 using reference::Dims;
+using reference::shape_of;
+using reference::slice_channels;
 
-Shape shape_of(Dims d) { return {d.n, d.c, d.h, d.w}; }
 
-std::vector<float> slice_channels(const std::vector<float>& data, Dims d, int first, int count) {
-  const std::size_t plane = static_cast<std::size_t>(d.h) * d.w;
-  std::vector<float> out;
-  for (int n = 0; n < d.n; ++n) {
-    const auto begin = data.begin() + static_cast<std::ptrdiff_t>((static_cast<std::size_t>(n) * d.c + first) * plane);
-    out.insert(out.end(), begin, begin + static_cast<std::ptrdiff_t>(count * plane));
-  }
-  return out;
-}
 
 // A float32 sum of a few squares and one sqrt against double: a few ulp.
 constexpr double kTolerance = 1e-6;
@@ -89,29 +81,20 @@ TEST(ChannelNorm, SlicedInputsAndOutputLeaveTheRestUntouched) {
   EXPECT_EQ(slice_channels(after, concat, 10, 1), slice_channels(concat_data, concat, 10, 1));
 }
 
-void expect_invalid(const std::function<void()>& call, const std::string& needle) {
-  try {
-    call();
-    ADD_FAILURE() << "accepted; expected an error mentioning \"" << needle << "\"";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.kind(), ErrorKind::InvalidInput) << e.what();
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
-}
 
 TEST(ChannelNorm, BadShapesAreInvalidInput) {
   Queue& queue = testing::test_queue();
   Device& device = testing::test_device();
   Tensor in = Tensor::empty(device, {2, 3, 8, 8});
-  expect_invalid([&] { channel_norm(queue, in, Tensor::empty(device, {2, 2, 8, 8})); },
+  testing::expect_invalid_input([&] { channel_norm(queue, in, Tensor::empty(device, {2, 2, 8, 8})); },
                  "output must have shape [2, 1, 8, 8], got [2, 2, 8, 8]");
-  expect_invalid([&] { channel_norm(queue, in, Tensor::empty(device, {1, 1, 8, 8})); }, "output must have shape");
-  expect_invalid([&] { channel_norm(queue, Tensor::empty(device, {3, 8, 8})); }, "must be NCHW");
-  expect_invalid([&] { channel_norm(queue, Tensor()); }, "undefined");
-  expect_invalid([&] { channel_norm_difference(queue, in, Tensor::empty(device, {2, 3, 8, 9})); },
+  testing::expect_invalid_input([&] { channel_norm(queue, in, Tensor::empty(device, {1, 1, 8, 8})); }, "output must have shape");
+  testing::expect_invalid_input([&] { channel_norm(queue, Tensor::empty(device, {3, 8, 8})); }, "must be NCHW");
+  testing::expect_invalid_input([&] { channel_norm(queue, Tensor()); }, "undefined");
+  testing::expect_invalid_input([&] { channel_norm_difference(queue, in, Tensor::empty(device, {2, 3, 8, 9})); },
                  "shapes [2, 3, 8, 8] and [2, 3, 8, 9]");
-  expect_invalid([&] { channel_norm(queue, in, in.channels(1, 1)); }, "overlaps");
-  expect_invalid([&] { channel_norm_output_shape({1, 3, 0, 8}); }, "empty dimension");
+  testing::expect_invalid_input([&] { channel_norm(queue, in, in.channels(1, 1)); }, "overlaps");
+  testing::expect_invalid_input([&] { channel_norm_output_shape({1, 3, 0, 8}); }, "empty dimension");
 }
 
 }  // namespace

@@ -184,15 +184,6 @@ TEST(Conv2d, ConvenienceOverloadAllocatesTheOutput) {
                                  std::sqrt(27.0)));
 }
 
-void expect_invalid(const std::function<void()>& call, const std::string& needle) {
-  try {
-    call();
-    ADD_FAILURE() << "accepted; expected an error mentioning '" << needle << "'";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.kind(), ErrorKind::InvalidInput) << e.what();
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
-}
 
 TEST(Conv2d, BadShapesAreInvalidInput) {
   Queue& queue = testing::test_queue();
@@ -205,31 +196,31 @@ TEST(Conv2d, BadShapesAreInvalidInput) {
   // The valid call, so each failure below is caused by the one thing it changes.
   EXPECT_NO_THROW(conv2d(queue, input, weight, bias, output, same));
 
-  expect_invalid([&] { conv2d(queue, Tensor::empty(device, {1, 5, 8, 8}), weight, bias, output, same); },
+  testing::expect_invalid_input([&] { conv2d(queue, Tensor::empty(device, {1, 5, 8, 8}), weight, bias, output, same); },
                  "input has 5 channels");
-  expect_invalid([&] { conv2d(queue, input, Tensor::empty(device, {8, 4, 9}), bias, output, same); },
+  testing::expect_invalid_input([&] { conv2d(queue, input, Tensor::empty(device, {8, 4, 9}), bias, output, same); },
                  "weight must be [co, ci, kh, kw]");
-  expect_invalid([&] { conv2d(queue, Tensor::empty(device, {4, 8, 8}), weight, bias, output, same); }, "NCHW");
-  expect_invalid([&] { conv2d(queue, input, weight, Tensor::empty(device, {7}), output, same); },
+  testing::expect_invalid_input([&] { conv2d(queue, Tensor::empty(device, {4, 8, 8}), weight, bias, output, same); }, "NCHW");
+  testing::expect_invalid_input([&] { conv2d(queue, input, weight, Tensor::empty(device, {7}), output, same); },
                  "bias has shape [7], expected [8]");
-  expect_invalid([&] { conv2d(queue, input, weight, Tensor::empty(device, {8, 1}), output, same); }, "bias has shape");
-  expect_invalid([&] { conv2d(queue, input, weight, bias, Tensor::empty(device, {1, 8, 6, 6}), same); },
+  testing::expect_invalid_input([&] { conv2d(queue, input, weight, Tensor::empty(device, {8, 1}), output, same); }, "bias has shape");
+  testing::expect_invalid_input([&] { conv2d(queue, input, weight, bias, Tensor::empty(device, {1, 8, 6, 6}), same); },
                  "output has shape [1, 8, 6, 6]");
-  expect_invalid([&] { conv2d(queue, input, weight, bias, Tensor::empty(device, {2, 8, 8, 8}), same); },
+  testing::expect_invalid_input([&] { conv2d(queue, input, weight, bias, Tensor::empty(device, {2, 8, 8, 8}), same); },
                  "gives [1, 8, 8, 8]");
   // Zero sizes: an undefined tensor, a kernel larger than the padded input, a zero stride.
-  expect_invalid([&] { conv2d(queue, Tensor(), weight, bias, output, same); }, "input tensor is undefined");
-  expect_invalid([&] { conv2d(queue, input, weight, bias, Tensor(), same); }, "output tensor is undefined");
-  expect_invalid(
+  testing::expect_invalid_input([&] { conv2d(queue, Tensor(), weight, bias, output, same); }, "input tensor is undefined");
+  testing::expect_invalid_input([&] { conv2d(queue, input, weight, bias, Tensor(), same); }, "output tensor is undefined");
+  testing::expect_invalid_input(
       [&] {
         conv2d(queue, Tensor::empty(device, {1, 4, 2, 8}), Tensor::empty(device, {8, 4, 5, 5}), bias, output, {});
       },
       "does not fit");
-  expect_invalid([&] { conv2d(queue, input, weight, bias, output, Conv2dOptions{0, 1, {}}); },
+  testing::expect_invalid_input([&] { conv2d(queue, input, weight, bias, output, Conv2dOptions{0, 1, {}}); },
                  "stride must be at least 1");
-  expect_invalid([&] { conv2d(queue, input, weight, bias, output, Conv2dOptions{1, -1, {}}); },
+  testing::expect_invalid_input([&] { conv2d(queue, input, weight, bias, output, Conv2dOptions{1, -1, {}}); },
                  "padding must not be negative");
-  expect_invalid([&] { conv2d_output_shape({1, 4, 0, 8}, {8, 4, 3, 3}, 1, 1); }, "zero or negative size");
+  testing::expect_invalid_input([&] { conv2d_output_shape({1, 4, 0, 8}, {8, 4, 3, 3}, 1, 1); }, "zero or negative size");
 }
 
 }  // namespace

@@ -145,15 +145,6 @@ TEST(ConvTranspose2d, ConvenienceOverloadAllocatesTheOutput) {
                                  std::sqrt(12.0)));
 }
 
-void expect_invalid(const std::function<void()>& call, const std::string& needle) {
-  try {
-    call();
-    ADD_FAILURE() << "accepted; expected an error mentioning '" << needle << "'";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.kind(), ErrorKind::InvalidInput) << e.what();
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
-}
 
 TEST(ConvTranspose2d, BadShapesAreInvalidInput) {
   Queue& queue = testing::test_queue();
@@ -166,28 +157,28 @@ TEST(ConvTranspose2d, BadShapesAreInvalidInput) {
   EXPECT_NO_THROW(conv_transpose2d(queue, input, weight, bias, output, flownet));
 
   // A Conv2d-layout weight [co, ci, k, k] is the likely mistake.
-  expect_invalid([&] { conv_transpose2d(queue, input, Tensor::empty(device, {3, 6, 4, 4}), bias, output, flownet); },
+  testing::expect_invalid_input([&] { conv_transpose2d(queue, input, Tensor::empty(device, {3, 6, 4, 4}), bias, output, flownet); },
                  "input has 6 channels");
-  expect_invalid([&] { conv_transpose2d(queue, input, Tensor::empty(device, {6, 3, 16}), bias, output, flownet); },
+  testing::expect_invalid_input([&] { conv_transpose2d(queue, input, Tensor::empty(device, {6, 3, 16}), bias, output, flownet); },
                  "weight must be [ci, co, kh, kw]");
-  expect_invalid([&] { conv_transpose2d(queue, input, weight, Tensor::empty(device, {6}), output, flownet); },
+  testing::expect_invalid_input([&] { conv_transpose2d(queue, input, weight, Tensor::empty(device, {6}), output, flownet); },
                  "bias has shape [6], expected [3]");
-  expect_invalid([&] { conv_transpose2d(queue, input, weight, bias, Tensor::empty(device, {1, 3, 9, 9}), flownet); },
+  testing::expect_invalid_input([&] { conv_transpose2d(queue, input, weight, bias, Tensor::empty(device, {1, 3, 9, 9}), flownet); },
                  "output has shape [1, 3, 9, 9]");
-  expect_invalid([&] { conv_transpose2d(queue, input, weight, bias, Tensor::empty(device, {1, 6, 8, 8}), flownet); },
+  testing::expect_invalid_input([&] { conv_transpose2d(queue, input, weight, bias, Tensor::empty(device, {1, 6, 8, 8}), flownet); },
                  "gives [1, 3, 8, 8]");
-  expect_invalid([&] { conv_transpose2d(queue, Tensor(), weight, bias, output, flownet); }, "input tensor is undefined");
-  expect_invalid([&] { conv_transpose2d(queue, input, weight, bias, Tensor(), flownet); }, "output tensor is undefined");
+  testing::expect_invalid_input([&] { conv_transpose2d(queue, Tensor(), weight, bias, output, flownet); }, "input tensor is undefined");
+  testing::expect_invalid_input([&] { conv_transpose2d(queue, input, weight, bias, Tensor(), flownet); }, "output tensor is undefined");
   // (1 − 1)·2 − 2·1 + 1 = −1: an empty output.
-  expect_invalid(
+  testing::expect_invalid_input(
       [&] {
         conv_transpose2d(queue, Tensor::empty(device, {1, 6, 1, 1}), Tensor::empty(device, {6, 3, 1, 1}), bias, output,
                          flownet);
       },
       "empty output");
-  expect_invalid([&] { conv_transpose2d(queue, input, weight, bias, output, ConvTranspose2dOptions{0, 1, {}}); },
+  testing::expect_invalid_input([&] { conv_transpose2d(queue, input, weight, bias, output, ConvTranspose2dOptions{0, 1, {}}); },
                  "stride must be at least 1");
-  expect_invalid([&] { conv_transpose2d_output_shape({1, 6, 4, 0}, {6, 3, 4, 4}, 2, 1); }, "zero or negative size");
+  testing::expect_invalid_input([&] { conv_transpose2d_output_shape({1, 6, 4, 0}, {6, 3, 4, 4}, 2, 1); }, "zero or negative size");
 }
 
 }  // namespace

@@ -11,19 +11,10 @@ namespace inertialnet {
 namespace {
 
 using reference::Dims;
+using reference::shape_of;
+using reference::slice_channels;
 
-Shape shape_of(Dims d) { return {d.n, d.c, d.h, d.w}; }
 
-// Channels [first, first + count) of each sample of a contiguous NCHW vector.
-std::vector<float> slice_channels(const std::vector<float>& data, Dims d, int first, int count) {
-  const std::size_t plane = static_cast<std::size_t>(d.h) * d.w;
-  std::vector<float> out;
-  for (int n = 0; n < d.n; ++n) {
-    const auto begin = data.begin() + static_cast<std::ptrdiff_t>((static_cast<std::size_t>(n) * d.c + first) * plane);
-    out.insert(out.end(), begin, begin + static_cast<std::ptrdiff_t>(count * plane));
-  }
-  return out;
-}
 
 // Float32 sums of n = k²·C products of values in [−1, 1] against a double reference: rounding
 // grows like sqrt(n)·eps on sums of magnitude ~sqrt(n), so after the division by n the error is
@@ -171,15 +162,6 @@ TEST(Correlation, SlicedInputsAndOutputLeaveTheRestUntouched) {
   EXPECT_EQ(slice_channels(after, parent_out, 473, 3), slice_channels(po, parent_out, 473, 3));
 }
 
-void expect_invalid(const std::function<void()>& call, const std::string& needle) {
-  try {
-    call();
-    ADD_FAILURE() << "accepted; expected an error mentioning \"" << needle << "\"";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.kind(), ErrorKind::InvalidInput) << e.what();
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
-}
 
 TEST(Correlation, BadShapesAndSettingsAreInvalidInput) {
   Queue& queue = testing::test_queue();
@@ -188,13 +170,13 @@ TEST(Correlation, BadShapesAndSettingsAreInvalidInput) {
   Tensor b = Tensor::empty(device, {1, 8, 8, 8});
   Tensor c = Tensor::empty(device, {1, 16, 8, 9});
   Tensor out = Tensor::empty(device, {1, 441, 8, 8});
-  expect_invalid([&] { correlation(queue, a, b, out); }, "16 and 8 channels");
-  expect_invalid([&] { correlation(queue, a, c, out); }, "shapes [1, 16, 8, 8] and [1, 16, 8, 9]");
-  expect_invalid([&] { correlation(queue, a, a, Tensor::empty(device, {1, 441, 8, 7})); },
+  testing::expect_invalid_input([&] { correlation(queue, a, b, out); }, "16 and 8 channels");
+  testing::expect_invalid_input([&] { correlation(queue, a, c, out); }, "shapes [1, 16, 8, 8] and [1, 16, 8, 9]");
+  testing::expect_invalid_input([&] { correlation(queue, a, a, Tensor::empty(device, {1, 441, 8, 7})); },
                  "needs an output of shape [1, 441, 8, 8], got [1, 441, 8, 7]");
-  expect_invalid([&] { correlation(queue, a, a, Tensor::empty(device, {441, 8, 8})); }, "must be NCHW");
-  expect_invalid([&] { correlation(queue, a, Tensor(), out); }, "undefined");
-  expect_invalid([&] { correlation(queue, out.channels(0, 16), a, out); }, "overlaps");
+  testing::expect_invalid_input([&] { correlation(queue, a, a, Tensor::empty(device, {441, 8, 8})); }, "must be NCHW");
+  testing::expect_invalid_input([&] { correlation(queue, a, Tensor(), out); }, "undefined");
+  testing::expect_invalid_input([&] { correlation(queue, out.channels(0, 16), a, out); }, "overlaps");
 
   auto with = [](auto change) {
     CorrelationParams p;
@@ -202,19 +184,19 @@ TEST(Correlation, BadShapesAndSettingsAreInvalidInput) {
     return p;
   };
   const Shape shape{1, 16, 8, 8};
-  expect_invalid([&] { correlation_output_shape(shape, with([](auto& p) { p.pad = 10; })); },
+  testing::expect_invalid_input([&] { correlation_output_shape(shape, with([](auto& p) { p.pad = 10; })); },
                  "max displacement exceeds the padding");
-  expect_invalid([&] { correlation(queue, a, a, out, with([](auto& p) { p.max_displacement = 24; })); },
+  testing::expect_invalid_input([&] { correlation(queue, a, a, out, with([](auto& p) { p.max_displacement = 24; })); },
                  "max displacement exceeds the padding");
-  expect_invalid([&] { correlation_output_shape(shape, with([](auto& p) { p.kernel_size = 2; })); }, "odd");
-  expect_invalid([&] { correlation_output_shape(shape, with([](auto& p) { p.kernel_size = 0; })); }, "odd");
-  expect_invalid([&] { correlation_output_shape(shape, with([](auto& p) { p.stride1 = 0; })); }, "strides");
-  expect_invalid([&] { correlation_output_shape(shape, with([](auto& p) { p.stride2 = -1; })); }, "strides");
-  expect_invalid([&] { correlation_output_shape(shape, with([](auto& p) { p.max_displacement = -2; })); },
+  testing::expect_invalid_input([&] { correlation_output_shape(shape, with([](auto& p) { p.kernel_size = 2; })); }, "odd");
+  testing::expect_invalid_input([&] { correlation_output_shape(shape, with([](auto& p) { p.kernel_size = 0; })); }, "odd");
+  testing::expect_invalid_input([&] { correlation_output_shape(shape, with([](auto& p) { p.stride1 = 0; })); }, "strides");
+  testing::expect_invalid_input([&] { correlation_output_shape(shape, with([](auto& p) { p.stride2 = -1; })); }, "strides");
+  testing::expect_invalid_input([&] { correlation_output_shape(shape, with([](auto& p) { p.max_displacement = -2; })); },
                  "must not be negative");
-  expect_invalid([&] { correlation_output_shape(shape, with([](auto& p) { p.vector_width = 3; })); },
+  testing::expect_invalid_input([&] { correlation_output_shape(shape, with([](auto& p) { p.vector_width = 3; })); },
                  "vector width 3");
-  expect_invalid(
+  testing::expect_invalid_input(
       [&] {
         correlation_output_shape(shape, with([](auto& p) {
                                    p.stride1 = 2;
@@ -223,14 +205,14 @@ TEST(Correlation, BadShapesAndSettingsAreInvalidInput) {
       },
       "needs stride1 1");
   // pad 2 < kernel radius + displacement: a 2×2 input has no output pixel.
-  expect_invalid([&] { correlation_output_shape({1, 4, 2, 2}, with([](auto& p) {
+  testing::expect_invalid_input([&] { correlation_output_shape({1, 4, 2, 2}, with([](auto& p) {
                                                   p.pad = 2;
                                                   p.max_displacement = 2;
                                                   p.kernel_size = 5;
                                                 })); },
                  "too small");
-  expect_invalid([&] { correlation_output_shape({1, 0, 8, 8}); }, "empty dimension");
-  expect_invalid([&] { correlation_output_shape({1, 16, 8}); }, "must be NCHW");
+  testing::expect_invalid_input([&] { correlation_output_shape({1, 0, 8, 8}); }, "empty dimension");
+  testing::expect_invalid_input([&] { correlation_output_shape({1, 16, 8}); }, "must be NCHW");
 }
 
 TEST(Correlation, OutputShapeFollowsFlowNet2PyTorch) {

@@ -106,15 +106,6 @@ TEST(Linear, FlattensAnNchwInputLikeTorchFlatten) {
                                  std::sqrt(static_cast<double>(in))));
 }
 
-void expect_invalid(const std::function<void()>& call, const std::string& needle) {
-  try {
-    call();
-    ADD_FAILURE() << "accepted; expected an error mentioning '" << needle << "'";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.kind(), ErrorKind::InvalidInput) << e.what();
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
-}
 
 TEST(Linear, BadShapesAreInvalidInput) {
   Queue& queue = testing::test_queue();
@@ -125,20 +116,20 @@ TEST(Linear, BadShapesAreInvalidInput) {
   const Tensor output = Tensor::empty(device, {2, 128});
   EXPECT_NO_THROW(linear(queue, input, weight, bias, output));
 
-  expect_invalid([&] { linear(queue, Tensor::empty(device, {2, 8, 6, 7}), weight, bias, output); },
+  testing::expect_invalid_input([&] { linear(queue, Tensor::empty(device, {2, 8, 6, 7}), weight, bias, output); },
                  "has 336 features per sample but the weight [128, 384] expects 384");
-  expect_invalid([&] { linear(queue, input, Tensor::empty(device, {384, 128}), bias, output); }, "expects 128");
-  expect_invalid([&] { linear(queue, input, Tensor::empty(device, {128, 384, 1}), bias, output); },
+  testing::expect_invalid_input([&] { linear(queue, input, Tensor::empty(device, {384, 128}), bias, output); }, "expects 128");
+  testing::expect_invalid_input([&] { linear(queue, input, Tensor::empty(device, {128, 384, 1}), bias, output); },
                  "weight must be [out, in]");
-  expect_invalid([&] { linear(queue, Tensor::empty(device, {384}), weight, bias, output); }, "rank 2 or more");
-  expect_invalid([&] { linear(queue, input, weight, Tensor::empty(device, {3}), output); },
+  testing::expect_invalid_input([&] { linear(queue, Tensor::empty(device, {384}), weight, bias, output); }, "rank 2 or more");
+  testing::expect_invalid_input([&] { linear(queue, input, weight, Tensor::empty(device, {3}), output); },
                  "bias has shape [3], expected [128]");
-  expect_invalid([&] { linear(queue, input, weight, bias, Tensor::empty(device, {2, 127})); },
+  testing::expect_invalid_input([&] { linear(queue, input, weight, bias, Tensor::empty(device, {2, 127})); },
                  "output has shape [2, 127]");
-  expect_invalid([&] { linear(queue, input, weight, bias, Tensor::empty(device, {3, 128})); }, "gives [2, 128]");
-  expect_invalid([&] { linear(queue, Tensor(), weight, bias, output); }, "input tensor is undefined");
-  expect_invalid([&] { linear(queue, input, weight, bias, Tensor()); }, "output tensor is undefined");
-  expect_invalid([&] { linear_output_shape({2, 0}, {128, 0}); }, "zero or negative size");
+  testing::expect_invalid_input([&] { linear(queue, input, weight, bias, Tensor::empty(device, {3, 128})); }, "gives [2, 128]");
+  testing::expect_invalid_input([&] { linear(queue, Tensor(), weight, bias, output); }, "input tensor is undefined");
+  testing::expect_invalid_input([&] { linear(queue, input, weight, bias, Tensor()); }, "output tensor is undefined");
+  testing::expect_invalid_input([&] { linear_output_shape({2, 0}, {128, 0}); }, "zero or negative size");
 }
 
 }  // namespace

@@ -11,18 +11,10 @@ namespace inertialnet {
 namespace {
 
 using reference::Dims;
+using reference::shape_of;
+using reference::slice_channels;
 
-Shape shape_of(Dims d) { return {d.n, d.c, d.h, d.w}; }
 
-std::vector<float> slice_channels(const std::vector<float>& data, Dims d, int first, int count) {
-  const std::size_t plane = static_cast<std::size_t>(d.h) * d.w;
-  std::vector<float> out;
-  for (int n = 0; n < d.n; ++n) {
-    const auto begin = data.begin() + static_cast<std::ptrdiff_t>((static_cast<std::size_t>(n) * d.c + first) * plane);
-    out.insert(out.end(), begin, begin + static_cast<std::ptrdiff_t>(count * plane));
-  }
-  return out;
-}
 
 // Bilinear: a blend of four values (≤ 1) with float32 weights, then ·scale; the kernel may
 // contract to FMAs where the loop does not: a few ulp relative to max(|value|, 1)·scale.
@@ -139,33 +131,24 @@ TEST(Upsample, SlicedInputAndOutputLeaveTheRestUntouched) {
   EXPECT_EQ(slice_channels(after, concat, 7, 4), slice_channels(concat_data, concat, 7, 4));
 }
 
-void expect_invalid(const std::function<void()>& call, const std::string& needle) {
-  try {
-    call();
-    ADD_FAILURE() << "accepted; expected an error mentioning \"" << needle << "\"";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.kind(), ErrorKind::InvalidInput) << e.what();
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
-}
 
 TEST(Upsample, BadShapesAreInvalidInput) {
   Queue& queue = testing::test_queue();
   Device& device = testing::test_device();
   Tensor in = Tensor::empty(device, {2, 3, 8, 8});
-  expect_invalid([&] { upsample(queue, in, 0, Interpolation::Bilinear); }, "factor 0");
-  expect_invalid([&] { resize(queue, in, Tensor::empty(device, {2, 2, 32, 32}), Interpolation::Nearest); },
+  testing::expect_invalid_input([&] { upsample(queue, in, 0, Interpolation::Bilinear); }, "factor 0");
+  testing::expect_invalid_input([&] { resize(queue, in, Tensor::empty(device, {2, 2, 32, 32}), Interpolation::Nearest); },
                  "must have the batch and channels of the input");
-  expect_invalid([&] { resize(queue, in, Tensor::empty(device, {1, 3, 32, 32}), Interpolation::Bilinear); },
+  testing::expect_invalid_input([&] { resize(queue, in, Tensor::empty(device, {1, 3, 32, 32}), Interpolation::Bilinear); },
                  "must have the batch and channels");
-  expect_invalid([&] { resize(queue, in, 0, 16, Interpolation::Bilinear); }, "target size 0×16 is empty");
-  expect_invalid([&] { resize(queue, Tensor::empty(device, {3, 8, 8}), 16, 16, Interpolation::Bilinear); },
+  testing::expect_invalid_input([&] { resize(queue, in, 0, 16, Interpolation::Bilinear); }, "target size 0×16 is empty");
+  testing::expect_invalid_input([&] { resize(queue, Tensor::empty(device, {3, 8, 8}), 16, 16, Interpolation::Bilinear); },
                  "must be NCHW");
-  expect_invalid([&] { resize_flow(queue, in, 16, 16); }, "must have 2 channels");
-  expect_invalid([&] { resize_flow(queue, Tensor::empty(device, {2, 2, 8, 8}), 16, -1); }, "is empty");
-  expect_invalid([&] { resize(queue, Tensor(), 16, 16, Interpolation::Nearest); }, "undefined");
-  expect_invalid([&] { resize(queue, in, in, Interpolation::Nearest); }, "overlaps");
-  expect_invalid([&] { upsample_output_shape({1, 2, 0, 4}, 4); }, "empty dimension");
+  testing::expect_invalid_input([&] { resize_flow(queue, in, 16, 16); }, "must have 2 channels");
+  testing::expect_invalid_input([&] { resize_flow(queue, Tensor::empty(device, {2, 2, 8, 8}), 16, -1); }, "is empty");
+  testing::expect_invalid_input([&] { resize(queue, Tensor(), 16, 16, Interpolation::Nearest); }, "undefined");
+  testing::expect_invalid_input([&] { resize(queue, in, in, Interpolation::Nearest); }, "overlaps");
+  testing::expect_invalid_input([&] { upsample_output_shape({1, 2, 0, 4}, 4); }, "empty dimension");
   EXPECT_EQ(upsample_output_shape({1, 2, 96, 128}, 4), (Shape{1, 2, 384, 512}));
 }
 

@@ -12,18 +12,10 @@ namespace inertialnet {
 namespace {
 
 using reference::Dims;
+using reference::shape_of;
+using reference::slice_channels;
 
-Shape shape_of(Dims d) { return {d.n, d.c, d.h, d.w}; }
 
-std::vector<float> slice_channels(const std::vector<float>& data, Dims d, int first, int count) {
-  const std::size_t plane = static_cast<std::size_t>(d.h) * d.w;
-  std::vector<float> out;
-  for (int n = 0; n < d.n; ++n) {
-    const auto begin = data.begin() + static_cast<std::ptrdiff_t>((static_cast<std::size_t>(n) * d.c + first) * plane);
-    out.insert(out.end(), begin, begin + static_cast<std::ptrdiff_t>(count * plane));
-  }
-  return out;
-}
 
 // A bilinear blend of four values with weights summing to one, in float32: a few ulp of the
 // values' magnitude (≤ 1 here). FMA contraction in the kernel is allowed to differ from the loop.
@@ -149,34 +141,25 @@ TEST(Warp, SlicedInputsAndOutputLeaveTheRestUntouched) {
   EXPECT_EQ(slice_channels(after, concat, 9, 3), slice_channels(concat_data, concat, 9, 3));
 }
 
-void expect_invalid(const std::function<void()>& call, const std::string& needle) {
-  try {
-    call();
-    ADD_FAILURE() << "accepted; expected an error mentioning \"" << needle << "\"";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.kind(), ErrorKind::InvalidInput) << e.what();
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
-  }
-}
 
 TEST(Warp, BadShapesAreInvalidInput) {
   Queue& queue = testing::test_queue();
   Device& device = testing::test_device();
   Tensor image = Tensor::empty(device, {2, 3, 8, 8});
   Tensor out = Tensor::empty(device, {2, 3, 8, 8});
-  expect_invalid([&] { warp(queue, image, Tensor::empty(device, {2, 3, 8, 8}), out); }, "must have 2 channels");
-  expect_invalid([&] { warp(queue, image, Tensor::empty(device, {2, 1, 8, 8}), out); }, "must have 2 channels");
-  expect_invalid([&] { warp(queue, image, Tensor::empty(device, {2, 2, 8, 9}), out); },
+  testing::expect_invalid_input([&] { warp(queue, image, Tensor::empty(device, {2, 3, 8, 8}), out); }, "must have 2 channels");
+  testing::expect_invalid_input([&] { warp(queue, image, Tensor::empty(device, {2, 1, 8, 8}), out); }, "must have 2 channels");
+  testing::expect_invalid_input([&] { warp(queue, image, Tensor::empty(device, {2, 2, 8, 9}), out); },
                  "flow of shape [2, 2, 8, 9] does not match the image of shape [2, 3, 8, 8]");
-  expect_invalid([&] { warp(queue, image, Tensor::empty(device, {1, 2, 8, 8}), out); }, "does not match the image");
-  expect_invalid([&] { warp(queue, image, Tensor::empty(device, {2, 2, 8, 8}), Tensor::empty(device, {2, 3, 8, 7})); },
+  testing::expect_invalid_input([&] { warp(queue, image, Tensor::empty(device, {1, 2, 8, 8}), out); }, "does not match the image");
+  testing::expect_invalid_input([&] { warp(queue, image, Tensor::empty(device, {2, 2, 8, 8}), Tensor::empty(device, {2, 3, 8, 7})); },
                  "output must have the image's shape [2, 3, 8, 8], got [2, 3, 8, 7]");
-  expect_invalid([&] { warp(queue, Tensor::empty(device, {3, 8, 8}), Tensor::empty(device, {2, 8, 8})); },
+  testing::expect_invalid_input([&] { warp(queue, Tensor::empty(device, {3, 8, 8}), Tensor::empty(device, {2, 8, 8})); },
                  "must be NCHW");
-  expect_invalid([&] { warp(queue, image, Tensor(), out); }, "undefined");
+  testing::expect_invalid_input([&] { warp(queue, image, Tensor(), out); }, "undefined");
   Tensor flow = Tensor::empty(device, {2, 2, 8, 8});
-  expect_invalid([&] { warp(queue, image, flow, image); }, "overlaps");
-  expect_invalid([&] { warp_output_shape({1, 0, 8, 8}, {1, 2, 8, 8}); }, "empty dimension");
+  testing::expect_invalid_input([&] { warp(queue, image, flow, image); }, "overlaps");
+  testing::expect_invalid_input([&] { warp_output_shape({1, 0, 8, 8}, {1, 2, 8, 8}); }, "empty dimension");
   EXPECT_EQ(warp_output_shape({2, 3, 8, 8}, {2, 2, 8, 8}), (Shape{2, 3, 8, 8}));
 }
 

@@ -93,6 +93,16 @@ Difference compare(const std::vector<float>& actual, const std::vector<float>& e
                                        << ", expected " << expected[d.worst_index] << " (max abs " << d.max_abs << ")";
 }
 
+void expect_invalid_input(const std::function<void()>& call, const std::string& needle) {
+  try {
+    call();
+    ADD_FAILURE() << "accepted; expected an invalid_input error mentioning \"" << needle << "\"";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::InvalidInput) << e.what();
+    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << "message: " << e.what();
+  }
+}
+
 std::string temporary_directory(const std::string& stem) {
   static std::vector<std::filesystem::path> created;
   static struct Cleanup {

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <functional>
 #include <random>
 #include <string>
 #include <vector>
@@ -31,6 +32,9 @@ struct Difference {
 Difference compare(const std::vector<float>& actual, const std::vector<float>& expected, double floor = 1e-3);
 ::testing::AssertionResult all_close(const std::vector<float>& actual, const std::vector<float>& expected,
                                      double relative_tolerance, double floor = 1e-3);
+
+// Runs `call` and expects an Error of kind InvalidInput whose message contains `needle`.
+void expect_invalid_input(const std::function<void()>& call, const std::string& needle);
 
 // A fresh, empty directory under the system temp dir, removed at process exit.
 std::string temporary_directory(const std::string& stem);
