@@ -1,10 +1,12 @@
 // `inertialnet eval RATES.csv SEQ`: the paper's metrics — per-axis RMSE (deg/s, its Table 1),
 // RMS(t) (its Eq. 1), error histograms and time-series plots (its Figs. 5–10).
+#include <filesystem>
 #include <iostream>
 #include <memory>
 
 #include "commands.hpp"
 #include "inertialnet/evaluate.hpp"
+#include "inertialnet/rates_csv.hpp"
 
 namespace inertialnet::cli {
 
@@ -35,11 +37,35 @@ Command register_eval(CLI::App& app, const GlobalOptions&) {
       options.sync.bias = BiasSource::Given;
       options.sync.gyro_bias = parse_vec3(o->gyro_bias, "--gyro-bias");
     }
-    if (!o->head.empty()) options.head_suffix = "_" + o->head;
     options.plot = o->plot;
-    const EvalReport report = evaluate(o->rates, o->sequence, options);
-    std::cout << (o->json ? report.json(o->series) : report.table());
-    for (const auto& w : report.warnings) std::cerr << "inertialnet: warning: " << w << "\n";
+    // A CSV from `predict --head both` holds two estimators: without --head, report both.
+    std::vector<std::string> suffixes;
+    if (!o->head.empty()) {
+      suffixes.push_back("_" + o->head);
+    } else {
+      suffixes.push_back("");
+      const RatesTable table = read_rates_csv(o->rates);
+      for (const auto& name : table.extra_names) {
+        if (name.rfind("wx_", 0) == 0) suffixes.push_back(name.substr(2));
+      }
+    }
+    std::string json = suffixes.size() > 1 ? "[\n" : "";
+    for (std::size_t i = 0; i < suffixes.size(); ++i) {
+      options.head_suffix = suffixes[i];
+      if (i > 0 && !o->plot.empty()) {
+        // One set of plots per estimator: out.png, out_geometric.png, …
+        const std::filesystem::path plot(o->plot);
+        options.plot = plot.parent_path() / (plot.stem().string() + suffixes[i] + plot.extension().string());
+      }
+      const EvalReport report = evaluate(o->rates, o->sequence, options);
+      if (o->json) {
+        json += report.json(o->series) + (i + 1 < suffixes.size() ? ",\n" : "");
+      } else {
+        std::cout << (i ? "\n" : "") << report.table();
+      }
+      for (const auto& w : report.warnings) std::cerr << "inertialnet: warning: " << w << "\n";
+    }
+    if (o->json) std::cout << json << (suffixes.size() > 1 ? "]\n" : "");
     return 0;
   };
 }
