@@ -2,11 +2,22 @@
 
 #include <clblast.h>
 
+#include <mutex>
+
 #include "inertialnet/device.hpp"
 
 namespace inertialnet {
 
 namespace {
+
+// CLBlast keeps process-wide caches of compiled programs and tuning data, and calling it from
+// several threads at once (the pipeline's lanes) crashed intermittently here, as reported
+// upstream for multi-threaded use (CLBlast issue 486). Calls only enqueue work — the GEMM runs
+// after the lock is released — so serialising them costs the lanes no overlap.
+std::mutex& clblast_mutex() {
+  static std::mutex mutex;
+  return mutex;
+}
 
 clblast::Transpose to_clblast(Transpose t) { return t == Transpose::Yes ? clblast::Transpose::kYes : clblast::Transpose::kNo; }
 
@@ -53,6 +64,7 @@ void gemm(Queue& queue, Transpose transpose_a, Transpose transpose_b, std::size_
           float alpha, const MatrixView& a, const MatrixView& b, float beta, const MatrixView& c) {
   check_problem(transpose_a, transpose_b, m, n, k, a, 0, b, 0, c, 0, 1);
   cl_command_queue handle = queue.handle();
+  std::lock_guard<std::mutex> lock(clblast_mutex());
   const auto status = clblast::Gemm<float>(clblast::Layout::kRowMajor, to_clblast(transpose_a), to_clblast(transpose_b),
                                            m, n, k, alpha, a.buffer, a.offset, a.leading_dimension, b.buffer, b.offset,
                                            b.leading_dimension, beta, c.buffer, c.offset, c.leading_dimension, &handle,
@@ -70,6 +82,7 @@ void gemm_strided_batched(Queue& queue, Transpose transpose_a, Transpose transpo
     return;
   }
   cl_command_queue handle = queue.handle();
+  std::lock_guard<std::mutex> lock(clblast_mutex());
   const auto status = clblast::GemmStridedBatched<float>(
       clblast::Layout::kRowMajor, to_clblast(transpose_a), to_clblast(transpose_b), m, n, k, alpha, a.buffer, a.offset,
       a.leading_dimension, stride_a, b.buffer, b.offset, b.leading_dimension, stride_b, beta, c.buffer, c.offset,
