@@ -55,6 +55,17 @@ Concat concat_at(Graph& g, const std::string& name, ValueId input, int level, st
   return c;
 }
 
+// The encoder from conv3_1's output (concat3's features) to conv6_1, the same in FlowNetC, -S and
+// -SD: conv4_1 and conv5_1 land in their concatenations. Returns conv6_1's output.
+ValueId encoder_4_to_6(Graph& g, const std::string& p, const Concat& c3, const Concat& c4, const Concat& c5) {
+  const ValueId c4_0 = conv(g, p + "conv4", c3.features, 2);
+  conv(g, p + "conv4_1", c4_0, 1, c4.features);
+  const ValueId c5_0 = conv(g, p + "conv5", c4.features, 2);
+  conv(g, p + "conv5_1", c5_0, 1, c5.features);
+  const ValueId c6_0 = conv(g, p + "conv6", c5.features, 2);
+  return conv(g, p + "conv6_1", c6_0, 1);
+}
+
 // The FlowNetC/FlowNetS decoder from conv6_1's output; concatN.features already written.
 ValueId decoder_cs(Graph& g, const std::string& p, ValueId conv6_1, Concat& c5, Concat& c4, Concat& c3, Concat& c2) {
   const ValueId flow6 = pred(g, p + "predict_flow6", conv6_1);
@@ -111,13 +122,7 @@ ValueId build_flownetc(Graph& g, const std::string& p, ValueId x6) {
   g.correlation(p + "corr", a3, b3, corr, g.slice(in3_1, 32, 441));
 
   conv(g, p + "conv3_1", in3_1, 1, c3.features);
-  const ValueId c4_0 = conv(g, p + "conv4", c3.features, 2);
-  conv(g, p + "conv4_1", c4_0, 1, c4.features);
-  const ValueId c5_0 = conv(g, p + "conv5", c4.features, 2);
-  conv(g, p + "conv5_1", c5_0, 1, c5.features);
-  const ValueId c6_0 = conv(g, p + "conv6", c5.features, 2);
-  const ValueId c6_1 = conv(g, p + "conv6_1", c6_0, 1);
-  return decoder_cs(g, p, c6_1, c5, c4, c3, c2);
+  return decoder_cs(g, p, encoder_4_to_6(g, p, c3, c4, c5), c5, c4, c3, c2);
 }
 
 ValueId build_flownets(Graph& g, const std::string& p, ValueId input) {
@@ -130,13 +135,7 @@ ValueId build_flownets(Graph& g, const std::string& p, ValueId input) {
   conv(g, p + "conv2", c1, 2, c2.features);
   const ValueId c3_0 = conv(g, p + "conv3", c2.features, 2);
   conv(g, p + "conv3_1", c3_0, 1, c3.features);
-  const ValueId c4_0 = conv(g, p + "conv4", c3.features, 2);
-  conv(g, p + "conv4_1", c4_0, 1, c4.features);
-  const ValueId c5_0 = conv(g, p + "conv5", c4.features, 2);
-  conv(g, p + "conv5_1", c5_0, 1, c5.features);
-  const ValueId c6_0 = conv(g, p + "conv6", c5.features, 2);
-  const ValueId c6_1 = conv(g, p + "conv6_1", c6_0, 1);
-  return decoder_cs(g, p, c6_1, c5, c4, c3, c2);
+  return decoder_cs(g, p, encoder_4_to_6(g, p, c3, c4, c5), c5, c4, c3, c2);
 }
 
 ValueId build_flownetsd(Graph& g, const std::string& p, ValueId x6) {
@@ -152,12 +151,7 @@ ValueId build_flownetsd(Graph& g, const std::string& p, ValueId x6) {
   conv(g, p + "conv2_1", c2_0, 1, c2.features);
   const ValueId c3_0 = conv(g, p + "conv3", c2.features, 2);
   conv(g, p + "conv3_1", c3_0, 1, c3.features);
-  const ValueId c4_0 = conv(g, p + "conv4", c3.features, 2);
-  conv(g, p + "conv4_1", c4_0, 1, c4.features);
-  const ValueId c5_0 = conv(g, p + "conv5", c4.features, 2);
-  conv(g, p + "conv5_1", c5_0, 1, c5.features);
-  const ValueId c6_0 = conv(g, p + "conv6", c5.features, 2);
-  const ValueId c6_1 = conv(g, p + "conv6_1", c6_0, 1);
+  const ValueId c6_1 = encoder_4_to_6(g, p, c3, c4, c5);
 
   // The decoder predicts each flow from an intermediate 3×3 convolution of the concatenation.
   const ValueId flow6 = pred(g, p + "predict_flow6", c6_1);

@@ -21,16 +21,7 @@ namespace it = inertialnet::testing;
 
 namespace {
 
-std::string invalid_input_message(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    EXPECT_EQ(e.kind(), ErrorKind::InvalidInput) << e.what();
-    return e.what();
-  }
-  ADD_FAILURE() << "expected an invalid_input error, nothing was thrown";
-  return {};
-}
+using it::invalid_input_message;
 
 bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 

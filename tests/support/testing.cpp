@@ -93,14 +93,21 @@ Difference compare(const std::vector<float>& actual, const std::vector<float>& e
                                        << ", expected " << expected[d.worst_index] << " (max abs " << d.max_abs << ")";
 }
 
-void expect_invalid_input(const std::function<void()>& call, const std::string& needle) {
+std::string invalid_input_message(const std::function<void()>& call) {
   try {
     call();
-    ADD_FAILURE() << "accepted; expected an invalid_input error mentioning \"" << needle << "\"";
   } catch (const Error& e) {
     EXPECT_EQ(e.kind(), ErrorKind::InvalidInput) << e.what();
-    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << "message: " << e.what();
+    return e.what();
   }
+  ADD_FAILURE() << "accepted; expected an invalid_input error";
+  return {};
+}
+
+void expect_invalid_input(const std::function<void()>& call, const std::string& needle) {
+  const std::string message = invalid_input_message(call);
+  EXPECT_NE(message.find(needle), std::string::npos) << "expected a message mentioning \"" << needle
+                                                     << "\", got: " << message;
 }
 
 std::string temporary_directory(const std::string& stem) {

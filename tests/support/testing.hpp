@@ -33,6 +33,9 @@ Difference compare(const std::vector<float>& actual, const std::vector<float>& e
 ::testing::AssertionResult all_close(const std::vector<float>& actual, const std::vector<float>& expected,
                                      double relative_tolerance, double floor = 1e-3);
 
+// Runs `call`, expects an Error of kind InvalidInput and returns its message ("" and a test
+// failure when nothing or something else is thrown).
+std::string invalid_input_message(const std::function<void()>& call);
 // Runs `call` and expects an Error of kind InvalidInput whose message contains `needle`.
 void expect_invalid_input(const std::function<void()>& call, const std::string& needle);
 
