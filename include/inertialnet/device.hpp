@@ -36,6 +36,9 @@ class Device {
   ClSite site(const std::string& kernel = {}) const { return ClSite{info_.name, kernel}; }
 
   ProgramCache& programs() noexcept { return *programs_; }
+  // The CLBlast parameter overrides applied to this device ("" for CLBlast's own database);
+  // see src/runtime/clblast_tuning.hpp, INERTIALNET_CLBLAST_TUNING=0 turns them off.
+  const std::string& gemm_tuning() const noexcept { return gemm_tuning_; }
   BufferPool& buffers() noexcept { return *buffers_; }
 
   // The default in-order queue. Use it from one thread at a time.
@@ -49,6 +52,7 @@ class Device {
   std::unique_ptr<ProgramCache> programs_;
   std::unique_ptr<BufferPool> buffers_;
   std::unique_ptr<Queue> queue_;
+  std::string gemm_tuning_;
 };
 
 }  // namespace inertialnet

@@ -3,6 +3,7 @@
 #include <cstdlib>
 
 #include "inertialnet/queue.hpp"
+#include "runtime/clblast_tuning.hpp"
 
 namespace inertialnet {
 
@@ -36,6 +37,7 @@ Device::Device(const DeviceInfo& info, DeviceOptions options) : info_(info) {
                                              std::move(directory));
   buffers_ = std::make_unique<BufferPool>(context_.get(), info_.name, info_.max_alloc_bytes);
   queue_ = std::make_unique<Queue>(*this, options.profiling);
+  gemm_tuning_ = detail::apply_clblast_tuning(info_);
 }
 
 Device::~Device() {

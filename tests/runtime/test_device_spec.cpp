@@ -3,6 +3,7 @@
 
 #include "inertialnet/device_selection.hpp"
 #include "inertialnet/error.hpp"
+#include "runtime/clblast_tuning.hpp"
 
 namespace inertialnet {
 namespace {
@@ -138,6 +139,17 @@ TEST(DeviceSelect, EnvironmentStandsInForTheFlag) {
   EXPECT_EQ(device_spec_or_environment("1"), "1");
   ::unsetenv(kDeviceEnvironmentVariable);
   EXPECT_EQ(device_spec_or_environment(""), "");
+}
+
+TEST(ClblastTuning, EntriesMatchOnlyTheDevicesTheyWereMeasuredFor) {
+  const DeviceInfo avx512 = make(0, 0, 0, DeviceType::CPU, "pthread-skylake-avx512-Intel(R) Xeon(R) Processor",
+                                 "Portable Computing Language", "The pocl project");
+  const auto matches = detail::clblast_overrides_for(avx512);
+  ASSERT_EQ(matches.size(), 1u);
+  EXPECT_STREQ(matches[0]->kernel, "Xgemm");
+  EXPECT_EQ(matches[0]->parameters.size(), 16u);  // CLBlast refuses partial Xgemm sets
+  EXPECT_TRUE(detail::clblast_overrides_for(make(0, 0, 0, DeviceType::CPU, "pthread-haswell", "Portable Computing Language")).empty());
+  EXPECT_TRUE(detail::clblast_overrides_for(make(0, 1, 0, DeviceType::GPU, "NVIDIA H100", "NVIDIA CUDA")).empty());
 }
 
 TEST(ErrorNames, OpenClAndClblastCodesHaveNames) {

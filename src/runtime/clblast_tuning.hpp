@@ -1,0 +1,39 @@
+// CLBlast parameters per device, kept as data (as CLBlast keeps its own database).
+//
+// CLBlast's database has no entry for CPUs under PoCL, whose generic defaults run SGEMM at a
+// tenth of what the machine can do (shared/PERF_NOTES.md). Each entry below names the devices it
+// is for, the CLBlast kernel it tunes, the full parameter set (CLBlast refuses partial ones) and
+// where it was measured. Opening a Device applies the matching entries once per device with
+// clblast::OverrideParameters; INERTIALNET_CLBLAST_TUNING=0 turns this off (to measure, or to
+// work around a bad entry). A refused override is reported and ignored: the defaults are slow
+// but correct.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "inertialnet/device_info.hpp"
+
+namespace inertialnet::detail {
+
+struct ClblastOverride {
+  const char* platform_contains;  // case-insensitive substring of the platform name
+  const char* device_contains;    // case-insensitive substring of the device name; "" = any
+  DeviceType type;
+  const char* kernel;  // CLBlast kernel family, e.g. "Xgemm"
+  std::vector<std::pair<std::string, std::size_t>> parameters;
+  const char* provenance;
+};
+
+inline constexpr const char* kClblastTuningEnvironmentVariable = "INERTIALNET_CLBLAST_TUNING";
+
+// The table entries that match `device` (pure; unit-tested without hardware).
+std::vector<const ClblastOverride*> clblast_overrides_for(const DeviceInfo& device);
+
+// Applies them (once per cl_device_id, thread-safe) unless turned off by the environment.
+// Returns a one-line description of what applies ("" when nothing does).
+std::string apply_clblast_tuning(const DeviceInfo& device);
+
+}  // namespace inertialnet::detail
