@@ -1,5 +1,7 @@
 #include "models/flownet_graphs.hpp"
 
+#include <array>
+
 #include "inertialnet/error.hpp"
 
 namespace inertialnet::graph {
@@ -55,6 +57,14 @@ Concat concat_at(Graph& g, const std::string& name, ValueId input, int level, st
   return c;
 }
 
+// The concatenations the FlowNetC, -S and -SD decoders fill, at 1/4 … 1/32 of `input`'s size:
+// [conv2 (128), deconv2 (64), flow], [conv3_1 (256), deconv3 (128), flow],
+// [conv4_1 (512), deconv4 (256), flow], [conv5_1 (512), deconv5 (512), flow].
+std::array<Concat, 4> decoder_concats(Graph& g, const std::string& p, ValueId input) {
+  return {concat_at(g, p + "concat2", input, 2, 128, 64), concat_at(g, p + "concat3", input, 3, 256, 128),
+          concat_at(g, p + "concat4", input, 4, 512, 256), concat_at(g, p + "concat5", input, 5, 512, 512)};
+}
+
 // The encoder from conv3_1's output (concat3's features) to conv6_1, the same in FlowNetC, -S and
 // -SD: conv4_1 and conv5_1 land in their concatenations. Returns conv6_1's output.
 ValueId encoder_4_to_6(Graph& g, const std::string& p, const Concat& c3, const Concat& c4, const Concat& c5) {
@@ -101,10 +111,7 @@ void require_multiple_of_64(const Graph& g, ValueId input) {
 ValueId build_flownetc(Graph& g, const std::string& p, ValueId x6) {
   require_multiple_of_64(g, x6);
   if (channels(g, x6) != 6) throw invalid_input("FlowNetC takes 6 channels, got " + to_string(g.shape(x6)));
-  Concat c2 = concat_at(g, p + "concat2", x6, 2, 128, 64);
-  Concat c3 = concat_at(g, p + "concat3", x6, 3, 256, 128);
-  Concat c4 = concat_at(g, p + "concat4", x6, 4, 512, 256);
-  Concat c5 = concat_at(g, p + "concat5", x6, 5, 512, 512);
+  auto [c2, c3, c4, c5] = decoder_concats(g, p, x6);
 
   // Siamese stream: one set of weights on each frame; frame 1's conv2 is part of concat2.
   const ValueId frame1 = g.slice(x6, 0, 3), frame2 = g.slice(x6, 3, 3);
@@ -127,10 +134,7 @@ ValueId build_flownetc(Graph& g, const std::string& p, ValueId x6) {
 
 ValueId build_flownets(Graph& g, const std::string& p, ValueId input) {
   require_multiple_of_64(g, input);
-  Concat c2 = concat_at(g, p + "concat2", input, 2, 128, 64);
-  Concat c3 = concat_at(g, p + "concat3", input, 3, 256, 128);
-  Concat c4 = concat_at(g, p + "concat4", input, 4, 512, 256);
-  Concat c5 = concat_at(g, p + "concat5", input, 5, 512, 512);
+  auto [c2, c3, c4, c5] = decoder_concats(g, p, input);
   const ValueId c1 = conv(g, p + "conv1", input, 2);
   conv(g, p + "conv2", c1, 2, c2.features);
   const ValueId c3_0 = conv(g, p + "conv3", c2.features, 2);
@@ -140,10 +144,7 @@ ValueId build_flownets(Graph& g, const std::string& p, ValueId input) {
 
 ValueId build_flownetsd(Graph& g, const std::string& p, ValueId x6) {
   require_multiple_of_64(g, x6);
-  Concat c2 = concat_at(g, p + "concat2", x6, 2, 128, 64);
-  Concat c3 = concat_at(g, p + "concat3", x6, 3, 256, 128);
-  Concat c4 = concat_at(g, p + "concat4", x6, 4, 512, 256);
-  Concat c5 = concat_at(g, p + "concat5", x6, 5, 512, 512);
+  auto [c2, c3, c4, c5] = decoder_concats(g, p, x6);
   const ValueId c0 = conv(g, p + "conv0", x6, 1);
   const ValueId c1 = conv(g, p + "conv1", c0, 2);
   const ValueId c1_1 = conv(g, p + "conv1_1", c1, 1);
