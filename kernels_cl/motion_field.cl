@@ -140,7 +140,7 @@ void moments(__global const float* restrict flow, const int flow_offset,
     const float y = 0.5f * (p1.y + p2.y);
     const float bx = (p2.x - p1.x) * inv_dt;
     const float by = (p2.y - p1.y) * inv_dt;
-    // The columns of A(x, y) (EUROC.md): ẋ = ax·ω, ẏ = ay·ω.
+    // The columns of A(x, y) (docs/data_conventions.md): ẋ = ax·ω, ẏ = ay·ω.
     const float ax0 = x * y, ax1 = -(1.0f + x * x), ax2 = y;
     const float ay0 = 1.0f + y * y, ay1 = -x * y, ay2 = -x;
     const float rx = bx - (ax0 * wx + ax1 * wy + ax2 * wz);

@@ -1,12 +1,64 @@
-// The whole public API.
+// The whole public API: every public header of every layer, lowest layer first.
 #pragma once
 
-#include "inertialnet/buffer_pool.hpp"
-#include "inertialnet/device.hpp"
-#include "inertialnet/device_info.hpp"
-#include "inertialnet/device_selection.hpp"
-#include "inertialnet/error.hpp"
+// core
+#include "inertialnet/core/vec3.hpp"
+
+// runtime
+#include "inertialnet/runtime/buffer_pool.hpp"
+#include "inertialnet/runtime/cl_handle.hpp"
+#include "inertialnet/runtime/device.hpp"
+#include "inertialnet/runtime/device_info.hpp"
+#include "inertialnet/runtime/device_selection.hpp"
+#include "inertialnet/runtime/error.hpp"
+#include "inertialnet/runtime/opencl.hpp"
+#include "inertialnet/runtime/program_cache.hpp"
+#include "inertialnet/runtime/queue.hpp"
+#include "inertialnet/runtime/tensor.hpp"
+
+// ops
+#include "inertialnet/ops/activation.hpp"
+#include "inertialnet/ops/channel_norm.hpp"
+#include "inertialnet/ops/concat.hpp"
+#include "inertialnet/ops/conv2d.hpp"
+#include "inertialnet/ops/conv_transpose2d.hpp"
+#include "inertialnet/ops/correlation.hpp"
+#include "inertialnet/ops/dropout.hpp"
+#include "inertialnet/ops/elementwise.hpp"
 #include "inertialnet/ops/gemm.hpp"
-#include "inertialnet/program_cache.hpp"
-#include "inertialnet/queue.hpp"
-#include "inertialnet/tensor.hpp"
+#include "inertialnet/ops/linear.hpp"
+#include "inertialnet/ops/normalize.hpp"
+#include "inertialnet/ops/pool.hpp"
+#include "inertialnet/ops/upsample.hpp"
+#include "inertialnet/ops/warp.hpp"
+
+// models
+#include "inertialnet/models/flownet.hpp"
+#include "inertialnet/models/geometric_head.hpp"
+#include "inertialnet/models/inertialnet_head.hpp"
+#include "inertialnet/models/opengv_head.hpp"
+#include "inertialnet/models/parameters.hpp"
+#include "inertialnet/models/synthetic_weights.hpp"
+#include "inertialnet/models/weights.hpp"
+
+// io
+#include "inertialnet/io/euroc.hpp"
+#include "inertialnet/io/flow_io.hpp"
+#include "inertialnet/io/frame_source.hpp"
+#include "inertialnet/io/image_io.hpp"
+#include "inertialnet/io/rates_csv.hpp"
+#include "inertialnet/io/safetensors.hpp"
+
+// synth
+#include "inertialnet/synth/synthetic_sequence.hpp"
+
+// eval
+#include "inertialnet/eval/evaluate.hpp"
+#include "inertialnet/eval/imu_sync.hpp"
+#include "inertialnet/eval/metrics.hpp"
+#include "inertialnet/eval/plots.hpp"
+#include "inertialnet/eval/spline.hpp"
+
+// pipeline
+#include "inertialnet/pipeline/pipeline.hpp"
+#include "inertialnet/pipeline/rates_processor.hpp"

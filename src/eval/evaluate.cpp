@@ -1,10 +1,10 @@
-#include "inertialnet/evaluate.hpp"
+#include "inertialnet/eval/evaluate.hpp"
 
 #include <cstdio>
 
 #include <nlohmann/json.hpp>
 
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/error.hpp"
 
 namespace inertialnet {
 

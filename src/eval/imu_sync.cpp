@@ -1,12 +1,12 @@
-#include "inertialnet/imu_sync.hpp"
+#include "inertialnet/eval/imu_sync.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 
-#include "inertialnet/error.hpp"
-#include "inertialnet/spline.hpp"
+#include "inertialnet/runtime/error.hpp"
+#include "inertialnet/eval/spline.hpp"
 
 namespace inertialnet {
 

@@ -1,10 +1,10 @@
-#include "inertialnet/metrics.hpp"
+#include "inertialnet/eval/metrics.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/error.hpp"
 
 namespace inertialnet {
 

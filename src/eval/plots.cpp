@@ -1,4 +1,4 @@
-#include "inertialnet/plots.hpp"
+#include "inertialnet/eval/plots.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/error.hpp"
 
 namespace inertialnet {
 

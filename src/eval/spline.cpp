@@ -1,11 +1,11 @@
-#include "inertialnet/spline.hpp"
+#include "inertialnet/eval/spline.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
 
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/error.hpp"
 
 namespace inertialnet {
 

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/error.hpp"
 
 namespace inertialnet::csv {
 

@@ -1,4 +1,4 @@
-#include "inertialnet/euroc.hpp"
+#include "inertialnet/io/euroc.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -10,7 +10,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/error.hpp"
 #include "io/csv_util.hpp"
 
 namespace fs = std::filesystem;

@@ -1,4 +1,4 @@
-#include "inertialnet/flow_io.hpp"
+#include "inertialnet/io/flow_io.hpp"
 
 #include <unistd.h>
 
@@ -16,7 +16,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/error.hpp"
 
 namespace fs = std::filesystem;
 

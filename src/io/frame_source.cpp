@@ -1,9 +1,9 @@
-#include "inertialnet/frame_source.hpp"
+#include "inertialnet/io/frame_source.hpp"
 
 #include <cmath>
 #include <opencv2/videoio.hpp>
 
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/error.hpp"
 #include "io/image_mat.hpp"
 
 namespace inertialnet {

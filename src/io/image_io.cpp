@@ -1,4 +1,4 @@
-#include "inertialnet/image_io.hpp"
+#include "inertialnet/io/image_io.hpp"
 
 #include <algorithm>
 #include <cstdint>
@@ -10,7 +10,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/error.hpp"
 #include "io/image_mat.hpp"
 
 namespace fs = std::filesystem;

@@ -5,7 +5,7 @@
 #include <opencv2/core.hpp>
 #include <string>
 
-#include "inertialnet/image_io.hpp"
+#include "inertialnet/io/image_io.hpp"
 
 namespace inertialnet {
 

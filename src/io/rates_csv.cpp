@@ -1,11 +1,11 @@
-#include "inertialnet/rates_csv.hpp"
+#include "inertialnet/io/rates_csv.hpp"
 
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <set>
 
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/error.hpp"
 #include "io/csv_util.hpp"
 
 namespace fs = std::filesystem;

@@ -1,4 +1,4 @@
-#include "inertialnet/safetensors.hpp"
+#include "inertialnet/io/safetensors.hpp"
 
 #include <fcntl.h>
 #include <sys/mman.h>
@@ -15,7 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/error.hpp"
 
 // The data section is reinterpreted as little-endian floats without swapping.
 #if !defined(__BYTE_ORDER__) || __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__

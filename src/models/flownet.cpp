@@ -1,6 +1,6 @@
 #include "inertialnet/models/flownet.hpp"
 
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/error.hpp"
 #include "models/flownet_graphs.hpp"
 
 namespace inertialnet {

@@ -2,7 +2,7 @@
 
 #include <array>
 
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/error.hpp"
 
 namespace inertialnet::graph {
 
@@ -267,7 +267,7 @@ void build_flow_model(Graph& g, ModelKind kind, ValueId frame1, ValueId frame2) 
   const ValueId f_s2 = g.resize("flownets_2.upsample", s2_flow2, h, w, Interpolation::Nearest, kDivFlow,
                                 g.slice(concat3, 5, 2));
   const ValueId sd_flow2 = build_flownetsd(g, "flownets_d.", x6);
-  // flownet2-pytorch divides fSD by div_flow here where the others multiply (MODEL_SPEC step 5).
+  // flownet2-pytorch divides fSD by div_flow here where the others multiply (docs/model_spec.md step 5).
   const ValueId f_sd = g.resize("flownets_d.upsample", sd_flow2, h, w, Interpolation::Nearest, 1.0f / kDivFlow,
                                 g.slice(concat3, 3, 2));
   g.mark_output("flownets_2", f_s2);

@@ -1,4 +1,4 @@
-// The FlowNet2 family as graphs (shared/MODEL_SPEC.md, to the letter). Each builder adds one
+// The FlowNet2 family as graphs (docs/model_spec.md, to the letter). Each builder adds one
 // sub-network to a graph, reading its parameters under `prefix` ("flownetc.", or "" for the
 // standalone checkpoints), and returns its finest prediction flow2 (flow0 for the fusion
 // network). Layer order, concatenation order and scaling follow flownet2-pytorch.
@@ -22,7 +22,7 @@ ValueId build_flownetfusion(Graph& graph, const std::string& prefix, ValueId inp
 
 // A whole model of `kind` on frames "frame1", "frame2" ([N, 3, H, W], RGB in [0, 255]) whose
 // size is a multiple of 64. Marks "flow" ([N, 2, H, W], pixels) and the intermediate flows of
-// MODEL_SPEC's FlowNet2 steps: "flownetc" (fC), "flownets_1" (fS1), "flownets_2" (fS2),
+// docs/model_spec.md's FlowNet2 steps: "flownetc" (fC), "flownets_1" (fS1), "flownets_2" (fS2),
 // "flownets_d" (fSD), as far as the model computes them, and for the standalone networks
 // their raw pyramid "flow2" … "flow6".
 void build_flow_model(Graph& graph, ModelKind kind, ValueId frame1, ValueId frame2);

@@ -68,7 +68,7 @@
 #include <limits>
 #include <sstream>
 
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/error.hpp"
 #include "inertialnet/models/opengv_head.hpp"
 
 namespace inertialnet {

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <numeric>
 
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/error.hpp"
 #include "inertialnet/ops/channel_norm.hpp"
 #include "inertialnet/ops/conv2d.hpp"
 #include "inertialnet/ops/conv_transpose2d.hpp"

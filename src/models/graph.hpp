@@ -15,13 +15,13 @@
 #include <string>
 #include <vector>
 
-#include "inertialnet/device.hpp"
+#include "inertialnet/runtime/device.hpp"
 #include "inertialnet/ops/activation.hpp"
 #include "inertialnet/ops/correlation.hpp"
 #include "inertialnet/ops/pool.hpp"
 #include "inertialnet/ops/upsample.hpp"
-#include "inertialnet/queue.hpp"
-#include "inertialnet/tensor.hpp"
+#include "inertialnet/runtime/queue.hpp"
+#include "inertialnet/runtime/tensor.hpp"
 
 namespace inertialnet::graph {
 

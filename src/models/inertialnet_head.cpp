@@ -1,6 +1,6 @@
 #include "inertialnet/models/inertialnet_head.hpp"
 
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/error.hpp"
 #include "models/graph.hpp"
 
 namespace inertialnet {

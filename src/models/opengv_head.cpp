@@ -20,7 +20,7 @@
 #include <cstdlib>
 #include <memory>
 
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/error.hpp"
 
 #if defined(__x86_64__) && EIGEN_MAX_STATIC_ALIGN_BYTES != 16
 #error "Debian's libopengv is built for 16-byte Eigen alignment; build opengv_head.cpp without -mavx/-march=native"

@@ -7,7 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/error.hpp"
 
 namespace inertialnet {
 namespace {
@@ -25,7 +25,7 @@ class TableBuilder {
   void deconv(const std::string& layer, int64_t ci, int64_t co) {
     add(layer + ".0", {ci, co, 4, 4}, LayerKind::ConvTranspose2d, transposed_fan_in(ci), 1.0, true);
   }
-  // predict_flow: a bare Conv2d(ci -> 2, 3x3) -> "L.weight", "L.bias". Small gain (MODEL_SPEC).
+  // predict_flow: a bare Conv2d(ci -> 2, 3x3) -> "L.weight", "L.bias". Small gain (docs/model_spec.md).
   void predict(const std::string& layer, int64_t ci) {
     add(layer, {2, ci, 3, 3}, LayerKind::Conv2d, ci * 9, kFlowGain, true);
   }
@@ -41,7 +41,7 @@ class TableBuilder {
     add(layer, {out, in}, LayerKind::Linear, in, 1.0, true);
   }
 
-  // The decoder FlowNetC and FlowNetS share (MODEL_SPEC "Decoder").
+  // The decoder FlowNetC and FlowNetS share (docs/model_spec.md "Decoder").
   void flownet_decoder(bool upsample_bias) {
     deconv("deconv5", 1024, 512);
     deconv("deconv4", 1026, 256);

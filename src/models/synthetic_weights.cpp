@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/error.hpp"
 #include "runtime/hash.hpp"
 
 namespace inertialnet {

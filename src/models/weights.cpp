@@ -4,10 +4,10 @@
 #include <set>
 #include <sstream>
 
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/error.hpp"
 #include "inertialnet/models/synthetic_weights.hpp"
-#include "inertialnet/queue.hpp"
-#include "inertialnet/safetensors.hpp"
+#include "inertialnet/runtime/queue.hpp"
+#include "inertialnet/io/safetensors.hpp"
 
 namespace inertialnet {
 

@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <string>
 
-#include "inertialnet/device.hpp"
+#include "inertialnet/runtime/device.hpp"
 #include "inertialnet/ops/gemm.hpp"
 #include "ops/op_support.hpp"
 

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "inertialnet/device.hpp"
+#include "inertialnet/runtime/device.hpp"
 #include "inertialnet/ops/elementwise.hpp"
 #include "ops/op_support.hpp"
 

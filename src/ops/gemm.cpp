@@ -4,7 +4,7 @@
 
 #include <mutex>
 
-#include "inertialnet/device.hpp"
+#include "inertialnet/runtime/device.hpp"
 
 namespace inertialnet {
 

@@ -3,7 +3,7 @@
 #include <cstdint>
 #include <string>
 
-#include "inertialnet/device.hpp"
+#include "inertialnet/runtime/device.hpp"
 #include "inertialnet/ops/conv2d.hpp"
 #include "inertialnet/ops/gemm.hpp"
 

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "inertialnet/device.hpp"
+#include "inertialnet/runtime/device.hpp"
 #include "ops/op_support.hpp"
 
 namespace inertialnet {

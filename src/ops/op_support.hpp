@@ -8,9 +8,9 @@
 #include <initializer_list>
 #include <string>
 
-#include "inertialnet/device.hpp"
-#include "inertialnet/error.hpp"
-#include "inertialnet/tensor.hpp"
+#include "inertialnet/runtime/device.hpp"
+#include "inertialnet/runtime/error.hpp"
+#include "inertialnet/runtime/tensor.hpp"
 
 namespace inertialnet::detail {
 

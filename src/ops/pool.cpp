@@ -1,6 +1,6 @@
 #include "inertialnet/ops/pool.hpp"
 
-#include "inertialnet/device.hpp"
+#include "inertialnet/runtime/device.hpp"
 #include "ops/op_support.hpp"
 
 namespace inertialnet {

@@ -1,4 +1,4 @@
-#include "inertialnet/pipeline.hpp"
+#include "inertialnet/pipeline/pipeline.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -7,7 +7,7 @@
 #include <mutex>
 #include <thread>
 
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/error.hpp"
 
 namespace inertialnet {
 

@@ -2,11 +2,11 @@
 #include <opencv2/core.hpp>
 #include <opencv2/video/tracking.hpp>
 
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/error.hpp"
 #include "inertialnet/models/flownet.hpp"
 #include "inertialnet/models/inertialnet_head.hpp"
-#include "inertialnet/processors.hpp"
-#include "inertialnet/queue.hpp"
+#include "inertialnet/pipeline/rates_processor.hpp"
+#include "inertialnet/runtime/queue.hpp"
 
 namespace inertialnet {
 

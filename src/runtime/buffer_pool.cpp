@@ -1,4 +1,4 @@
-#include "inertialnet/buffer_pool.hpp"
+#include "inertialnet/runtime/buffer_pool.hpp"
 
 #include <algorithm>
 

@@ -10,7 +10,7 @@
 #include <set>
 #include <unordered_map>
 
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/error.hpp"
 
 namespace inertialnet::detail {
 
@@ -26,7 +26,7 @@ const std::vector<ClblastOverride>& table() {
        {{"GEMMK", 0}, {"KREG", 1}, {"KWG", 16}, {"KWI", 2}, {"MDIMA", 16}, {"MDIMC", 8}, {"MWG", 128},
         {"NDIMB", 32}, {"NDIMC", 16}, {"NWG", 128}, {"SA", 0}, {"SB", 0}, {"STRM", 1}, {"STRN", 1}, {"VWM", 8},
         {"VWN", 4}},
-       "clblast_tuner_xgemm (2 % random search, 1024^3) on an AMD EPYC Zen 4 under PoCL 3.1, shared/PERF_NOTES.md"},
+       "clblast_tuner_xgemm (2 % random search, 1024^3) on an AMD EPYC Zen 4 under PoCL 3.1, docs/performance.md"},
   };
   return entries;
 }

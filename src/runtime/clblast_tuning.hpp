@@ -1,7 +1,7 @@
 // CLBlast parameters per device, kept as data (as CLBlast keeps its own database).
 //
 // CLBlast's database has no entry for CPUs under PoCL, whose generic defaults run SGEMM at a
-// tenth of what the machine can do (shared/PERF_NOTES.md). Each entry below names the devices it
+// tenth of what the machine can do (docs/performance.md). Each entry below names the devices it
 // is for, the CLBlast kernel it tunes, the full parameter set (CLBlast refuses partial ones) and
 // where it was measured. Opening a Device applies the matching entries once per device with
 // clblast::OverrideParameters; INERTIALNET_CLBLAST_TUNING=0 turns this off (to measure, or to
@@ -14,7 +14,7 @@
 #include <utility>
 #include <vector>
 
-#include "inertialnet/device_info.hpp"
+#include "inertialnet/runtime/device_info.hpp"
 
 namespace inertialnet::detail {
 

@@ -1,8 +1,8 @@
-#include "inertialnet/device.hpp"
+#include "inertialnet/runtime/device.hpp"
 
 #include <cstdlib>
 
-#include "inertialnet/queue.hpp"
+#include "inertialnet/runtime/queue.hpp"
 #include "runtime/clblast_tuning.hpp"
 
 namespace inertialnet {

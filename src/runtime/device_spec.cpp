@@ -3,8 +3,8 @@
 #include <cstdlib>
 #include <sstream>
 
-#include "inertialnet/device_selection.hpp"
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/device_selection.hpp"
+#include "inertialnet/runtime/error.hpp"
 
 namespace inertialnet {
 

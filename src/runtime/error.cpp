@@ -1,4 +1,4 @@
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/error.hpp"
 
 #include <sstream>
 

@@ -1,5 +1,5 @@
 // FNV-1a, 64 bit: a stable, dependency-free hash for cache keys and for the synthetic-weight
-// generator of MODEL_SPEC (which fixes this exact function).
+// generator of docs/model_spec.md (which fixes this exact function).
 #pragma once
 
 #include <cstdint>

@@ -5,8 +5,8 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "inertialnet/device_info.hpp"
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/device_info.hpp"
+#include "inertialnet/runtime/error.hpp"
 
 namespace inertialnet {
 

@@ -1,4 +1,4 @@
-#include "inertialnet/program_cache.hpp"
+#include "inertialnet/runtime/program_cache.hpp"
 
 #include <unistd.h>
 
@@ -10,7 +10,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/error.hpp"
 #include "runtime/embedded_kernels.hpp"
 #include "runtime/hash.hpp"
 

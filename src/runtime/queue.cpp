@@ -1,6 +1,6 @@
-#include "inertialnet/queue.hpp"
+#include "inertialnet/runtime/queue.hpp"
 
-#include "inertialnet/device.hpp"
+#include "inertialnet/runtime/device.hpp"
 
 namespace inertialnet {
 

@@ -1,10 +1,10 @@
-#include "inertialnet/tensor.hpp"
+#include "inertialnet/runtime/tensor.hpp"
 
 #include <limits>
 #include <sstream>
 
-#include "inertialnet/device.hpp"
-#include "inertialnet/queue.hpp"
+#include "inertialnet/runtime/device.hpp"
+#include "inertialnet/runtime/queue.hpp"
 
 namespace inertialnet {
 

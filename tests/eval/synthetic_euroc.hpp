@@ -17,7 +17,7 @@
 
 #include <unistd.h>
 
-#include "inertialnet/vec3.hpp"
+#include "inertialnet/core/vec3.hpp"
 
 namespace inertialnet::testing_euroc {
 

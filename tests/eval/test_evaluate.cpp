@@ -7,8 +7,8 @@
 #include <nlohmann/json.hpp>
 
 #include "eval/synthetic_euroc.hpp"
-#include "inertialnet/error.hpp"
-#include "inertialnet/evaluate.hpp"
+#include "inertialnet/runtime/error.hpp"
+#include "inertialnet/eval/evaluate.hpp"
 
 namespace fs = std::filesystem;
 using namespace inertialnet;

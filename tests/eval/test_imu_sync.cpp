@@ -5,8 +5,8 @@
 #include <functional>
 
 #include "eval/synthetic_euroc.hpp"
-#include "inertialnet/error.hpp"
-#include "inertialnet/imu_sync.hpp"
+#include "inertialnet/runtime/error.hpp"
+#include "inertialnet/eval/imu_sync.hpp"
 
 namespace fs = std::filesystem;
 using namespace inertialnet;
@@ -153,7 +153,7 @@ TEST(ImuSync, NoOverlapIsAnError) {
 }
 
 TEST(ImuSync, CameraFrameRotationFollowsEurocTBS) {
-  // Body rate (1, 0, 0) only: EUROC.md says ω_C ≈ (ω_By, −ω_Bx, ω_Bz) = (0, −1, 0).
+  // Body rate (1, 0, 0) only: docs/data_conventions.md says ω_C ≈ (ω_By, −ω_Bx, ω_Bz) = (0, −1, 0).
   te::TempDir dir("sync_rot");
   te::Spec spec;
   spec.rate = [](double) { return Vec3{1.0, 0.0, 0.0}; };
@@ -168,7 +168,7 @@ TEST(ImuSync, CameraFrameRotationFollowsEurocTBS) {
   EXPECT_NEAR(g.raw[5][0], 0.0148655429818, 1e-12);
   EXPECT_NEAR(g.raw[5][1], -0.999880929698, 1e-12);
   EXPECT_NEAR(g.raw[5][2], 0.00414029679422, 1e-12);
-  // Approximate convention from EUROC.md (T_BS is 0.86° off the ideal axis swap).
+  // Approximate convention from docs/data_conventions.md (T_BS is 0.86° off the ideal axis swap).
   EXPECT_NEAR(g.raw[5][1], -1.0, 2e-4);
   EXPECT_NEAR(g.raw[5][0], 0.0, 2e-2);
 

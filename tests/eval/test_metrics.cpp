@@ -4,8 +4,8 @@
 #include <cmath>
 #include <functional>
 
-#include "inertialnet/error.hpp"
-#include "inertialnet/metrics.hpp"
+#include "inertialnet/runtime/error.hpp"
+#include "inertialnet/eval/metrics.hpp"
 
 using namespace inertialnet;
 

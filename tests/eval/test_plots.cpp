@@ -8,8 +8,8 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "eval/synthetic_euroc.hpp"
-#include "inertialnet/error.hpp"
-#include "inertialnet/plots.hpp"
+#include "inertialnet/runtime/error.hpp"
+#include "inertialnet/eval/plots.hpp"
 
 using namespace inertialnet;
 namespace te = inertialnet::testing_euroc;

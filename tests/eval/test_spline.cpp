@@ -5,8 +5,8 @@
 #include <functional>
 #include <string>
 
-#include "inertialnet/error.hpp"
-#include "inertialnet/spline.hpp"
+#include "inertialnet/runtime/error.hpp"
+#include "inertialnet/eval/spline.hpp"
 
 using namespace inertialnet;
 

@@ -4,8 +4,8 @@
 #include <fstream>
 
 #include "eval/synthetic_euroc.hpp"
-#include "inertialnet/error.hpp"
-#include "inertialnet/euroc.hpp"
+#include "inertialnet/runtime/error.hpp"
+#include "inertialnet/io/euroc.hpp"
 
 namespace fs = std::filesystem;
 using namespace inertialnet;

@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "inertialnet/error.hpp"
-#include "inertialnet/flow_io.hpp"
-#include "inertialnet/image_io.hpp"
+#include "inertialnet/runtime/error.hpp"
+#include "inertialnet/io/flow_io.hpp"
+#include "inertialnet/io/image_io.hpp"
 #include "support/testing.hpp"
 
 using namespace inertialnet;

@@ -11,8 +11,8 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include "inertialnet/error.hpp"
-#include "inertialnet/image_io.hpp"
+#include "inertialnet/runtime/error.hpp"
+#include "inertialnet/io/image_io.hpp"
 #include "support/testing.hpp"
 
 using namespace inertialnet;

@@ -5,8 +5,8 @@
 #include <functional>
 
 #include "eval/synthetic_euroc.hpp"
-#include "inertialnet/error.hpp"
-#include "inertialnet/rates_csv.hpp"
+#include "inertialnet/runtime/error.hpp"
+#include "inertialnet/io/rates_csv.hpp"
 
 using namespace inertialnet;
 namespace te = inertialnet::testing_euroc;

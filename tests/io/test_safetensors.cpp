@@ -1,6 +1,6 @@
 // The safetensors reader and writer: round trips, every malformed-file error (files written byte
 // by byte here), exact F16 conversion, and the model-fit check's single error message.
-#include "inertialnet/safetensors.hpp"
+#include "inertialnet/io/safetensors.hpp"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/error.hpp"
 
 namespace inertialnet {
 namespace {

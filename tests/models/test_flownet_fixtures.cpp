@@ -6,7 +6,7 @@
 #include <filesystem>
 
 #include "inertialnet/models/flownet.hpp"
-#include "inertialnet/safetensors.hpp"
+#include "inertialnet/io/safetensors.hpp"
 #include "models/flownet_graphs.hpp"
 #include "support/testing.hpp"
 

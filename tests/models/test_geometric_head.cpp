@@ -92,7 +92,7 @@ struct Motion {
 
 // Exact flow of the static room: with R = exp([ω·dt]×) the camera's rotation over the frame
 // interval and c its displacement, a point P seen at t−1 is at Rᵀ(P − c) at t, i.e.
-// Ṗ = −ω × P − v: the convention of EUROC.md's motion-field equations.
+// Ṗ = −ω × P − v: the convention of docs/data_conventions.md's motion-field equations.
 FlowField render(const CameraIntrinsics& k, const std::vector<float>& map, const Motion& m) {
   FlowField f(k.width, k.height);
   const Mat r = exp_so3({m.omega[0] * m.dt, m.omega[1] * m.dt, m.omega[2] * m.dt});
@@ -345,7 +345,7 @@ TEST(MotionFieldMoments, CorrespondencesMatchTheReference) {
 // --- ω from exact flow ---------------------------------------------------------------------------
 
 TEST(GeometricHead, UniformRightwardFlowIsANegativeYawRate) {
-  // EUROC.md: ẋ = −(1 + x²)·ωy + …, so image content moving right (+x) means ωy < 0.
+  // docs/data_conventions.md: ẋ = −(1 + x²)·ωy + …, so image content moving right (+x) means ωy < 0.
   Queue& queue = testing::test_queue();
   const CameraIntrinsics k = quarter_euroc(false);
   GeometricHeadOptions o = quarter_options();

@@ -5,7 +5,7 @@
 #include <filesystem>
 
 #include "inertialnet/models/inertialnet_head.hpp"
-#include "inertialnet/safetensors.hpp"
+#include "inertialnet/io/safetensors.hpp"
 #include "support/testing.hpp"
 
 namespace inertialnet {

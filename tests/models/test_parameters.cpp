@@ -1,4 +1,4 @@
-// Parameter tables against shared/MODEL_SPEC.md: exact counts, flownet2-pytorch names and
+// Parameter tables against docs/model_spec.md: exact counts, flownet2-pytorch names and
 // shapes, fan-ins and gains, the head's FC1 width, HeadConfig JSON and model-kind names.
 #include "inertialnet/models/parameters.hpp"
 
@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/error.hpp"
 
 namespace inertialnet {
 namespace {
@@ -40,7 +40,7 @@ bool ends_with(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
-// Counts are MODEL_SPEC's (and flownet2-pytorch's docstrings').
+// Counts are docs/model_spec.md's (and flownet2-pytorch's docstrings').
 TEST(Parameters, CountsMatchTheSpecification) {
   EXPECT_EQ(total_parameter_count(flownetc_parameters()), 39175298);
   EXPECT_EQ(total_parameter_count(flownets_parameters(12)), 38695322);
@@ -125,7 +125,7 @@ TEST(Parameters, FlowNet2NamesAndShapes) {
     ASSERT_NE(it, table.end()) << e.first;
     EXPECT_EQ(it->second.shape, e.second) << e.first;
   }
-  // FlowNetS's up layers have no bias (MODEL_SPEC); the others have one.
+  // FlowNetS's up layers have no bias (docs/model_spec.md); the others have one.
   EXPECT_EQ(table.count("flownets_1.upsampled_flow6_to_5.bias"), 0u);
   EXPECT_EQ(table.count("flownets_2.upsampled_flow3_to_2.bias"), 0u);
   // No sub-network has batch-norm tensors or an un-suffixed layer.

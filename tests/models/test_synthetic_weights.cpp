@@ -1,4 +1,4 @@
-// Deterministic synthetic weights (shared/MODEL_SPEC.md): bit-exact against values computed
+// Deterministic synthetic weights (docs/model_spec.md): bit-exact against values computed
 // independently in Python and, once committed, against tests/data/fixtures/synthetic_weights.json
 // written by the Python twin in tools/reference/.
 #include "inertialnet/models/synthetic_weights.hpp"
@@ -21,8 +21,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "inertialnet/error.hpp"
-#include "inertialnet/safetensors.hpp"
+#include "inertialnet/runtime/error.hpp"
+#include "inertialnet/io/safetensors.hpp"
 #include "support/sha256.hpp"
 
 namespace inertialnet {
@@ -83,7 +83,7 @@ TEST(SyntheticWeights, SHA256HelperMatchesFips180Vectors) {
   EXPECT_EQ(hex, "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
 }
 
-// Computed with a few lines of stdlib-only Python (struct + hashlib) written from MODEL_SPEC, not
+// Computed with a few lines of stdlib-only Python (struct + hashlib) written from docs/model_spec.md, not
 // from this implementation: sha256 of the tensor's little-endian float32 bytes, first values as
 // float.hex() of the float32 values.
 struct HandComputed {

@@ -33,7 +33,7 @@ struct Placement {
 
 constexpr float kSentinel = 123.25f;  // fills the wide output around the slice; must survive
 
-// FlowNet's layer kinds (MODEL_SPEC): conv = k×k, stride s, padding (k−1)/2, bias, LeakyReLU(0.1);
+// FlowNet's layer kinds (docs/model_spec.md): conv = k×k, stride s, padding (k−1)/2, bias, LeakyReLU(0.1);
 // iconv = 3×3 stride 1 no activation; pred = 3×3 → 2 channels, no activation.
 ConvCase conv(const char* name, int ci, int co, int size, int k, int s = 1) {
   return {name, ci, co, size, size, k, s, (k - 1) / 2, true, ActivationSpec::leaky_relu(0.1f)};

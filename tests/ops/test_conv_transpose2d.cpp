@@ -31,7 +31,7 @@ struct Placement {
 
 constexpr float kSentinel = -77.5f;  // fills the wide output around the slice; must survive
 
-// MODEL_SPEC: deconv = ConvTranspose2d(4, 2, 1) + bias + LeakyReLU(0.1); up = ConvTranspose2d(2→2,
+// docs/model_spec.md: deconv = ConvTranspose2d(4, 2, 1) + bias + LeakyReLU(0.1); up = ConvTranspose2d(2→2,
 // 4, 2, 1) without activation, with a bias in FlowNetC/SD/Fusion and without in FlowNetS.
 DeconvCase deconv(const char* name, int ci, int co, int size) {
   return {name, ci, co, size, size, 4, 2, 1, true, ActivationSpec::leaky_relu(0.1f)};

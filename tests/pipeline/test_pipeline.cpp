@@ -9,10 +9,10 @@
 #include "inertialnet/models/flownet.hpp"
 #include "inertialnet/models/inertialnet_head.hpp"
 #include "inertialnet/models/synthetic_weights.hpp"
-#include "inertialnet/pipeline.hpp"
-#include "inertialnet/processors.hpp"
-#include "inertialnet/rates_csv.hpp"
-#include "inertialnet/synthetic_sequence.hpp"
+#include "inertialnet/pipeline/pipeline.hpp"
+#include "inertialnet/pipeline/rates_processor.hpp"
+#include "inertialnet/io/rates_csv.hpp"
+#include "inertialnet/synth/synthetic_sequence.hpp"
 #include "support/testing.hpp"
 
 namespace inertialnet {

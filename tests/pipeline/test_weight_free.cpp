@@ -5,9 +5,9 @@
 // deg/s, since the rates reach ±40 deg/s.
 #include <cmath>
 
-#include "inertialnet/frame_source.hpp"
-#include "inertialnet/processors.hpp"
-#include "inertialnet/synthetic_sequence.hpp"
+#include "inertialnet/io/frame_source.hpp"
+#include "inertialnet/pipeline/rates_processor.hpp"
+#include "inertialnet/synth/synthetic_sequence.hpp"
 #include "support/testing.hpp"
 
 namespace inertialnet {

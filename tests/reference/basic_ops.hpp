@@ -1,6 +1,6 @@
 // Plain C++ loops for the memory-bound ops: elementwise, activation, concat, max pooling,
 // FlowNet2's input normalisation and dropout. Host vectors hold tensors contiguously in
-// row-major (NCHW) order; written from MODEL_SPEC.md's semantics, not from the kernels.
+// row-major (NCHW) order; written from docs/model_spec.md's semantics, not from the kernels.
 #pragma once
 
 #include <cstdint>

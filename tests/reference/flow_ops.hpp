@@ -1,4 +1,4 @@
-// Plain C++ loops of FlowNet2's flow-specific layers, written from /work/shared/MODEL_SPEC.md
+// Plain C++ loops of FlowNet2's flow-specific layers, written from docs/model_spec.md
 // (Correlation, Warp, ChannelNorm, the FlowNet2 up-sampling steps, "Any input size"): the
 // references for kernels_cl/{correlation,warp,channel_norm,upsample}.cl. Tensors are
 // contiguous NCHW vectors.
@@ -8,7 +8,7 @@
 #include <ostream>
 #include <vector>
 
-#include "inertialnet/tensor.hpp"
+#include "inertialnet/runtime/tensor.hpp"
 
 namespace inertialnet::reference {
 

@@ -111,7 +111,7 @@ MotionFieldMoments motion_field_moments(const FlowField& flow, const std::vector
       m.usable += 1;
       const double x = 0.5 * (e2->x1 + e2->x2), y = 0.5 * (e2->y1 + e2->y2);
       const double b[2] = {(e2->x2 - e2->x1) / p.dt, (e2->y2 - e2->y1) / p.dt};
-      // EUROC.md: ẋ = x·y·ωx − (1 + x²)·ωy + y·ωz,  ẏ = (1 + y²)·ωx − x·y·ωy − x·ωz.
+      // docs/data_conventions.md: ẋ = x·y·ωx − (1 + x²)·ωy + y·ωz,  ẏ = (1 + y²)·ωx − x·y·ωy − x·ωz.
       const double ax[3] = {x * y, -(1 + x * x), y};
       const double ay[3] = {1 + y * y, -x * y, -x};
       const double r[2] = {b[0] - (ax[0] * w[0] + ax[1] * w[1] + ax[2] * w[2]),

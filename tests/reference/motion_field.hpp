@@ -5,7 +5,7 @@
 
 #include <vector>
 
-#include "inertialnet/flow_io.hpp"
+#include "inertialnet/io/flow_io.hpp"
 #include "inertialnet/models/geometric_head.hpp"
 
 namespace inertialnet::reference {

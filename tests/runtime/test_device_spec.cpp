@@ -1,8 +1,8 @@
 // The --device grammar, without hardware: parsing and resolution over made-up device lists.
 #include <gtest/gtest.h>
 
-#include "inertialnet/device_selection.hpp"
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/device_selection.hpp"
+#include "inertialnet/runtime/error.hpp"
 #include "runtime/clblast_tuning.hpp"
 
 namespace inertialnet {

@@ -4,8 +4,8 @@
 #include <memory>
 
 #include "commands.hpp"
-#include "inertialnet/device_info.hpp"
-#include "inertialnet/device_selection.hpp"
+#include "inertialnet/runtime/device_info.hpp"
+#include "inertialnet/runtime/device_selection.hpp"
 
 namespace inertialnet::cli {
 

@@ -5,8 +5,8 @@
 #include <memory>
 
 #include "commands.hpp"
-#include "inertialnet/evaluate.hpp"
-#include "inertialnet/rates_csv.hpp"
+#include "inertialnet/eval/evaluate.hpp"
+#include "inertialnet/io/rates_csv.hpp"
 
 namespace inertialnet::cli {
 

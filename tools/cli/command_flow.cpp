@@ -7,9 +7,9 @@
 
 #include "commands.hpp"
 #include "common.hpp"
-#include "inertialnet/error.hpp"
-#include "inertialnet/flow_io.hpp"
-#include "inertialnet/image_io.hpp"
+#include "inertialnet/runtime/error.hpp"
+#include "inertialnet/io/flow_io.hpp"
+#include "inertialnet/io/image_io.hpp"
 #include "inertialnet/models/flownet.hpp"
 
 namespace inertialnet::cli {

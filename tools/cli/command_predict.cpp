@@ -8,13 +8,13 @@
 
 #include "commands.hpp"
 #include "common.hpp"
-#include "inertialnet/device_selection.hpp"
-#include "inertialnet/error.hpp"
-#include "inertialnet/flow_io.hpp"
-#include "inertialnet/frame_source.hpp"
-#include "inertialnet/pipeline.hpp"
-#include "inertialnet/processors.hpp"
-#include "inertialnet/rates_csv.hpp"
+#include "inertialnet/runtime/device_selection.hpp"
+#include "inertialnet/runtime/error.hpp"
+#include "inertialnet/io/flow_io.hpp"
+#include "inertialnet/io/frame_source.hpp"
+#include "inertialnet/pipeline/pipeline.hpp"
+#include "inertialnet/pipeline/rates_processor.hpp"
+#include "inertialnet/io/rates_csv.hpp"
 #include "progress.hpp"
 
 namespace inertialnet::cli {

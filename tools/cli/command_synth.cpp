@@ -1,12 +1,12 @@
 // `inertialnet synth OUT_DIR`: a EuRoC-layout sequence rendered from a known camera motion, with
-// exact gyro ground truth (include/inertialnet/synthetic_sequence.hpp).
+// exact gyro ground truth (include/inertialnet/synth/synthetic_sequence.hpp).
 #include <cstdio>
 #include <iostream>
 #include <memory>
 
 #include "commands.hpp"
 #include "common.hpp"
-#include "inertialnet/synthetic_sequence.hpp"
+#include "inertialnet/synth/synthetic_sequence.hpp"
 
 namespace inertialnet::cli {
 

@@ -5,9 +5,9 @@
 
 #include "commands.hpp"
 #include "common.hpp"
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/error.hpp"
 #include "inertialnet/models/synthetic_weights.hpp"
-#include "inertialnet/safetensors.hpp"
+#include "inertialnet/io/safetensors.hpp"
 
 namespace inertialnet::cli {
 

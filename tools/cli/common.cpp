@@ -3,8 +3,8 @@
 #include <iostream>
 #include <regex>
 
-#include "inertialnet/device_selection.hpp"
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/device_selection.hpp"
+#include "inertialnet/runtime/error.hpp"
 
 namespace inertialnet::cli {
 

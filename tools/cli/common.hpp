@@ -8,7 +8,7 @@
 #include <utility>
 
 #include "commands.hpp"
-#include "inertialnet/device.hpp"
+#include "inertialnet/runtime/device.hpp"
 #include "inertialnet/models/weights.hpp"
 
 namespace inertialnet::cli {

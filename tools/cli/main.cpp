@@ -5,8 +5,8 @@
 #include <map>
 
 #include "commands.hpp"
-#include "inertialnet/error.hpp"
-#include "inertialnet/program_cache.hpp"
+#include "inertialnet/runtime/error.hpp"
+#include "inertialnet/runtime/program_cache.hpp"
 
 int main(int argc, char** argv) {
   using namespace inertialnet;

@@ -1,4 +1,4 @@
-"""Independent PyTorch reference of the FlowNet2 family, written from shared/MODEL_SPEC.md.
+"""Independent PyTorch reference of the FlowNet2 family, written from docs/model_spec.md.
 
 Only torch built-ins are used (F.conv2d, F.conv_transpose2d, F.leaky_relu, F.interpolate, gather,
 pad/shift). Parameter names equal flownet2-pytorch's state_dict names so published checkpoints
@@ -124,7 +124,7 @@ def resize_bilinear(x: torch.Tensor, h: int, w: int) -> torch.Tensor:
 
 
 def normalise_frames(frame1: torch.Tensor, frame2: torch.Tensor) -> torch.Tensor:
-    """MODEL_SPEC step 1: subtract the per-(batch, channel) mean over both frames, divide by 255,
+    """docs/model_spec.md step 1: subtract the per-(batch, channel) mean over both frames, divide by 255,
     and concatenate to 6 channels."""
     both = torch.stack((frame1, frame2), dim=2)  # [B, 3, 2, H, W]
     mean = both.reshape(both.shape[0], both.shape[1], -1).mean(dim=-1)
@@ -455,7 +455,7 @@ MODELS = {
     "FlowNet2-CSS": FlowNet2CSS,
 }
 
-# Parameter counts stated in MODEL_SPEC.md (the self-test checks the modules against them).
+# Parameter counts stated in docs/model_spec.md (the self-test checks the modules against them).
 EXPECTED_PARAMETERS = {
     "FlowNetC": 39_175_298,
     "FlowNetS(12)": 38_695_322,
@@ -488,7 +488,7 @@ def expected_shapes(kind: str) -> dict:
 
 
 def run_any_size(model: nn.Module, frame1: torch.Tensor, frame2: torch.Tensor) -> dict:
-    """MODEL_SPEC "Any input size": resize both frames bilinearly to multiples of 64, run, resize
+    """docs/model_spec.md "Any input size": resize both frames bilinearly to multiples of 64, run, resize
     the flow back and scale u by W/W', v by H/H'. Returns the model's dict (at the working size)
     plus "input1"/"input2" (the resized frames) and "flow" replaced by the flow at H x W
     ("flow_work" keeps the working-size result)."""

@@ -1,4 +1,4 @@
-"""InertialNet rotation head (shared/MODEL_SPEC.md, last section; shared/paper_tables.md).
+"""InertialNet rotation head (docs/model_spec.md, "InertialNet head").
 
 flow [B, 2, H, W] (pixels, times flow_scale) -> conv1 kxk + ReLU -> max-pool -> conv2 kxk + ReLU
 -> max-pool -> conv3 (1x1) + ReLU -> flatten (C, H, W order) -> dropout (training only) -> fc1 +

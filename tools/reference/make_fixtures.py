@@ -300,7 +300,7 @@ def synthetic_weights_json(out_dir: str, written: list) -> None:
         return d
 
     doc = {
-        "description": "Deterministic synthetic weights (shared/MODEL_SPEC.md): per tensor, its layer "
+        "description": "Deterministic synthetic weights (docs/model_spec.md): per tensor, its layer "
                        "kind, fan_in, gain, the stream key, the first four u values and float32 "
                        "values as exact hex floats, and the sha256 of all its little-endian float32 "
                        "bytes. Head tensors are those of the default head (input 752x480, so fc1 has "

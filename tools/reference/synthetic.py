@@ -1,4 +1,4 @@
-"""Deterministic synthetic weights (shared/MODEL_SPEC.md, "Deterministic synthetic weights").
+"""Deterministic synthetic weights (docs/model_spec.md, "Deterministic synthetic weights").
 
 The C++ library implements the same generator; both must agree bit for bit, which
 tests/data/fixtures/synthetic_weights.json checks. The arithmetic is spelled out here in the

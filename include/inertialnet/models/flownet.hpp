@@ -1,5 +1,5 @@
 // The FlowNet2 family on a device: FlowNet2, FlowNet2-CS, FlowNet2-CSS and the standalone
-// FlowNet2-C, -S and -SD, exactly as shared/MODEL_SPEC.md specifies them.
+// FlowNet2-C, -S and -SD, exactly as docs/model_spec.md specifies them.
 //
 // Frames of any size are accepted: they are resized bilinearly to the next multiples of 64, the
 // network runs there, and the flow is resized back with its vectors rescaled (what the Caffe
@@ -12,11 +12,11 @@
 #include <string>
 #include <vector>
 
-#include "inertialnet/device.hpp"
+#include "inertialnet/runtime/device.hpp"
 #include "inertialnet/models/parameters.hpp"
 #include "inertialnet/models/weights.hpp"
-#include "inertialnet/queue.hpp"
-#include "inertialnet/tensor.hpp"
+#include "inertialnet/runtime/queue.hpp"
+#include "inertialnet/runtime/tensor.hpp"
 
 namespace inertialnet {
 

@@ -5,7 +5,7 @@
 // or a host FlowField), the camera (intrinsics and lens distortion) and the frame interval dt.
 // Output: ω in the CAMERA frame (x right, y down, z forward), rad/s, with diagnostics.
 //
-// Model (shared/EUROC.md, "Sign conventions"). With undistorted normalised coordinates (x, y)
+// Model (docs/data_conventions.md, "Sign conventions"). With undistorted normalised coordinates (x, y)
 // taken at the MIDPOINT of each flow vector and the image velocity (ẋ, ẏ) = normalised
 // displacement / dt, a camera moving with angular velocity ω and translational velocity T
 // through a static scene of inverse depth ρ(x, y) sees
@@ -32,12 +32,12 @@
 #include <string>
 #include <vector>
 
-#include "inertialnet/device.hpp"
-#include "inertialnet/euroc.hpp"
-#include "inertialnet/flow_io.hpp"
-#include "inertialnet/queue.hpp"
-#include "inertialnet/tensor.hpp"
-#include "inertialnet/vec3.hpp"
+#include "inertialnet/runtime/device.hpp"
+#include "inertialnet/io/euroc.hpp"
+#include "inertialnet/io/flow_io.hpp"
+#include "inertialnet/runtime/queue.hpp"
+#include "inertialnet/runtime/tensor.hpp"
+#include "inertialnet/core/vec3.hpp"
 
 namespace inertialnet {
 

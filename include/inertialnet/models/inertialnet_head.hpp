@@ -1,4 +1,4 @@
-// The InertialNet rotation head (shared/paper_tables.md, MODEL_SPEC "InertialNet head"):
+// The InertialNet rotation head (docs/model_spec.md, "InertialNet head"):
 // flow [N, 2, H, W] in pixels → conv1 + ReLU → max-pool → conv2 + ReLU → max-pool →
 // 1×1 conv3 + ReLU → flatten → (dropout, training only) → fc1 + ReLU → fc2 → (ωx, ωy, ωz) in
 // rad/s. Every hyper-parameter, including the flow size that fixes fc1's width, comes from
@@ -8,11 +8,11 @@
 #include <atomic>
 #include <memory>
 
-#include "inertialnet/device.hpp"
+#include "inertialnet/runtime/device.hpp"
 #include "inertialnet/models/parameters.hpp"
 #include "inertialnet/models/weights.hpp"
-#include "inertialnet/queue.hpp"
-#include "inertialnet/tensor.hpp"
+#include "inertialnet/runtime/queue.hpp"
+#include "inertialnet/runtime/tensor.hpp"
 
 namespace inertialnet {
 

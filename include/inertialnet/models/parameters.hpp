@@ -1,5 +1,5 @@
 // The parameter tables of every network: names (exactly flownet2-pytorch's state_dict keys),
-// shapes, layer kinds and the fan-in and gain the synthetic weights use (shared/MODEL_SPEC.md).
+// shapes, layer kinds and the fan-in and gain the synthetic weights use (docs/model_spec.md).
 // A model loads its weights by these names; a weight file is checked against these shapes.
 #pragma once
 
@@ -47,7 +47,7 @@ inline constexpr const char* kMetadataHead = "inertialnet.head";            // h
 inline constexpr const char* kMetadataSynthetic = "inertialnet.synthetic";  // "true" for generated weights
 inline constexpr const char* kMetadataSeed = "inertialnet.seed";            // decimal seed of synthetic weights
 
-// The InertialNet head's hyper-parameters (shared/paper_tables.md; defaults reproduce the paper's
+// The InertialNet head's hyper-parameters (docs/model_spec.md; defaults reproduce the paper's
 // ≈23.1 M-weight FC1 for a 752×480 flow). The same fields, names and JSON form as the Python twin
 // (tools/reference/head.py). Convolutions use padding (k−1)/2, so kernels are odd and keep the
 // size; the two pool×pool/pool max-pools floor, hence FC1 sees conv3_channels·⌊⌊H/p⌋/p⌋·⌊⌊W/p⌋/p⌋

@@ -1,4 +1,4 @@
-// Deterministic synthetic weights (shared/MODEL_SPEC.md "Deterministic synthetic weights"):
+// Deterministic synthetic weights (docs/model_spec.md "Deterministic synthetic weights"):
 // every tensor is a pure function of (seed, tensor name, fan-in, gain), bit-identical to the
 // Python twin in tools/reference/, so full-size networks can be compared with PyTorch without
 // shipping real checkpoints.
@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "inertialnet/models/parameters.hpp"
-#include "inertialnet/safetensors.hpp"
+#include "inertialnet/io/safetensors.hpp"
 
 namespace inertialnet {
 

@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "inertialnet/device.hpp"
+#include "inertialnet/runtime/device.hpp"
 #include "inertialnet/models/parameters.hpp"
-#include "inertialnet/tensor.hpp"
+#include "inertialnet/runtime/tensor.hpp"
 
 namespace inertialnet {
 
@@ -24,7 +24,7 @@ class WeightSet {
   // Every tensor of every file, converted to float32 and uploaded. Duplicate names across files
   // are refused. The files' metadata is kept (model kind, synthetic flag, head configuration).
   static WeightSet load(Device& device, const std::vector<std::string>& paths);
-  // The synthetic weights of `kind` (MODEL_SPEC), generated on the host and uploaded.
+  // The synthetic weights of `kind` (docs/model_spec.md), generated on the host and uploaded.
   static WeightSet synthetic(Device& device, ModelKind kind, std::uint64_t seed, const HeadConfig& head = {});
 
   bool contains(const std::string& name) const { return tensors_.count(name) != 0; }

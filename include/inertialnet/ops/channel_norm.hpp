@@ -5,8 +5,8 @@
 // computes sqrt(Σ_c (a − b)²) without materialising a − b.
 #pragma once
 
-#include "inertialnet/queue.hpp"
-#include "inertialnet/tensor.hpp"
+#include "inertialnet/runtime/queue.hpp"
+#include "inertialnet/runtime/tensor.hpp"
 
 namespace inertialnet {
 

@@ -8,8 +8,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "inertialnet/queue.hpp"
-#include "inertialnet/tensor.hpp"
+#include "inertialnet/runtime/queue.hpp"
+#include "inertialnet/runtime/tensor.hpp"
 
 namespace inertialnet {
 

@@ -7,8 +7,8 @@
 #pragma once
 
 #include "inertialnet/ops/activation.hpp"
-#include "inertialnet/queue.hpp"
-#include "inertialnet/tensor.hpp"
+#include "inertialnet/runtime/queue.hpp"
+#include "inertialnet/runtime/tensor.hpp"
 
 namespace inertialnet {
 

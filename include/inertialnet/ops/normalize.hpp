@@ -1,4 +1,4 @@
-// FlowNet2's input normalisation (step 1 of MODEL_SPEC.md's FlowNet2): for frames [N, C, H, W]
+// FlowNet2's input normalisation (step 1 of docs/model_spec.md's FlowNet2): for frames [N, C, H, W]
 // in [0, 255] (C = 3, RGB),
 //   rgb_mean[n, c] = mean over both frames and all pixels of channel c,
 //   out[n, c]     = (frame1[n, c] − rgb_mean[n, c]) / rgb_max,
@@ -15,8 +15,8 @@
 // frame2 are exactly channels [0, C) and [C, 2C) of the output; any other overlap is refused.
 #pragma once
 
-#include "inertialnet/queue.hpp"
-#include "inertialnet/tensor.hpp"
+#include "inertialnet/runtime/queue.hpp"
+#include "inertialnet/runtime/tensor.hpp"
 
 namespace inertialnet {
 

@@ -4,8 +4,8 @@
 // Input and output may be channel slices.
 #pragma once
 
-#include "inertialnet/queue.hpp"
-#include "inertialnet/tensor.hpp"
+#include "inertialnet/runtime/queue.hpp"
+#include "inertialnet/runtime/tensor.hpp"
 
 namespace inertialnet {
 

@@ -1,5 +1,5 @@
 // Resampling of NCHW tensors to another spatial size, with PyTorch's interpolate() semantics,
-// and the flow-field resize of MODEL_SPEC "Any input size".
+// and the flow-field resize of docs/model_spec.md "Any input size".
 //
 // With s_y = H_in / H_out and s_x = W_in / W_out (computed in float32, as PyTorch does):
 //  - Bilinear (align_corners = False): src = max(s·(dst + 0.5) − 0.5, 0); i0 = floor(src),
@@ -13,8 +13,8 @@
 
 #include <cstdint>
 
-#include "inertialnet/queue.hpp"
-#include "inertialnet/tensor.hpp"
+#include "inertialnet/runtime/queue.hpp"
+#include "inertialnet/runtime/tensor.hpp"
 
 namespace inertialnet {
 

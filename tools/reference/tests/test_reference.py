@@ -1,5 +1,5 @@
 """Self-test of the PyTorch reference: the generator, parameter counts and names, and each op
-against a loop written straight from MODEL_SPEC.md (test_fixtures.py checks the fixtures).
+against a loop written straight from docs/model_spec.md (test_fixtures.py checks the fixtures).
 
 Run: .venv-reference/bin/python -m pytest tools/reference/tests -q
 """

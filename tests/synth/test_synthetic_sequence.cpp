@@ -1,5 +1,5 @@
 // synth sequences: read back by the EuRoC reader, gyro against the generating rates, images
-// against the rotation (EUROC.md's sign convention), ground-truth consistency, determinism,
+// against the rotation (docs/data_conventions.md's sign convention), ground-truth consistency, determinism,
 // coverage of the field of view, and errors.
 #include <gtest/gtest.h>
 
@@ -15,9 +15,9 @@
 #include <opencv2/video/tracking.hpp>
 
 #include "eval/synthetic_euroc.hpp"
-#include "inertialnet/error.hpp"
-#include "inertialnet/euroc.hpp"
-#include "inertialnet/synthetic_sequence.hpp"
+#include "inertialnet/runtime/error.hpp"
+#include "inertialnet/io/euroc.hpp"
+#include "inertialnet/synth/synthetic_sequence.hpp"
 
 namespace fs = std::filesystem;
 using namespace inertialnet;
@@ -238,7 +238,7 @@ TEST(SynthSequence, NoisyGyroHasEurocNoiseAndTheRecordedBias) {
 }
 
 // The images move as the rotation says: tracked points against the exact homography and against
-// the rotational motion field of EUROC.md, with ω_C = R_BSᵀ·ω_gyro. The opposite sign and the
+// the rotational motion field of docs/data_conventions.md, with ω_C = R_BSᵀ·ω_gyro. The opposite sign and the
 // unrotated body-frame rate must not fit.
 TEST(SynthSequence, ImagesFollowTheRotationWithEurocSigns) {
   TempDir dir("synth_flow");

@@ -16,7 +16,7 @@
 #include <string_view>
 #include <vector>
 
-#include "inertialnet/device_info.hpp"
+#include "inertialnet/runtime/device_info.hpp"
 
 namespace inertialnet {
 

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "inertialnet/buffer_pool.hpp"
+#include "inertialnet/runtime/buffer_pool.hpp"
 
 namespace inertialnet {
 

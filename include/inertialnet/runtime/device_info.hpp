@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "inertialnet/opencl.hpp"
+#include "inertialnet/runtime/opencl.hpp"
 
 namespace inertialnet {
 

@@ -32,8 +32,8 @@
 #include <string>
 #include <vector>
 
-#include "inertialnet/euroc.hpp"
-#include "inertialnet/vec3.hpp"
+#include "inertialnet/io/euroc.hpp"
+#include "inertialnet/core/vec3.hpp"
 
 namespace inertialnet {
 

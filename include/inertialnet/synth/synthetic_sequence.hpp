@@ -35,7 +35,7 @@
 #include <string>
 #include <vector>
 
-#include "inertialnet/vec3.hpp"
+#include "inertialnet/core/vec3.hpp"
 
 namespace inertialnet {
 

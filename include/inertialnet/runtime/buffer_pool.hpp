@@ -8,8 +8,8 @@
 #include <memory>
 #include <mutex>
 
-#include "inertialnet/cl_handle.hpp"
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/cl_handle.hpp"
+#include "inertialnet/runtime/error.hpp"
 
 namespace inertialnet {
 

@@ -10,7 +10,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "inertialnet/opencl.hpp"
+#include "inertialnet/runtime/opencl.hpp"
 
 namespace inertialnet {
 

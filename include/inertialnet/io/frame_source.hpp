@@ -9,8 +9,8 @@
 #include <optional>
 #include <string>
 
-#include "inertialnet/euroc.hpp"
-#include "inertialnet/image_io.hpp"
+#include "inertialnet/io/euroc.hpp"
+#include "inertialnet/io/image_io.hpp"
 
 namespace inertialnet {
 

@@ -6,11 +6,11 @@
 #include <memory>
 #include <string>
 
-#include "inertialnet/buffer_pool.hpp"
-#include "inertialnet/cl_handle.hpp"
-#include "inertialnet/device_info.hpp"
-#include "inertialnet/error.hpp"
-#include "inertialnet/program_cache.hpp"
+#include "inertialnet/runtime/buffer_pool.hpp"
+#include "inertialnet/runtime/cl_handle.hpp"
+#include "inertialnet/runtime/device_info.hpp"
+#include "inertialnet/runtime/error.hpp"
+#include "inertialnet/runtime/program_cache.hpp"
 
 namespace inertialnet {
 

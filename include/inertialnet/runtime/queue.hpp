@@ -17,9 +17,9 @@
 #include <string>
 #include <type_traits>
 
-#include "inertialnet/cl_handle.hpp"
-#include "inertialnet/error.hpp"
-#include "inertialnet/tensor.hpp"
+#include "inertialnet/runtime/cl_handle.hpp"
+#include "inertialnet/runtime/error.hpp"
+#include "inertialnet/runtime/tensor.hpp"
 
 namespace inertialnet {
 

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "inertialnet/vec3.hpp"
+#include "inertialnet/core/vec3.hpp"
 
 namespace inertialnet {
 

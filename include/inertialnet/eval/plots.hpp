@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "inertialnet/metrics.hpp"
-#include "inertialnet/vec3.hpp"
+#include "inertialnet/eval/metrics.hpp"
+#include "inertialnet/core/vec3.hpp"
 
 namespace inertialnet {
 

@@ -20,8 +20,8 @@
 #include <string_view>
 #include <vector>
 
-#include "inertialnet/cl_handle.hpp"
-#include "inertialnet/device_info.hpp"
+#include "inertialnet/runtime/cl_handle.hpp"
+#include "inertialnet/runtime/device_info.hpp"
 
 namespace inertialnet {
 

@@ -4,7 +4,7 @@
 
 #include <utility>
 
-#include "inertialnet/opencl.hpp"
+#include "inertialnet/runtime/opencl.hpp"
 
 namespace inertialnet {
 

@@ -22,9 +22,9 @@
 #include <string>
 #include <vector>
 
-#include "inertialnet/device.hpp"
-#include "inertialnet/flow_io.hpp"
-#include "inertialnet/frame_source.hpp"
+#include "inertialnet/runtime/device.hpp"
+#include "inertialnet/io/flow_io.hpp"
+#include "inertialnet/io/frame_source.hpp"
 
 namespace inertialnet {
 

@@ -12,8 +12,8 @@
 #include "inertialnet/models/geometric_head.hpp"
 #include "inertialnet/models/parameters.hpp"
 #include "inertialnet/models/weights.hpp"
-#include "inertialnet/pipeline.hpp"
-#include "inertialnet/vec3.hpp"
+#include "inertialnet/pipeline/pipeline.hpp"
+#include "inertialnet/core/vec3.hpp"
 
 namespace inertialnet {
 

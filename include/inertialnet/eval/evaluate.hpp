@@ -14,11 +14,11 @@
 #include <string>
 #include <vector>
 
-#include "inertialnet/euroc.hpp"
-#include "inertialnet/imu_sync.hpp"
-#include "inertialnet/metrics.hpp"
-#include "inertialnet/plots.hpp"
-#include "inertialnet/rates_csv.hpp"
+#include "inertialnet/io/euroc.hpp"
+#include "inertialnet/eval/imu_sync.hpp"
+#include "inertialnet/eval/metrics.hpp"
+#include "inertialnet/eval/plots.hpp"
+#include "inertialnet/io/rates_csv.hpp"
 
 namespace inertialnet {
 

@@ -1,4 +1,4 @@
-#include "inertialnet/synthetic_sequence.hpp"
+#include "inertialnet/synth/synthetic_sequence.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -13,7 +13,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "inertialnet/error.hpp"
+#include "inertialnet/runtime/error.hpp"
 
 namespace fs = std::filesystem;
 
