@@ -17,6 +17,7 @@
 #include <initializer_list>
 #include <iterator>
 #include <limits>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -440,6 +441,26 @@ TEST_F(SafetensorsTest, CheckWeightsFitRejectsUnreadableDTypes) {
   SafetensorsFile f(write_file("f64.safetensors", h, std::string(8, '\0')));
   expect_invalid_input([&] { check_weights_fit(f, {{"w", {1}}}, "Head"); },
                        {"f64.safetensors do not fit Head", "1 with a dtype other than F32/F16 (w: F64)"});
+}
+
+// The check WeightSet::check uses: only the names the model owns can be unexpected, long lists are
+// cut, and a set holding none of the model's tensors is called another model's.
+TEST(WeightFit, HeldShapesOwnedNamesCutListsAndTheOtherModelHint) {
+  const std::map<std::string, Shape> held = {{"a", {2}}, {"head.x", {1}}, {"stray", {1}}};
+  WeightFitOptions flow_only;
+  flow_only.owns = [](const std::string& name) { return name.rfind("head.", 0) != 0; };
+  EXPECT_NO_THROW(check_weights_fit("weights w", {{"a", {2}}, {"stray", {1}}}, {{"a", {2}}, {"stray", {1}}}, "M",
+                                    flow_only));
+  expect_invalid_input([&] { check_weights_fit("weights w", held, {{"a", {2}}}, "M", flow_only); },
+                       {"weights w do not fit M: 1 unexpected (stray)"});
+
+  std::vector<TensorSpec> many;
+  for (int i = 0; i < 10; ++i) many.push_back({"t" + std::to_string(i), {1}});
+  expect_invalid_input([&] { check_weights_fit("weights w", {}, many, "Big"); },
+                       {"missing 10 tensors (t0, t1, t2, t3, t4, t5, t6, t7, … 2 more)",
+                        "Is this a weight file of another model?"});
+  expect_invalid_input([&] { check_weights_fit("weights w", held, {{"a", {3}}, {"b", {1}}}, "M", flow_only); },
+                       {"missing 1 tensor (b); 1 unexpected (stray); 1 with wrong shape (a: file [2], model [3])"});
 }
 
 // ---- files written by the reference implementation ------------------------------------------------
