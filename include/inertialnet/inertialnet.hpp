@@ -2,6 +2,7 @@
 #pragma once
 
 // core
+#include "inertialnet/core/tensor_spec.hpp"
 #include "inertialnet/core/vec3.hpp"
 
 // runtime
@@ -48,6 +49,8 @@
 #include "inertialnet/io/image_io.hpp"
 #include "inertialnet/io/rates_csv.hpp"
 #include "inertialnet/io/safetensors.hpp"
+#include "inertialnet/io/safetensors_writer.hpp"
+#include "inertialnet/io/weight_fit.hpp"
 
 // synth
 #include "inertialnet/synth/synthetic_sequence.hpp"

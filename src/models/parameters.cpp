@@ -41,6 +41,16 @@ class TableBuilder {
     add(layer, {out, in}, LayerKind::Linear, in, 1.0, true);
   }
 
+  // conv4 … conv6_1, the end of the encoder FlowNetC, -S and -SD share.
+  void flownet_encoder_tail() {
+    conv("conv4", 256, 512, 3);
+    conv("conv4_1", 512, 512, 3);
+    conv("conv5", 512, 512, 3);
+    conv("conv5_1", 512, 512, 3);
+    conv("conv6", 512, 1024, 3);
+    conv("conv6_1", 1024, 1024, 3);
+  }
+
   // The decoder FlowNetC and FlowNetS share (docs/model_spec.md "Decoder").
   void flownet_decoder(bool upsample_bias) {
     deconv("deconv5", 1024, 512);
@@ -115,12 +125,6 @@ const char* to_string(LayerKind kind) {
     case LayerKind::Linear: return "Linear";
   }
   return "?";
-}
-
-int64_t ParameterSpec::numel() const {
-  int64_t n = 1;
-  for (int64_t d : shape) n *= d;
-  return n;
 }
 
 const char* to_string(ModelKind kind) {
@@ -270,12 +274,7 @@ std::vector<ParameterSpec> flownetc_parameters(const std::string& prefix) {
   b.conv("conv3", 128, 256, 5);
   b.conv("conv_redir", 256, 32, 1);
   b.conv("conv3_1", 32 + 441, 256, 3);
-  b.conv("conv4", 256, 512, 3);
-  b.conv("conv4_1", 512, 512, 3);
-  b.conv("conv5", 512, 512, 3);
-  b.conv("conv5_1", 512, 512, 3);
-  b.conv("conv6", 512, 1024, 3);
-  b.conv("conv6_1", 1024, 1024, 3);
+  b.flownet_encoder_tail();
   b.flownet_decoder(/*upsample_bias=*/true);
   return b.take();
 }
@@ -289,12 +288,7 @@ std::vector<ParameterSpec> flownets_parameters(int64_t input_channels, const std
   b.conv("conv2", 64, 128, 5);
   b.conv("conv3", 128, 256, 5);
   b.conv("conv3_1", 256, 256, 3);
-  b.conv("conv4", 256, 512, 3);
-  b.conv("conv4_1", 512, 512, 3);
-  b.conv("conv5", 512, 512, 3);
-  b.conv("conv5_1", 512, 512, 3);
-  b.conv("conv6", 512, 1024, 3);
-  b.conv("conv6_1", 1024, 1024, 3);
+  b.flownet_encoder_tail();
   b.flownet_decoder(/*upsample_bias=*/false);
   return b.take();
 }
@@ -308,12 +302,7 @@ std::vector<ParameterSpec> flownetsd_parameters(const std::string& prefix) {
   b.conv("conv2_1", 128, 128, 3);
   b.conv("conv3", 128, 256, 3);
   b.conv("conv3_1", 256, 256, 3);
-  b.conv("conv4", 256, 512, 3);
-  b.conv("conv4_1", 512, 512, 3);
-  b.conv("conv5", 512, 512, 3);
-  b.conv("conv5_1", 512, 512, 3);
-  b.conv("conv6", 512, 1024, 3);
-  b.conv("conv6_1", 1024, 1024, 3);
+  b.flownet_encoder_tail();
   b.deconv("deconv5", 1024, 512);
   b.deconv("deconv4", 1026, 256);
   b.deconv("deconv3", 770, 128);

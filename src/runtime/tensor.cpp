@@ -1,20 +1,11 @@
 #include "inertialnet/runtime/tensor.hpp"
 
 #include <limits>
-#include <sstream>
 
 #include "inertialnet/runtime/device.hpp"
 #include "inertialnet/runtime/queue.hpp"
 
 namespace inertialnet {
-
-std::string to_string(const Shape& shape) {
-  std::ostringstream out;
-  out << '[';
-  for (std::size_t i = 0; i < shape.size(); ++i) out << (i ? ", " : "") << shape[i];
-  out << ']';
-  return out.str();
-}
 
 std::int64_t element_count(const Shape& shape) {
   std::int64_t count = 1;

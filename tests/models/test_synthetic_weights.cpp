@@ -23,6 +23,7 @@
 
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/io/safetensors.hpp"
+#include "inertialnet/io/weight_fit.hpp"
 #include "support/sha256.hpp"
 
 namespace inertialnet {
@@ -192,9 +193,8 @@ TEST(SyntheticWeights, WholeModelAndWrittenFileAgree) {
   write_synthetic_weights(path, ModelKind::InertialNetHead, 99, head);
   {
     SafetensorsFile file(path);
-    std::vector<ExpectedTensor> expected;
-    for (const auto& s : specs) expected.push_back({s.name, s.shape});
-    EXPECT_NO_THROW(check_tensors_fit(file, expected, "InertialNetHead"));
+    const std::vector<TensorSpec> expected(specs.begin(), specs.end());
+    EXPECT_NO_THROW(check_weights_fit(file, expected, "InertialNetHead"));
     for (std::size_t i = 0; i < specs.size(); ++i) {
       EXPECT_EQ(tensors[i].name, specs[i].name);
       EXPECT_EQ(tensors[i].data, synthetic_tensor(specs[i], 99));

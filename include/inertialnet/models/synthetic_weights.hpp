@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "inertialnet/models/parameters.hpp"
-#include "inertialnet/io/safetensors.hpp"
+#include "inertialnet/io/safetensors_writer.hpp"
 
 namespace inertialnet {
 
