@@ -10,9 +10,7 @@ namespace inertialnet {
 
 namespace {
 
-void check_defined(const Tensor& t, const char* name) {
-  if (!t.defined()) throw invalid_input(std::string("channel norm ") + name + " is an undefined tensor");
-}
+void check_defined(const Tensor& t, const char* name) { detail::require_defined(t, "channel norm", name); }
 
 void check_output(const Tensor& output, const Shape& expected) {
   check_defined(output, "output");
@@ -45,8 +43,7 @@ void channel_norm(Queue& queue, const Tensor& input, const Tensor& output) {
   check_output(output, expected);
   if (output.overlaps(input)) throw invalid_input("channel norm output overlaps its input");
   Kernel& kernel = queue.kernel("channel_norm", "channel_norm");
-  kernel.set_args(input, static_cast<int>(input.batch_stride()), output, static_cast<int>(output.batch_stride()),
-                  static_cast<int>(input.c()), static_cast<int>(input.h() * input.w()));
+  kernel.set_args(input, input.batch_stride(), output, output.batch_stride(), input.c(), input.h() * input.w());
   launch(queue, kernel, output);
 }
 
@@ -70,8 +67,7 @@ void channel_norm_difference(Queue& queue, const Tensor& a, const Tensor& b, con
     throw invalid_input("channel norm output overlaps one of its inputs");
   }
   Kernel& kernel = queue.kernel("channel_norm", "channel_norm_difference");
-  kernel.set_args(a, static_cast<int>(a.batch_stride()), b, static_cast<int>(b.batch_stride()), output,
-                  static_cast<int>(output.batch_stride()), static_cast<int>(a.c()), static_cast<int>(a.h() * a.w()));
+  kernel.set_args(a, a.batch_stride(), b, b.batch_stride(), output, output.batch_stride(), a.c(), a.h() * a.w());
   launch(queue, kernel, output);
 }
 
