@@ -26,10 +26,7 @@ Shape conv_transpose2d_output_shape(const Shape& input, const Shape& weight, int
   }
   detail::require_positive_sizes(input, kOp, "input");
   detail::require_positive_sizes(weight, kOp, "weight");
-  if (stride < 1) throw invalid_input("conv_transpose2d: the stride must be at least 1, got " + std::to_string(stride));
-  if (padding < 0) {
-    throw invalid_input("conv_transpose2d: the padding must not be negative, got " + std::to_string(padding));
-  }
+  detail::require_stride_padding(stride, padding, kOp);
   if (input[1] != weight[0]) {
     throw invalid_input("conv_transpose2d: the input has " + std::to_string(input[1]) + " channels (shape " +
                         to_string(input) + ") but the weight " + to_string(weight) + " expects " +

@@ -62,6 +62,12 @@ inline void require_positive_sizes(const Shape& shape, const std::string& op, co
   }
 }
 
+// A convolution's stride (at least 1) and zero padding (not negative).
+inline void require_stride_padding(int stride, int padding, const std::string& op) {
+  if (stride < 1) throw invalid_input(op + ": the stride must be at least 1, got " + std::to_string(stride));
+  if (padding < 0) throw invalid_input(op + ": the padding must not be negative, got " + std::to_string(padding));
+}
+
 // The parameters of a weighted layer (conv2d, conv_transpose2d, linear): a contiguous weight
 // (the GEMM reads it as one matrix) and a bias of [out_channels] or none.
 inline void require_layer_parameters(const Tensor& weight, const Tensor& bias, std::int64_t out_channels,

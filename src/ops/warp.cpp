@@ -10,7 +10,7 @@ namespace inertialnet {
 
 namespace {
 
-void check_defined(const Tensor& t, const char* name) { detail::require_defined(t, "warp", name); }
+const std::string kOp = "warp";
 
 }  // namespace
 
@@ -31,9 +31,9 @@ Shape warp_output_shape(const Shape& image, const Shape& flow) {
 }
 
 void warp(Queue& queue, const Tensor& image, const Tensor& flow, const Tensor& output) {
-  check_defined(image, "image");
-  check_defined(flow, "flow");
-  check_defined(output, "output");
+  detail::require_defined(image, kOp, "image");
+  detail::require_defined(flow, kOp, "flow");
+  detail::require_defined(output, kOp, "output");
   const Shape expected = warp_output_shape(image.shape(), flow.shape());
   if (output.shape() != expected) {
     throw invalid_input("warp output must have the image's shape " + to_string(expected) + ", got " +
@@ -55,8 +55,8 @@ void warp(Queue& queue, const Tensor& image, const Tensor& flow, const Tensor& o
 }
 
 Tensor warp(Queue& queue, const Tensor& image, const Tensor& flow) {
-  check_defined(image, "image");
-  check_defined(flow, "flow");
+  detail::require_defined(image, kOp, "image");
+  detail::require_defined(flow, kOp, "flow");
   Tensor output = Tensor::empty(queue, warp_output_shape(image.shape(), flow.shape()));
   warp(queue, image, flow, output);
   return output;
