@@ -12,6 +12,7 @@
 #include "inertialnet/runtime/device_info.hpp"
 #include "inertialnet/runtime/device_selection.hpp"
 #include "inertialnet/runtime/error.hpp"
+#include "inertialnet/runtime/kernel_defines.hpp"
 #include "inertialnet/runtime/opencl.hpp"
 #include "inertialnet/runtime/program_cache.hpp"
 #include "inertialnet/runtime/queue.hpp"
@@ -19,6 +20,7 @@
 
 // ops
 #include "inertialnet/ops/activation.hpp"
+#include "inertialnet/ops/bias_activation.hpp"
 #include "inertialnet/ops/channel_norm.hpp"
 #include "inertialnet/ops/concat.hpp"
 #include "inertialnet/ops/conv2d.hpp"

@@ -129,7 +129,7 @@ ProgramHandle ProgramCache::build(const std::string& name, const std::string& so
   const std::size_t length = source.size();
   cl_int status = CL_SUCCESS;
   ProgramHandle program(clCreateProgramWithSource(context_, 1, &text, &length, &status));
-  check_cl(status, "clCreateProgramWithSource", ClSite{device_.name, name});
+  check_cl(status, INERTIALNET_CL_NAME(clCreateProgramWithSource), ClSite{device_.name, name});
   status = clBuildProgram(program.get(), 1, &device_.device_id, options.c_str(), nullptr, nullptr);
   if (status != CL_SUCCESS) {
     const std::string log = build_log(program.get(), device_.device_id);
