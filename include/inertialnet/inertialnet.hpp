@@ -11,6 +11,7 @@
 #include "inertialnet/runtime/device_info.hpp"
 #include "inertialnet/runtime/device_selection.hpp"
 #include "inertialnet/runtime/error.hpp"
+#include "inertialnet/runtime/layer_profiler.hpp"
 #include "inertialnet/runtime/opencl.hpp"
 #include "inertialnet/runtime/program_cache.hpp"
 #include "inertialnet/runtime/queue.hpp"

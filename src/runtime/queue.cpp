@@ -21,6 +21,15 @@ std::uint64_t Event::duration_ns() const {
   return end > start ? end - start : 0;
 }
 
+std::uint64_t Event::end_ns() const {
+  if (!handle_) return 0;
+  wait();
+  cl_ulong end = 0;
+  check_cl(clGetEventProfilingInfo(handle_.get(), CL_PROFILING_COMMAND_END, sizeof end, &end, nullptr),
+           "clGetEventProfilingInfo(CL_PROFILING_COMMAND_END)", ClSite{{}, what_});
+  return end;
+}
+
 void Kernel::set_raw(cl_uint index, std::size_t size, const void* value) {
   const cl_int status = clSetKernelArg(handle_.get(), index, size, value);
   if (status != CL_SUCCESS) {
