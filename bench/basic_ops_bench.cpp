@@ -6,6 +6,7 @@
 
 #include <memory>
 
+#include "bench_support.hpp"
 #include "inertialnet/inertialnet.hpp"
 #include "inertialnet/ops/elementwise.hpp"
 #include "inertialnet/ops/normalize.hpp"
@@ -14,32 +15,12 @@
 namespace {
 
 using namespace inertialnet;
-
-Device& bench_device() {
-  static std::unique_ptr<Device> device = [] {
-    const auto info = select_device(device_spec_or_environment(""), discover_devices());
-    return std::make_unique<Device>(info);
-  }();
-  return *device;
-}
+using namespace inertialnet::bench;
 
 Tensor filled(Device& device, const Shape& shape, float value) {
   Tensor t = Tensor::empty(device, shape);
   fill(device.queue(), t, value);
   return t;
-}
-
-template <class Run>
-void time_it(benchmark::State& state, Device& device, Run&& run, double bytes) {
-  Queue& queue = device.queue();
-  run();  // compile and warm up outside the timed loop
-  queue.finish();
-  for (auto _ : state) {
-    run();
-    queue.finish();
-  }
-  state.counters["GB/s"] = benchmark::Counter(bytes * 1e-9, benchmark::Counter::kIsIterationInvariantRate);
-  state.SetLabel(device.info().name);
 }
 
 void BM_NormalizeFrames(benchmark::State& state) {
@@ -49,7 +30,7 @@ void BM_NormalizeFrames(benchmark::State& state) {
   Tensor out = Tensor::empty(device, {1, 6, h, w});
   const double plane_bytes = static_cast<double>(h * w) * sizeof(float);
   // Reduction reads 6 planes, normalisation reads 6 and writes 6.
-  time_it(state, device, [&] { normalize_frames(device.queue(), f1, f2, out); }, 18 * plane_bytes);
+  time_op(state, device.queue(), [&] { normalize_frames(device.queue(), f1, f2, out); }, 18 * plane_bytes);
 }
 BENCHMARK(BM_NormalizeFrames)
     ->Args({512, 384})
@@ -63,7 +44,7 @@ void BM_FrameChannelMeans(benchmark::State& state) {
   Tensor f1 = filled(device, {1, 3, h, w}, 100.0f), f2 = filled(device, {1, 3, h, w}, 150.0f);
   Tensor means = Tensor::empty(device, {1, 3});
   const double plane_bytes = static_cast<double>(h * w) * sizeof(float);
-  time_it(state, device, [&] { frame_channel_means(device.queue(), f1, f2, means); }, 6 * plane_bytes);
+  time_op(state, device.queue(), [&] { frame_channel_means(device.queue(), f1, f2, means); }, 6 * plane_bytes);
 }
 BENCHMARK(BM_FrameChannelMeans)
     ->Args({512, 384})
@@ -76,7 +57,7 @@ void BM_MaxPool2x2(benchmark::State& state) {
   Tensor in = filled(device, {1, c, h, w}, 1.0f);
   Tensor out = Tensor::empty(device, max_pool_output_shape(in.shape()));
   const double bytes = static_cast<double>(in.numel() + out.numel()) * sizeof(float);
-  time_it(state, device, [&] { max_pool2d(device.queue(), in, out); }, bytes);
+  time_op(state, device.queue(), [&] { max_pool2d(device.queue(), in, out); }, bytes);
 }
 // The head's first pooling on a EuRoC-size flow (conv1: 16 channels at 480×752).
 BENCHMARK(BM_MaxPool2x2)
@@ -89,7 +70,7 @@ void BM_Add(benchmark::State& state) {
   Device& device = bench_device();
   Tensor a = filled(device, {1, c, h, w}, 1.0f), b = filled(device, {1, c, h, w}, 2.0f);
   Tensor out = Tensor::empty(device, {1, c, h, w});
-  time_it(state, device, [&] { add(device.queue(), a, b, out); }, 3.0 * static_cast<double>(a.numel()) * sizeof(float));
+  time_op(state, device.queue(), [&] { add(device.queue(), a, b, out); }, 3.0 * static_cast<double>(a.numel()) * sizeof(float));
 }
 BENCHMARK(BM_Add)
     ->Args({3, 384, 512})
@@ -103,7 +84,7 @@ void BM_AddIntoSlice(benchmark::State& state) {
   Tensor a = filled(device, {3, c, h, w}, 1.0f), b = filled(device, {3, c, h, w}, 2.0f);
   Tensor concat = Tensor::empty(device, {3, 12, h, w});
   const Tensor out = concat.channels(6, c);
-  time_it(state, device, [&] { add(device.queue(), a, b, out); }, 3.0 * static_cast<double>(a.numel()) * sizeof(float));
+  time_op(state, device.queue(), [&] { add(device.queue(), a, b, out); }, 3.0 * static_cast<double>(a.numel()) * sizeof(float));
 }
 BENCHMARK(BM_AddIntoSlice)
     ->Args({3, 384, 512})
@@ -116,7 +97,7 @@ void BM_Copy(benchmark::State& state) {
   Device& device = bench_device();
   Tensor a = filled(device, {1, c, h, w}, 1.0f);
   Tensor out = Tensor::empty(device, {1, c, h, w});
-  time_it(state, device, [&] { copy(device.queue(), a, out); }, 2.0 * static_cast<double>(a.numel()) * sizeof(float));
+  time_op(state, device.queue(), [&] { copy(device.queue(), a, out); }, 2.0 * static_cast<double>(a.numel()) * sizeof(float));
 }
 BENCHMARK(BM_Copy)
     ->Args({3, 384, 512})

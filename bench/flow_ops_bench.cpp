@@ -6,10 +6,10 @@
 #include <benchmark/benchmark.h>
 
 #include <memory>
-#include <random>
 #include <string>
 #include <vector>
 
+#include "bench_support.hpp"
 #include "inertialnet/inertialnet.hpp"
 #include "inertialnet/ops/channel_norm.hpp"
 #include "inertialnet/ops/correlation.hpp"
@@ -19,46 +19,15 @@
 namespace {
 
 using namespace inertialnet;
-
-Device& bench_device() {
-  static std::unique_ptr<Device> device = [] {
-    const auto info = select_device(device_spec_or_environment(""), discover_devices());
-    return std::make_unique<Device>(info);
-  }();
-  return *device;
-}
-
-Tensor random_tensor(Queue& queue, const Shape& shape, float lo, float hi, unsigned seed) {
-  std::mt19937 generator(seed);
-  std::uniform_real_distribution<float> distribution(lo, hi);
-  std::vector<float> data(static_cast<std::size_t>(element_count(shape)));
-  for (auto& v : data) v = distribution(generator);
-  return Tensor::from_host(queue, shape, data);
-}
-
-// Runs `op` once to compile and warm up, then times it with queue.finish() in the loop.
-template <class Op>
-void time_op(benchmark::State& state, Queue& queue, Op&& op, double bytes, double flops = 0) {
-  op();
-  queue.finish();
-  for (auto _ : state) {
-    op();
-    queue.finish();
-  }
-  state.counters["GB/s"] = benchmark::Counter(bytes * 1e-9, benchmark::Counter::kIsIterationInvariantRate);
-  if (flops > 0) {
-    state.counters["GFLOP/s"] = benchmark::Counter(flops * 1e-9, benchmark::Counter::kIsIterationInvariantRate);
-  }
-  state.SetLabel(queue.device().info().name);
-}
+using namespace inertialnet::bench;
 
 // FlowNetC at 512×384: conv3 features 256×48×64; argument: vector width (0 = the op's choice).
 void BM_CorrelationFlowNetC(benchmark::State& state) {
   Device& device = bench_device();
   Queue& queue = device.queue();
   const std::int64_t n = 1, c = 256, h = 48, w = 64;
-  Tensor f1 = random_tensor(queue, {n, c, h, w}, -1, 1, 1);
-  Tensor f2 = random_tensor(queue, {n, c, h, w}, -1, 1, 2);
+  Tensor f1 = random_tensor(queue, {n, c, h, w}, 1, -1, 1);
+  Tensor f2 = random_tensor(queue, {n, c, h, w}, 2, -1, 1);
   CorrelationOptions params = CorrelationOptions::flownetc();
   params.activation = ActivationSpec::leaky_relu(0.1f);  // as FlowNetC runs it
   params.vector_width = static_cast<int>(state.range(0));
@@ -73,8 +42,8 @@ void BM_Warp(benchmark::State& state) {
   Device& device = bench_device();
   Queue& queue = device.queue();
   const std::int64_t n = 1, c = 3, h = 384, w = 512;
-  Tensor image = random_tensor(queue, {n, c, h, w}, 0, 1, 3);
-  Tensor flow = random_tensor(queue, {n, 2, h, w}, -4, 4, 4);
+  Tensor image = random_tensor(queue, {n, c, h, w}, 3, 0, 1);
+  Tensor flow = random_tensor(queue, {n, 2, h, w}, 4, -4, 4);
   Tensor out = Tensor::empty(device, {n, c, h, w});
   time_op(state, queue, [&] { warp(queue, image, flow, out); }, 4.0 * (2.0 * c + 2.0) * h * w);
 }
@@ -84,7 +53,7 @@ void BM_ChannelNorm(benchmark::State& state) {
   Device& device = bench_device();
   Queue& queue = device.queue();
   const std::int64_t n = 1, c = state.range(0), h = 384, w = 512;
-  Tensor in = random_tensor(queue, {n, c, h, w}, -1, 1, 5);
+  Tensor in = random_tensor(queue, {n, c, h, w}, 5, -1, 1);
   Tensor out = Tensor::empty(device, {n, 1, h, w});
   time_op(state, queue, [&] { channel_norm(queue, in, out); }, 4.0 * (c + 1.0) * h * w);
 }
@@ -94,8 +63,8 @@ void BM_ChannelNormDifference(benchmark::State& state) {
   Device& device = bench_device();
   Queue& queue = device.queue();
   const std::int64_t n = 1, c = 3, h = 384, w = 512;
-  Tensor a = random_tensor(queue, {n, c, h, w}, -1, 1, 6);
-  Tensor b = random_tensor(queue, {n, c, h, w}, -1, 1, 7);
+  Tensor a = random_tensor(queue, {n, c, h, w}, 6, -1, 1);
+  Tensor b = random_tensor(queue, {n, c, h, w}, 7, -1, 1);
   Tensor out = Tensor::empty(device, {n, 1, h, w});
   time_op(state, queue, [&] { channel_norm_difference(queue, a, b, out); }, 4.0 * (2.0 * c + 1.0) * h * w);
 }
@@ -106,7 +75,7 @@ void BM_Upsample4(benchmark::State& state) {
   Queue& queue = device.queue();
   const std::int64_t n = 1, c = 2, h = 96, w = 128;
   const Interpolation mode = state.range(0) == 0 ? Interpolation::Bilinear : Interpolation::Nearest;
-  Tensor in = random_tensor(queue, {n, c, h, w}, -1, 1, 8);
+  Tensor in = random_tensor(queue, {n, c, h, w}, 8, -1, 1);
   Tensor out = Tensor::empty(device, upsample_output_shape(in.shape(), 4));
   time_op(state, queue, [&] { resize(queue, in, out, {mode, 20.0f}); }, 4.0 * (c * h * w + static_cast<double>(out.numel())));
   state.SetLabel(std::string(mode == Interpolation::Bilinear ? "bilinear " : "nearest ") + device.info().name);

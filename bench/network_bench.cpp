@@ -7,6 +7,7 @@
 
 #include <memory>
 
+#include "bench_support.hpp"
 #include "inertialnet/inertialnet.hpp"
 #include "inertialnet/models/flownet.hpp"
 #include "inertialnet/models/inertialnet_head.hpp"
@@ -14,12 +15,7 @@
 namespace {
 
 using namespace inertialnet;
-
-Device& bench_device() {
-  static std::unique_ptr<Device> device =
-      std::make_unique<Device>(select_device(device_spec_or_environment(""), discover_devices()));
-  return *device;
-}
+using namespace inertialnet::bench;
 
 void BM_FlowNet(benchmark::State& state, ModelKind kind) {
   const std::int64_t width = state.range(0), height = state.range(1);
@@ -31,14 +27,9 @@ void BM_FlowNet(benchmark::State& state, ModelKind kind) {
   std::vector<float> pixels(static_cast<std::size_t>(3 * width * height));
   for (std::size_t i = 0; i < pixels.size(); ++i) pixels[i] = static_cast<float>((i * 2654435761u) % 256);
   const Tensor frame = Tensor::from_host(queue, {1, 3, height, width}, pixels);
-  net.compute(queue, frame, frame);  // compile and plan outside the timed loop
-  queue.finish();
-  for (auto _ : state) {
-    net.compute(queue, frame, frame);
-    queue.finish();
-  }
+  time_loop(state, queue, [&] { net.compute(queue, frame, frame); });  // compiles and plans outside the loop
   const FlowNetMemory memory = net.memory();
-  state.counters["pairs/s"] = benchmark::Counter(1, benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["pairs/s"] = rate(1, 1);
   state.counters["weight_MB"] = static_cast<double>(memory.weight_bytes) / 1e6;
   state.counters["activation_MB"] = static_cast<double>(memory.activation_bytes) / 1e6;
   state.counters["unplanned_MB"] = static_cast<double>(memory.unplanned_activation_bytes) / 1e6;
@@ -53,13 +44,8 @@ void BM_InertialNetHead(benchmark::State& state) {
   InertialNetHead head(device, weights);
   const Tensor flow = Tensor::from_host(queue, {1, 2, config.input_height, config.input_width},
                                         std::vector<float>(static_cast<std::size_t>(2 * config.input_height * config.input_width), 0.5f));
-  head.compute(queue, flow);
-  queue.finish();
-  for (auto _ : state) {
-    head.compute(queue, flow);
-    queue.finish();
-  }
-  state.counters["pairs/s"] = benchmark::Counter(1, benchmark::Counter::kIsIterationInvariantRate);
+  time_loop(state, queue, [&] { head.compute(queue, flow); });
+  state.counters["pairs/s"] = rate(1, 1);
   state.counters["weight_MB"] = static_cast<double>(weights.bytes()) / 1e6;
 }
 

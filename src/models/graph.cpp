@@ -11,6 +11,7 @@
 #include "inertialnet/ops/linear.hpp"
 #include "inertialnet/ops/normalize.hpp"
 #include "inertialnet/ops/warp.hpp"
+#include "models/layer_description.hpp"
 
 namespace inertialnet::graph {
 
@@ -290,7 +291,9 @@ void Executor::run(Queue& queue, const std::map<std::string, Tensor>& inputs, co
     return found->second;
   };
 
+  LayerProfiler* const profiler = queue.profiler();
   for (const Node& node : graph_.nodes()) {
+    if (profiler) profiler->begin(queue, describe_layer(graph_, node));
     std::vector<Tensor> in;
     for (const ValueId id : node.inputs) in.push_back(resolve(id));
     const Tensor out = resolve(node.output);
@@ -318,6 +321,7 @@ void Executor::run(Queue& queue, const std::map<std::string, Tensor>& inputs, co
       case OpKind::Activation: apply_activation(queue, in[0], out, node.options_as<ActivationSpec>()); break;
       case OpKind::MaxPool: max_pool2d(queue, in[0], out, node.options_as<MaxPool2dOptions>()); break;
     }
+    if (profiler) profiler->end(queue);
     if (stop) {
       queue.finish();
       if (stop->load()) throw runtime_error("cancelled after layer " + node.name);

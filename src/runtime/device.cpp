@@ -36,7 +36,8 @@ Device::Device(const DeviceInfo& info, DeviceOptions options) : info_(info) {
   programs_ = std::make_unique<ProgramCache>(info_, context_.get(), effective_cache_mode(options.program_cache),
                                              std::move(directory));
   buffers_ = std::make_unique<BufferPool>(context_.get(), info_.name, info_.max_alloc_bytes);
-  queue_ = std::make_unique<Queue>(*this, options.profiling);
+  profiler_ = options.profiler;
+  queue_ = create_queue(options.profiling);
   gemm_tuning_ = detail::apply_clblast_tuning(info_);
 }
 
@@ -45,6 +46,10 @@ Device::~Device() {
   if (queue_) clFinish(queue_->handle());
 }
 
-std::unique_ptr<Queue> Device::create_queue(bool profiling) { return std::make_unique<Queue>(*this, profiling); }
+std::unique_ptr<Queue> Device::create_queue(bool profiling) {
+  auto queue = std::make_unique<Queue>(*this, profiling || profiler_ != nullptr);
+  queue->set_profiler(profiler_);
+  return queue;
+}
 
 }  // namespace inertialnet

@@ -13,16 +13,21 @@ void Event::wait() const {
   INERTIALNET_CHECK_CL(site, clWaitForEvents, 1, &event);
 }
 
-std::uint64_t Event::duration_ns() const {
+std::uint64_t Event::profiling_ns(cl_profiling_info which) const {
   if (!handle_) return 0;
   wait();
-  cl_ulong start = 0, end = 0;
+  cl_ulong value = 0;
   const ClSite site{{}, what_};
-  INERTIALNET_CHECK_CL(site, clGetEventProfilingInfo, handle_.get(), CL_PROFILING_COMMAND_START, sizeof start, &start,
-                       nullptr);
-  INERTIALNET_CHECK_CL(site, clGetEventProfilingInfo, handle_.get(), CL_PROFILING_COMMAND_END, sizeof end, &end, nullptr);
+  INERTIALNET_CHECK_CL(site, clGetEventProfilingInfo, handle_.get(), which, sizeof value, &value, nullptr);
+  return value;
+}
+
+std::uint64_t Event::duration_ns() const {
+  const std::uint64_t start = profiling_ns(CL_PROFILING_COMMAND_START), end = profiling_ns(CL_PROFILING_COMMAND_END);
   return end > start ? end - start : 0;
 }
+
+std::uint64_t Event::end_ns() const { return profiling_ns(CL_PROFILING_COMMAND_END); }
 
 cl_int Kernel::narrow(cl_uint index, bool is_signed, long long value, unsigned long long unsigned_value) const {
   const bool fits = is_signed ? value >= std::numeric_limits<cl_int>::min() && value <= std::numeric_limits<cl_int>::max()

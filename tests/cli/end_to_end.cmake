@@ -41,6 +41,10 @@ endif()
 if(NOT EXISTS "${WORK}/pair.png")
   message(FATAL_ERROR "no pair.png")
 endif()
+run(0 ${CLI} flow ${first} ${second} --weights c.safetensors --profile)
+expect_match("profile: FlowNet2-C on ")
+expect_match("conv3_1[.0]* +conv 3×3 s1")
+expect_match("per kind:")
 
 # Rates for every pair, then the paper's metrics on them.
 run(0 ${CLI} predict seq -w c.safetensors -w head.safetensors -o rates.csv --save-flow flows --stats)
@@ -68,6 +72,12 @@ expect_match("\"raw\"")
 if(NOT EXISTS "${WORK}/plot.png" OR NOT EXISTS "${WORK}/plot_hist.png")
   message(FATAL_ERROR "eval --plot wrote no plots")
 endif()
+
+# The per-layer profile of a pipelined run: the network's layers and the head's, per pair.
+run(0 ${CLI} predict seq -w c.safetensors -w head.safetensors -o profiled.csv --max-pairs 2 --profile)
+expect_match("profile: per pair, mean over 2 pairs")
+expect_match("conv3_1[.0]* +conv 3×3 s1")
+expect_match("head.fc1 +linear")
 
 # Bad input: readable message, exit code 2.
 run(2 ${CLI} predict seq --head inertialnet)

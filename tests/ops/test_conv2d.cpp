@@ -6,17 +6,19 @@
 #include <functional>
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include "inertialnet/ops/conv2d.hpp"
 #include "reference/conv.hpp"
 #include "ops/op_testing.hpp"
+#include "support/flownet_layers.hpp"
 #include "support/testing.hpp"
 
 namespace inertialnet {
 namespace {
 
 struct ConvCase {
-  const char* name;
+  std::string name;
   int ci, co, h, w, k, stride, padding;
   bool bias;
   ActivationSpec activation;
@@ -32,15 +34,10 @@ struct Placement {
   std::size_t max_column_floats = 0;
 };
 
-// FlowNet's layer kinds (docs/model_spec.md): conv = k×k, stride s, padding (k−1)/2, bias, LeakyReLU(0.1);
-// iconv = 3×3 stride 1 no activation; pred = 3×3 → 2 channels, no activation.
-ConvCase conv(const char* name, int ci, int co, int size, int k, int s = 1) {
-  return {name, ci, co, size, size, k, s, (k - 1) / 2, true, ActivationSpec::leaky_relu(0.1f)};
+// A FlowNet2 layer of the shared table as a test case.
+ConvCase from_layer(const flownet_layers::LayerShape& l) {
+  return {l.identifier(), l.ci, l.co, l.h, l.w, l.k, l.stride, l.padding, l.bias, l.activation};
 }
-ConvCase iconv(const char* name, int ci, int co, int size) {
-  return {name, ci, co, size, size, 3, 1, 1, true, ActivationSpec::none()};
-}
-ConvCase pred(const char* name, int ci, int size) { return {name, ci, 2, size, size, 3, 1, 1, true, ActivationSpec::none()}; }
 
 void expect_conv_matches(const ConvCase& c, const Placement& p) {
   SCOPED_TRACE(c.name);
@@ -78,35 +75,17 @@ TEST_P(FlowNetConvShapes, MatchTheReference) { expect_conv_matches(GetParam(), P
 
 // Every FlowNet2 convolution at a 64×64 network input (FlowNetC/S/SD at 1/2…1/64 resolution,
 // FlowNetFusion at full, 1/2 and 1/4 resolution).
+std::vector<ConvCase> flownet2_conv_cases() {
+  std::vector<ConvCase> cases;
+  for (const auto& layer : flownet_layers::flownet2_layers(64, 64, flownet_layers::LayerKind::Conv)) {
+    cases.push_back(from_layer(layer));
+  }
+  return cases;
+}
+
 INSTANTIATE_TEST_SUITE_P(
-    FlowNet2, FlowNetConvShapes,
-    ::testing::Values(
-        // FlowNetC
-        conv("flownetc_conv1", 3, 64, 64, 7, 2), conv("flownetc_conv2", 64, 128, 32, 5, 2),
-        conv("flownetc_conv3", 128, 256, 16, 5, 2), conv("flownetc_conv_redir", 256, 32, 8, 1),
-        conv("flownetc_conv3_1", 473, 256, 8, 3), conv("flownetc_conv4", 256, 512, 8, 3, 2),
-        conv("flownetc_conv4_1", 512, 512, 4, 3), conv("flownetc_conv5", 512, 512, 4, 3, 2),
-        conv("flownetc_conv5_1", 512, 512, 2, 3), conv("flownetc_conv6", 512, 1024, 2, 3, 2),
-        conv("flownetc_conv6_1", 1024, 1024, 1, 3), pred("flownetc_predict_flow6", 1024, 1),
-        pred("flownetc_predict_flow5", 1026, 2), pred("flownetc_predict_flow4", 770, 4),
-        pred("flownetc_predict_flow3", 386, 8), pred("flownetc_predict_flow2", 194, 16),
-        // FlowNetS (FlowNet2 feeds it 12 channels; conv2… as FlowNetC's; conv3_1 is 256→256)
-        conv("flownets_conv1", 12, 64, 64, 7, 2), conv("flownets_conv3_1", 256, 256, 8, 3),
-        // FlowNetSD
-        conv("flownetsd_conv0", 6, 64, 64, 3), conv("flownetsd_conv1", 64, 64, 64, 3, 2),
-        conv("flownetsd_conv1_1", 64, 128, 32, 3), conv("flownetsd_conv2", 128, 128, 32, 3, 2),
-        conv("flownetsd_conv2_1", 128, 128, 16, 3), conv("flownetsd_conv3", 128, 256, 16, 3, 2),
-        iconv("flownetsd_inter_conv5", 1026, 512, 2), iconv("flownetsd_inter_conv4", 770, 256, 4),
-        iconv("flownetsd_inter_conv3", 386, 128, 8), iconv("flownetsd_inter_conv2", 194, 64, 16),
-        pred("flownetsd_predict_flow5", 512, 2), pred("flownetsd_predict_flow4", 256, 4),
-        pred("flownetsd_predict_flow3", 128, 8), pred("flownetsd_predict_flow2", 64, 16),
-        // FlowNetFusion
-        conv("fusion_conv0", 11, 64, 64, 3), conv("fusion_conv1", 64, 64, 64, 3, 2),
-        conv("fusion_conv1_1", 64, 128, 32, 3), conv("fusion_conv2", 128, 128, 32, 3, 2),
-        conv("fusion_conv2_1", 128, 128, 16, 3), pred("fusion_predict_flow2", 128, 16),
-        iconv("fusion_inter_conv1", 162, 32, 32), pred("fusion_predict_flow1", 32, 32),
-        iconv("fusion_inter_conv0", 82, 16, 64), pred("fusion_predict_flow0", 16, 64)),
-    [](const ::testing::TestParamInfo<ConvCase>& info) { return std::string(info.param.name); });
+    FlowNet2, FlowNetConvShapes, ::testing::ValuesIn(flownet2_conv_cases()),
+    [](const ::testing::TestParamInfo<ConvCase>& info) { return info.param.name; });
 
 TEST(Conv2d, OddSizesBatchThree) {
   // 37×23 is not a multiple of the work-group width; strides and paddings that leave remainders.

@@ -6,17 +6,19 @@
 #include <functional>
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include "inertialnet/ops/conv_transpose2d.hpp"
 #include "reference/conv.hpp"
 #include "ops/op_testing.hpp"
+#include "support/flownet_layers.hpp"
 #include "support/testing.hpp"
 
 namespace inertialnet {
 namespace {
 
 struct DeconvCase {
-  const char* name;
+  std::string name;
   int ci, co, h, w, k, stride, padding;
   bool bias;
   ActivationSpec activation;
@@ -30,12 +32,10 @@ struct Placement {
   std::size_t max_column_floats = 0;
 };
 
-// docs/model_spec.md: deconv = ConvTranspose2d(4, 2, 1) + bias + LeakyReLU(0.1); up = ConvTranspose2d(2→2,
-// 4, 2, 1) without activation, with a bias in FlowNetC/SD/Fusion and without in FlowNetS.
-DeconvCase deconv(const char* name, int ci, int co, int size) {
-  return {name, ci, co, size, size, 4, 2, 1, true, ActivationSpec::leaky_relu(0.1f)};
+// A FlowNet2 layer of the shared table as a test case.
+DeconvCase from_layer(const flownet_layers::LayerShape& l) {
+  return {l.identifier(), l.ci, l.co, l.h, l.w, l.k, l.stride, l.padding, l.bias, l.activation};
 }
-DeconvCase up(const char* name, int size, bool bias) { return {name, 2, 2, size, size, 4, 2, 1, bias, ActivationSpec::none()}; }
 
 void expect_deconv_matches(const DeconvCase& c, const Placement& p) {
   SCOPED_TRACE(c.name);
@@ -74,16 +74,17 @@ TEST_P(FlowNetDeconvShapes, MatchTheReference) { expect_deconv_matches(GetParam(
 
 // FlowNet2's up-convolutions at a 64×64 network input. FlowNetC, FlowNetS and FlowNetSD share the
 // decoder shapes (FlowNetC: 1/64 → 1/4 resolution); the up layers differ only in their bias.
+std::vector<DeconvCase> flownet2_deconv_cases() {
+  std::vector<DeconvCase> cases;
+  for (const auto& layer : flownet_layers::flownet2_layers(64, 64, flownet_layers::LayerKind::Deconv)) {
+    cases.push_back(from_layer(layer));
+  }
+  return cases;
+}
+
 INSTANTIATE_TEST_SUITE_P(
-    FlowNet2, FlowNetDeconvShapes,
-    ::testing::Values(deconv("flownetc_deconv5", 1024, 512, 1), deconv("flownetc_deconv4", 1026, 256, 2),
-                      deconv("flownetc_deconv3", 770, 128, 4), deconv("flownetc_deconv2", 386, 64, 8),
-                      up("flownetc_upsampled_flow6_to_5", 1, true), up("flownetc_upsampled_flow5_to_4", 2, true),
-                      up("flownetc_upsampled_flow4_to_3", 4, true), up("flownetc_upsampled_flow3_to_2", 8, true),
-                      up("flownets_upsampled_flow6_to_5", 1, false), up("flownets_upsampled_flow3_to_2", 8, false),
-                      deconv("fusion_deconv1", 128, 32, 16), deconv("fusion_deconv0", 162, 16, 32),
-                      up("fusion_upsampled_flow2_to_1", 16, true), up("fusion_upsampled_flow1_to_0", 32, true)),
-    [](const ::testing::TestParamInfo<DeconvCase>& info) { return std::string(info.param.name); });
+    FlowNet2, FlowNetDeconvShapes, ::testing::ValuesIn(flownet2_deconv_cases()),
+    [](const ::testing::TestParamInfo<DeconvCase>& info) { return info.param.name; });
 
 TEST(ConvTranspose2d, OtherKernelsStridesAndPaddingsBatchThree) {
   // 37×23 inputs; kernels smaller than, equal to and larger than the stride; paddings that crop.

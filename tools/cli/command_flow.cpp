@@ -11,6 +11,8 @@
 #include "inertialnet/io/flow_io.hpp"
 #include "inertialnet/io/image_io.hpp"
 #include "inertialnet/models/flownet.hpp"
+#include "inertialnet/runtime/layer_profiler.hpp"
+#include "profile.hpp"
 
 namespace inertialnet::cli {
 
@@ -20,6 +22,7 @@ struct FlowOptions {
   std::vector<std::string> weights;
   std::string model;
   std::string flo, png;
+  bool profile = false;
 };
 
 ModelKind flow_model(const WeightSet& weights, const std::string& requested) {
@@ -40,6 +43,7 @@ Command register_flow(CLI::App& app, const GlobalOptions& global) {
   app.add_option("--model", o->model, "FlowNet2, FlowNet2-C, -S, -SD, -CS or -CSS (default: from the weights)");
   app.add_option("-o,--output", o->flo, "write the flow as Middlebury .flo");
   app.add_option("--png", o->png, "write the flow as a colour-wheel PNG");
+  app.add_flag("--profile", o->profile, "print the device time of every layer (after one warm-up run)");
   return [o, &global]() {
     const HostImage first = load_rgb_image(o->image1);
     const HostImage second = load_rgb_image(o->image2);
@@ -66,6 +70,15 @@ Command register_flow(CLI::App& app, const GlobalOptions& global) {
     std::cout << to_string(net.kind()) << " on " << device->info().name << ": " << first.width << "x" << first.height
               << " flow in " << seconds << " s, mean |flow| " << sum / static_cast<double>(flow.pixel_count())
               << " px, max " << max_flow_magnitude(flow) << " px\n";
+    if (o->profile) {
+      // A second run on a profiling queue: the first one compiled the kernels, whose time is not the layers'.
+      const auto profiling_queue = device->create_queue(true);
+      LayerProfiler profiler;
+      profiling_queue->set_profiler(&profiler);
+      net.compute(*profiling_queue, frame1, frame2);
+      profiling_queue->finish();
+      print_profile(std::string(to_string(net.kind())) + " on " + device->info().name, profiler.collect());
+    }
     if (!o->flo.empty()) write_flo(o->flo, flow);
     if (!o->png.empty()) write_flow_png(o->png, flow);
     if (o->flo.empty() && o->png.empty()) std::cout << "(no output file: add -o out.flo and/or --png out.png)\n";

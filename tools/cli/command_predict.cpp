@@ -10,11 +10,13 @@
 #include "common.hpp"
 #include "inertialnet/runtime/device_selection.hpp"
 #include "inertialnet/runtime/error.hpp"
+#include "inertialnet/runtime/layer_profiler.hpp"
 #include "inertialnet/io/flow_io.hpp"
 #include "inertialnet/io/frame_source.hpp"
 #include "inertialnet/pipeline/pipeline.hpp"
 #include "inertialnet/pipeline/rates_processor.hpp"
 #include "inertialnet/io/rates_csv.hpp"
+#include "profile.hpp"
 #include "progress.hpp"
 
 namespace inertialnet::cli {
@@ -39,6 +41,7 @@ struct PredictOptions {
   int decode_threads = 2;
   std::size_t max_pairs = 0;
   bool stats = false;
+  bool profile = false;
 };
 
 ModelKind flow_model_of(const WeightSet& weights, const std::string& requested) {
@@ -78,6 +81,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
   app.add_option("--decode-threads", o->decode_threads, "image decoding threads")->capture_default_str()->check(CLI::Range(1, 64));
   app.add_option("--max-pairs", o->max_pairs, "stop after this many pairs");
   app.add_flag("--stats", o->stats, "print time per stage and pairs per second");
+  app.add_flag("--profile", o->profile, "print the device time of every network layer per pair (profiling queues)");
   return [o, &global]() {
     const bool have_weights = !o->weights.empty();
     RatesProcessorOptions processor;
@@ -124,6 +128,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
 
     // Devices and their weights (one set per device).
     const auto infos = select_devices(device_spec_or_environment(global.device), discover_devices());
+    LayerProfiler profiler;  // declared before the devices, whose queues report to it
     std::vector<std::unique_ptr<Device>> devices;
     std::vector<std::unique_ptr<WeightSet>> weight_sets;
     std::map<const Device*, const WeightSet*> weights_of;
@@ -131,6 +136,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
     for (const auto& info : infos) {
       DeviceOptions options;
       if (global.no_cache) options.program_cache = DiskCacheMode::Off;
+      if (o->profile) options.profiler = &profiler;
       devices.push_back(std::make_unique<Device>(info, options));
       if (have_weights) {
         weight_sets.push_back(std::make_unique<WeightSet>(WeightSet::load(*devices.back(), o->weights)));
@@ -210,6 +216,18 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
                   << " s per pair\n";
       }
       for (const auto& [device, count] : stats.pairs_per_device) std::cerr << device << ": " << count << " pairs\n";
+    }
+    if (o->profile && stats.pairs > 0) {
+      // Lanes run side by side, so a layer's time includes the other lanes' load on the device;
+      // the first pair of each lane also waits for its kernels to compile.
+      std::vector<LayerTime> per_pair = total_by_layer(profiler.collect());
+      for (auto& l : per_pair) {
+        l.seconds /= static_cast<double>(stats.pairs);
+        l.layer.flops /= static_cast<double>(stats.pairs);
+      }
+      print_profile("per pair, mean over " + std::to_string(stats.pairs) + " pairs and " + std::to_string(o->lanes) +
+                        " lanes in flight per device; the first pairs include compiling",
+                    per_pair);
     }
     if (stats.cancelled) {
       std::cerr << "inertialnet: interrupted after " << stats.pairs << " of " << pairs

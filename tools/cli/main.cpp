@@ -43,6 +43,10 @@ int main(int argc, char** argv) {
     commands[sub] = cli::register_synth(*sub, global);
   }
   {
+    CLI::App* sub = app.add_subcommand("bench", "pairs per second, stage split and per-layer profile (synthetic weights)");
+    commands[sub] = cli::register_bench(*sub, global);
+  }
+  {
     CLI::App* sub = app.add_subcommand("weights", "write synthetic weights, or describe a weight file");
     commands[sub] = cli::register_weights(*sub, global);
   }

@@ -14,12 +14,16 @@
 
 namespace inertialnet {
 
+class LayerProfiler;
 class Queue;
 
 struct DeviceOptions {
   DiskCacheMode program_cache = DiskCacheMode::Auto;  // $INERTIALNET_NO_CACHE forces Off
   std::filesystem::path cache_directory;              // empty: default_cache_directory()
   bool profiling = false;                             // profiling on the default queue
+  // When set, every queue of the device (the default one and those created later) is a
+  // profiling queue reporting its layers to this profiler (not owned; must outlive the device).
+  LayerProfiler* profiler = nullptr;
 };
 
 class Device {
@@ -53,6 +57,7 @@ class Device {
   std::unique_ptr<BufferPool> buffers_;
   std::unique_ptr<Queue> queue_;
   std::string gemm_tuning_;
+  LayerProfiler* profiler_ = nullptr;
 };
 
 }  // namespace inertialnet

@@ -25,6 +25,7 @@
 namespace inertialnet {
 
 class Device;
+class LayerProfiler;
 
 // Up to three work dimensions; unused trailing dimensions are 0.
 struct Range {
@@ -46,8 +47,11 @@ class Event {
   void wait() const;
   // Nanoseconds between start and end of the command (profiling queues only).
   std::uint64_t duration_ns() const;
+  // The device clock when the command ended, in ns (profiling queues only; waits for it).
+  std::uint64_t end_ns() const;
 
  private:
+  std::uint64_t profiling_ns(cl_profiling_info which) const;  // a CL_PROFILING_COMMAND_* time
   EventHandle handle_;
   std::string what_;
 };
@@ -135,12 +139,18 @@ class Queue {
   void flush();
   void finish();
 
+  // The per-layer profiler the graph executor reports to (none by default; not owned). Needs a
+  // profiling queue.
+  void set_profiler(LayerProfiler* profiler) noexcept { profiler_ = profiler; }
+  LayerProfiler* profiler() const noexcept { return profiler_; }
+
  private:
   Device& device_;
   bool profiling_;
   QueueHandle queue_;
   std::unique_ptr<BufferPool> buffers_;
   std::map<std::string, std::unique_ptr<Kernel>> kernels_;
+  LayerProfiler* profiler_ = nullptr;
 };
 
 }  // namespace inertialnet

@@ -1,0 +1,105 @@
+#include "bench_report.hpp"
+
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+namespace inertialnet::cli {
+
+namespace {
+
+std::string fixed(double value, int decimals) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
+  return buffer;
+}
+
+std::string megabytes(std::size_t bytes) { return fixed(static_cast<double>(bytes) / 1e6, 1) + " MB"; }
+
+double profiled_seconds(const std::vector<LayerTime>& layers) {
+  double total = 0;
+  for (const auto& l : layers) total += l.seconds;
+  return total;
+}
+
+}  // namespace
+
+std::string format_bench_text(const BenchResult& r, bool layers) {
+  std::string out;
+  out += r.model + " + InertialNet head at " + std::to_string(r.width) + "x" + std::to_string(r.height) +
+         " (network " + std::to_string(r.network_width) + "x" + std::to_string(r.network_height) + ") on " + r.device +
+         " (" + r.platform + ")\n";
+  out += "synthetic weights: the timing is that of trained weights, the flow is not a measurement\n";
+  out += std::to_string(r.pairs) + " pairs after " + std::to_string(r.warmup_pairs) + " warm-up pair (" +
+         fixed(r.warmup_seconds, 2) + " s, compiling)\n\n";
+  out += "pairs/s            " + fixed(r.pairs_per_second(), 3) + "\n";
+  out += "seconds per pair   " + fixed(r.seconds_per_pair(), 3) + "\n\n";
+  out += "stage        s/pair   share\n";
+  const double total = r.seconds_per_pair();
+  auto stage = [&](const char* name, double seconds) {
+    char row[128];
+    std::snprintf(row, sizeof row, "%-10s %8.4f %6.1f%%\n", name, seconds, total > 0 ? 100 * seconds / total : 0);
+    out += row;
+  };
+  stage("upload", r.upload);
+  stage("flow", r.flow);
+  stage("head", r.head_seconds);
+  stage("download", r.download);
+  out += "\ndevice memory: weights " + megabytes(r.weight_bytes) + " (flow) + " + megabytes(r.head_weight_bytes) +
+         " (head); activations " + megabytes(r.activation_bytes) + " planned (" +
+         megabytes(r.unplanned_activation_bytes) + " with one buffer each)\n\n";
+  out += "per layer kind (one profiled pair, device time " + fixed(profiled_seconds(r.layers), 3) + " s):\n";
+  out += format_kind_table(group_by_kind(r.layers));
+  if (layers) out += "\nper layer:\n" + format_layer_table(r.layers);
+  return out;
+}
+
+std::string format_bench_json(const std::vector<BenchResult>& results) {
+  nlohmann::json doc;
+  doc["schema"] = "inertialnet.bench/1";
+  doc["results"] = nlohmann::json::array();
+  for (const auto& r : results) {
+    nlohmann::json j;
+    j["device"] = r.device;
+    j["platform"] = r.platform;
+    j["model"] = r.model;
+    j["head"] = r.head;
+    j["width"] = r.width;
+    j["height"] = r.height;
+    j["network_width"] = r.network_width;
+    j["network_height"] = r.network_height;
+    j["synthetic_weights"] = r.synthetic_weights;
+    j["pairs"] = r.pairs;
+    j["warmup_pairs"] = r.warmup_pairs;
+    j["warmup_seconds"] = r.warmup_seconds;
+    j["pairs_per_second"] = r.pairs_per_second();
+    j["seconds_per_pair"] = r.seconds_per_pair();
+    j["stages"] = {{"upload", r.upload}, {"flow", r.flow}, {"head", r.head_seconds}, {"download", r.download}};
+    j["memory"] = {{"weight_bytes", r.weight_bytes},
+                   {"head_weight_bytes", r.head_weight_bytes},
+                   {"activation_bytes", r.activation_bytes},
+                   {"unplanned_activation_bytes", r.unplanned_activation_bytes}};
+    const double total = profiled_seconds(r.layers);
+    nlohmann::json kinds = nlohmann::json::array(), layers = nlohmann::json::array();
+    for (const auto& k : group_by_kind(r.layers)) {
+      kinds.push_back({{"kind", k.kind},
+                       {"layers", k.layers},
+                       {"seconds", k.seconds},
+                       {"share", total > 0 ? k.seconds / total : 0},
+                       {"gflops", k.seconds > 0 ? k.flops * 1e-9 / k.seconds : 0},
+                       {"backends", k.backends}});
+    }
+    for (const auto& l : r.layers) {
+      layers.push_back({{"name", l.layer.name},
+                        {"kind", l.layer.kind},
+                        {"seconds", l.seconds},
+                        {"flops", l.layer.flops},
+                        {"gflops", l.seconds > 0 ? l.layer.flops * 1e-9 / l.seconds : 0},
+                        {"backend", l.layer.backend}});
+    }
+    j["profile"] = {{"seconds", total}, {"kinds", kinds}, {"layers", layers}};
+    doc["results"].push_back(std::move(j));
+  }
+  return doc.dump(2) + "\n";
+}
+
+}  // namespace inertialnet::cli

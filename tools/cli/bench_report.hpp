@@ -1,0 +1,56 @@
+// What `inertialnet bench` measured on one device, and its two renderings: a text report and
+// JSON with a stable schema.
+//
+// JSON schema "inertialnet.bench/1" (fields are only ever added under this name; a change of
+// meaning gets a new number):
+//   { "schema": "inertialnet.bench/1",
+//     "results": [ {                        one per device
+//       "device", "platform": string,
+//       "model": "FlowNet2" | "FlowNet2-C" | …,  "head": "inertialnet",
+//       "width", "height": int               the frames; "network_width", "network_height": the
+//                                            size the network runs at (multiples of 64)
+//       "synthetic_weights": true            the weights are the deterministic synthetic ones
+//       "pairs": int                         timed pairs (after "warmup_pairs", which compile)
+//       "warmup_seconds": number             the first (compiling) pair
+//       "pairs_per_second", "seconds_per_pair": number
+//       "stages": { "upload", "flow", "head", "download": seconds per pair }
+//       "memory": { "weight_bytes", "head_weight_bytes", "activation_bytes",
+//                   "unplanned_activation_bytes": int }   device memory of the flow network
+//                                            (planned arena vs one buffer per activation) and
+//                                            of the head's weights
+//       "profile": {                         one more pair on a profiling queue, device time
+//         "seconds": number                  the sum over layers
+//         "kinds": [ { "kind", "layers", "seconds", "share", "gflops", "backends": [string] } ]
+//         "layers": [ { "name", "kind", "seconds", "flops", "gflops", "backend" } ]
+//       } } ] }
+// "backend" is the GEMM backend a layer ran on ("clblast", …; "" for layers without a GEMM).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "inertialnet/runtime/layer_profiler.hpp"
+
+namespace inertialnet::cli {
+
+struct BenchResult {
+  std::string device, platform, model, head = "inertialnet";
+  std::int64_t width = 0, height = 0, network_width = 0, network_height = 0;
+  bool synthetic_weights = true;
+  int pairs = 0, warmup_pairs = 1;
+  double warmup_seconds = 0;
+  double upload = 0, flow = 0, head_seconds = 0, download = 0;  // seconds per pair
+  std::size_t weight_bytes = 0, head_weight_bytes = 0, activation_bytes = 0, unplanned_activation_bytes = 0;
+  std::vector<LayerTime> layers;  // the profiled pair
+
+  double seconds_per_pair() const { return upload + flow + head_seconds + download; }
+  double pairs_per_second() const { return seconds_per_pair() > 0 ? 1.0 / seconds_per_pair() : 0; }
+};
+
+// The report a person reads; with `layers`, the per-layer table too.
+std::string format_bench_text(const BenchResult& result, bool layers);
+// The "inertialnet.bench/1" document for all devices.
+std::string format_bench_json(const std::vector<BenchResult>& results);
+
+}  // namespace inertialnet::cli

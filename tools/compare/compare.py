@@ -1,0 +1,101 @@
+#!/usr/bin/env python3
+"""Seconds per frame pair, ours against PyTorch, interleaved in one run on one machine.
+
+For each round and each model, runs `inertialnet bench --json` (our OpenCL network, its "flow"
+stage: the same work as the PyTorch forward pass) and then torch_bench.py (the repository's PyTorch
+reference in float32, correlation as one batched matrix product) with the same thread count, the
+same frames, the same size and the same synthetic weights; prints the per-round figures, the
+medians and the ratio ours / PyTorch. Needs no torch itself: torch runs in the reference's virtual
+environment (see README.md here for how to create it).
+
+    tools/compare/compare.py [--venv DIR] [--inertialnet build/inertialnet] \
+        [--models FlowNet2,FlowNet2-C] [--size 512x384] [--threads 2] [--pairs 3] [--rounds 2] [--json]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+
+
+def run_json(command: list[str], env: dict) -> dict:
+    done = subprocess.run(command, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    if done.returncode != 0:
+        sys.stderr.write(done.stderr)
+        raise SystemExit(f"compare: {' '.join(command)} failed with exit code {done.returncode}")
+    return json.loads(done.stdout)
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--venv", default=os.environ.get("INERTIALNET_REFERENCE_VENV", os.path.join(ROOT, ".venv-reference")),
+                        help="the reference's virtual environment (env INERTIALNET_REFERENCE_VENV; default .venv-reference)")
+    parser.add_argument("--inertialnet", default=os.path.join(ROOT, "build", "inertialnet"), help="the CLI binary")
+    parser.add_argument("--models", default="FlowNet2,FlowNet2-C")
+    parser.add_argument("--size", default="512x384", help="WIDTHxHEIGHT")
+    parser.add_argument("--threads", type=int, default=os.cpu_count(), help="threads for both (default: all cores)")
+    parser.add_argument("--pairs", type=int, default=3, help="timed pairs per run")
+    parser.add_argument("--rounds", type=int, default=2, help="alternations ours/PyTorch per model")
+    parser.add_argument("--device", default="", help="--device for inertialnet (default: its default)")
+    parser.add_argument("--correlation", choices=("bmm", "shift"), default="bmm", help="PyTorch's correlation")
+    parser.add_argument("--json", action="store_true", help="print the results as JSON")
+    args = parser.parse_args()
+
+    python = os.path.join(args.venv, "bin", "python")
+    if not os.access(python, os.X_OK):
+        raise SystemExit(f"compare: no Python in {args.venv}; create the environment as tools/compare/README.md says")
+    if not os.access(args.inertialnet, os.X_OK):
+        raise SystemExit(f"compare: {args.inertialnet} is not built (cmake --build build --target inertialnet_cli)")
+
+    # The same thread count on both sides: PoCL's pthread device and PyTorch's intra-op pool.
+    env = dict(os.environ, POCL_MAX_PTHREAD_COUNT=str(args.threads), POCL_CPU_MAX_CU_NUM=str(args.threads),
+               OMP_NUM_THREADS=str(args.threads))
+    ours_command = [args.inertialnet, "bench", "--size", args.size, "--pairs", str(args.pairs), "--json"]
+    if args.device:
+        ours_command += ["--device", args.device]
+    torch_command = [python, os.path.join(HERE, "torch_bench.py"), "--size", args.size, "--threads", str(args.threads),
+                     "--pairs", str(args.pairs), "--correlation", args.correlation]
+
+    models = [m for m in args.models.split(",") if m]
+    runs = {m: {"ours": [], "ours_total": [], "torch": []} for m in models}
+    device = torch_version = ""
+    for round_index in range(args.rounds):
+        for model in models:
+            ours = run_json(ours_command + ["--model", model], env)["results"][0]
+            torch_run = run_json(torch_command + ["--model", model], env)
+            device, torch_version = ours["device"], torch_run["torch"]
+            runs[model]["ours"].append(ours["stages"]["flow"])
+            runs[model]["ours_total"].append(ours["seconds_per_pair"])
+            runs[model]["torch"].append(torch_run["seconds_per_pair"])
+            print(f"round {round_index + 1} {model}: ours {ours['stages']['flow']:.3f} s/pair "
+                  f"(with upload, head, download {ours['seconds_per_pair']:.3f}), PyTorch {torch_run['seconds_per_pair']:.3f} s/pair",
+                  file=sys.stderr)
+
+    summary = []
+    for model in models:
+        ours = statistics.median(runs[model]["ours"])
+        theirs = statistics.median(runs[model]["torch"])
+        summary.append({"model": model, "size": args.size, "threads": args.threads, "ours_seconds_per_pair": ours,
+                        "ours_total_seconds_per_pair": statistics.median(runs[model]["ours_total"]),
+                        "torch_seconds_per_pair": theirs, "ratio": ours / theirs, "runs": runs[model]})
+    if args.json:
+        print(json.dumps({"device": device, "torch": torch_version, "correlation": args.correlation,
+                          "results": summary}, indent=2))
+        return 0
+    print(f"{args.size}, {args.threads} threads, float32; ours on {device}, PyTorch {torch_version} "
+          f"(correlation: {args.correlation}); medians of {args.rounds} interleaved rounds of {args.pairs} pairs")
+    print(f"{'model':<14} {'ours s/pair':>12} {'PyTorch s/pair':>15} {'ours/PyTorch':>13}")
+    for s in summary:
+        print(f"{s['model']:<14} {s['ours_seconds_per_pair']:>12.3f} {s['torch_seconds_per_pair']:>15.3f} {s['ratio']:>13.2f}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
