@@ -2,6 +2,8 @@
 #pragma once
 
 // core
+#include "inertialnet/core/constants.hpp"
+#include "inertialnet/core/random.hpp"
 #include "inertialnet/core/vec3.hpp"
 
 // runtime
