@@ -11,15 +11,19 @@
 #include <random>
 #include <sstream>
 
+#include "inertialnet/core/constants.hpp"
+#include "inertialnet/io/camera.hpp"
 #include "inertialnet/models/geometric_head.hpp"
-#include "inertialnet/models/opengv_head.hpp"
+#include "inertialnet/ops/motion_field.hpp"
+#include "models/motion_field_solver.hpp"
+#include "models/opengv_head.hpp"
 #include "reference/motion_field.hpp"
 #include "support/testing.hpp"
 
 namespace inertialnet {
 namespace {
 
-constexpr double kDeg = 3.14159265358979323846 / 180;
+constexpr double kDeg = kPi / 180;
 
 // --- analytic flow fields ------------------------------------------------------------------
 
@@ -124,6 +128,11 @@ Tensor upload(Queue& queue, const FlowField& f) {
   std::vector<float> planes(f.u);
   planes.insert(planes.end(), f.v.begin(), f.v.end());
   return Tensor::from_host(queue, {1, 2, f.height, f.width}, planes);
+}
+
+// The camera's normalised-coordinate map as the motion-field op takes it.
+Tensor upload_map(Queue& queue, const CameraIntrinsics& k, const std::vector<float>& map) {
+  return Tensor::from_host(queue, {1, 2, k.height, k.width}, map);
 }
 
 // Options for 188×120 flow: a quarter of the full-size scales (the same angles).
@@ -265,8 +274,8 @@ double rel(double a, double b, double floor) { return std::fabs(a - b) / (std::f
 TEST(MotionFieldMoments, MatchTheReferenceInEveryModeAndLoss) {
   Queue& queue = testing::test_queue();
   const CameraIntrinsics k = quarter_euroc();
-  GeometricHead head(testing::test_device(), k);
   const std::vector<float> map = normalized_coordinate_map(k);
+  const Tensor map_tensor = upload_map(queue, k, map);
   const FlowField flow = awkward_flow(k, map);
   // The flow as channels 1–2 of a 4-channel tensor, so the kernel must honour the offset.
   std::vector<float> wide(4 * flow.pixel_count(), 7.0f);
@@ -291,7 +300,7 @@ TEST(MotionFieldMoments, MatchTheReferenceInEveryModeAndLoss) {
           p.scale = 0.08;            // ≈0.5 px in normalised image velocity
           p.inlier_threshold = 0.3;  // ≈2 px
           p.stride = stride;
-          const MotionFieldMoments got = head.moments(queue, slice, p);
+          const MotionFieldMoments got = motion_field_moments(queue, slice, map_tensor, p);
           const MotionFieldMoments want = reference::motion_field_moments(flow, map, p);
           // Counts are exact; the sample set must be the same one.
           EXPECT_EQ(got.usable, want.usable);
@@ -328,10 +337,9 @@ TEST(MotionFieldMoments, MatchTheReferenceInEveryModeAndLoss) {
 TEST(MotionFieldMoments, CorrespondencesMatchTheReference) {
   Queue& queue = testing::test_queue();
   const CameraIntrinsics k = quarter_euroc();
-  GeometricHead head(testing::test_device(), k);
   const std::vector<float> map = normalized_coordinate_map(k);
   const FlowField flow = awkward_flow(k, map);
-  const auto got = head.correspondences(queue, upload(queue, flow), 2);
+  const auto got = motion_field_correspondences(queue, upload(queue, flow), upload_map(queue, k, map), 2);
   const auto want = reference::motion_field_correspondences(flow, map, 2);
   ASSERT_EQ(got.size(), want.size());
   double worst = 0;
@@ -469,7 +477,7 @@ TEST(GeometricHead, KernelAndReferenceDriveTheSolverAlike) {
   m.velocity = kVelocities[2];
   const FlowField flow = render(k, map, m);
   const RotationEstimate device = head.estimate(queue, upload(queue, flow), m.dt);
-  const RotationEstimate host = solve_motion_field(
+  const RotationEstimate host = detail::solve_motion_field(
       [&](const MotionFieldParams& p) { return reference::motion_field_moments(flow, map, p); }, m.dt,
       0.5 * (k.fx + k.fy), o);
   EXPECT_TRUE(near_rates(host.omega, m.omega, 1.5));
@@ -540,7 +548,7 @@ TEST(GeometricHead, BadInputIsInvalidInput) {
   o.solver = GeometricSolver::OpenGV;
   head.set_options(o);
   testing::expect_invalid_input([&] { head.estimate(queue, outside, 0.05); }, "at least 10 are needed");
-  testing::expect_invalid_input([&] { solve_opengv({}, 0.05, 100, o); }, "at least 10 are needed");
+  testing::expect_invalid_input([&] { detail::solve_opengv({}, 0.05, 100, o); }, "at least 10 are needed");
 }
 
 }  // namespace
