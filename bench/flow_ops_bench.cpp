@@ -59,7 +59,7 @@ void BM_CorrelationFlowNetC(benchmark::State& state) {
   const std::int64_t n = 1, c = 256, h = 48, w = 64;
   Tensor f1 = random_tensor(queue, {n, c, h, w}, -1, 1, 1);
   Tensor f2 = random_tensor(queue, {n, c, h, w}, -1, 1, 2);
-  CorrelationParams params = CorrelationParams::flownetc();
+  CorrelationOptions params = CorrelationOptions::flownetc();
   params.activation = ActivationSpec::leaky_relu(0.1f);  // as FlowNetC runs it
   params.vector_width = static_cast<int>(state.range(0));
   Tensor out = Tensor::empty(device, correlation_output_shape(f1.shape(), params));
@@ -108,7 +108,7 @@ void BM_Upsample4(benchmark::State& state) {
   const Interpolation mode = state.range(0) == 0 ? Interpolation::Bilinear : Interpolation::Nearest;
   Tensor in = random_tensor(queue, {n, c, h, w}, -1, 1, 8);
   Tensor out = Tensor::empty(device, upsample_output_shape(in.shape(), 4));
-  time_op(state, queue, [&] { resize(queue, in, out, mode, 20.0f); }, 4.0 * (c * h * w + static_cast<double>(out.numel())));
+  time_op(state, queue, [&] { resize(queue, in, out, {mode, 20.0f}); }, 4.0 * (c * h * w + static_cast<double>(out.numel())));
   state.SetLabel(std::string(mode == Interpolation::Bilinear ? "bilinear " : "nearest ") + device.info().name);
 }
 

@@ -1,5 +1,6 @@
 # Embeds kernels_cl/*.cl into the library as C++ raw strings (as CLBlast does with its .opencl
-# files), so the library never reads kernel files at run time.
+# files), so the library never reads kernel files at run time. `#include "common.cl"` in a
+# kernel file is inlined here (OpenCL compilers get no include path for embedded sources).
 #
 # Two roles:
 #  - included from the top-level CMakeLists.txt: defines inertialnet_embed_kernels();
@@ -9,10 +10,43 @@ if(CMAKE_SCRIPT_MODE_FILE)
   # Script mode: OUTPUT=<file.cpp> SOURCES=<a.cl|b.cl|...>
   string(REPLACE "|" ";" SOURCES "${SOURCES}")
   set(_delim "inertialnet_cl")
+  # A kernel file may `#include "<name>.cl"` of another file in the list (common.cl): the line is
+  # replaced by that file's text, so the embedded source, and with it the program cache key, is
+  # the whole program. A file that is included is a header, not a kernel family of its own.
+  set(_headers "")
+  foreach(_src IN LISTS SOURCES)
+    file(READ "${_src}" _text)
+    string(REGEX MATCHALL "#include \"[A-Za-z0-9_]+\\.cl\"" _includes "${_text}")
+    foreach(_include IN LISTS _includes)
+      string(REGEX REPLACE "#include \"([A-Za-z0-9_]+)\\.cl\"" "\\1" _included "${_include}")
+      list(APPEND _headers "${_included}")
+    endforeach()
+  endforeach()
+  list(REMOVE_DUPLICATES _headers)
+  foreach(_header IN LISTS _headers)
+    set(_found "")
+    foreach(_src IN LISTS SOURCES)
+      get_filename_component(_name "${_src}" NAME_WE)
+      if(_name STREQUAL _header)
+        file(READ "${_src}" _header_text_${_header})
+        set(_found TRUE)
+      endif()
+    endforeach()
+    if(NOT _found)
+      message(FATAL_ERROR "a kernel includes ${_header}.cl, which is not among the kernel sources")
+    endif()
+  endforeach()
   set(_body "")
   foreach(_src IN LISTS SOURCES)
     get_filename_component(_name "${_src}" NAME_WE)
+    list(FIND _headers "${_name}" _is_header)
+    if(NOT _is_header EQUAL -1)
+      continue()
+    endif()
     file(READ "${_src}" _text)
+    foreach(_header IN LISTS _headers)
+      string(REPLACE "#include \"${_header}.cl\"" "${_header_text_${_header}}" _text "${_text}")
+    endforeach()
     string(FIND "${_text}" ")${_delim}\"" _clash)
     if(NOT _clash EQUAL -1)
       message(FATAL_ERROR "${_src} contains the raw-string delimiter ')${_delim}\"'")

@@ -3,13 +3,7 @@
 // apart (a channel slice of a wider tensor leaves the elements between its samples alone).
 // Build options: -DHAS_BIAS=0|1, -DACTIVATION (0 none, 1 ReLU, 2 LeakyReLU), -DNEGATIVE_SLOPE.
 
-#if ACTIVATION == 1
-#define ACTIVATE(v) ((v) < 0.0f ? 0.0f : (v))
-#elif ACTIVATION == 2
-#define ACTIVATE(v) ((v) < 0.0f ? (v) * NEGATIVE_SLOPE : (v))
-#else
-#define ACTIVATE(v) (v)
-#endif
+#include "common.cl"
 
 __kernel void bias_activation(__global float* x, const int x_offset, const int batch_stride,
                               const int batch, const int channels, const int plane,

@@ -5,13 +5,7 @@
 // summation order), so the result is deterministic.
 // Build options: -DKH, -DKW, -DSTRIDE, -DPAD, -DHAS_BIAS=0|1, -DACTIVATION, -DNEGATIVE_SLOPE.
 
-#if ACTIVATION == 1
-#define ACTIVATE(v) ((v) < 0.0f ? 0.0f : (v))
-#elif ACTIVATION == 2
-#define ACTIVATE(v) ((v) < 0.0f ? (v) * NEGATIVE_SLOPE : (v))
-#else
-#define ACTIVATE(v) (v)
-#endif
+#include "common.cl"
 
 __kernel void col2im(__global const float* restrict col, const int col_offset,
                      __global float* restrict out, const int out_offset,

@@ -43,14 +43,7 @@ typedef float16 floatv;
 #error "VX must be 1, 4, 8 or 16"
 #endif
 
-// fmax/fmin forms are exact for both scalars and vectors: v ≥ 0 gives v + s·0, v < 0 gives s·v.
-#if ACTIVATION == 1
-#define ACTIVATE(v) fmax(v, (floatv)0.0f)
-#elif ACTIVATION == 2
-#define ACTIVATE(v) (fmax(v, (floatv)0.0f) + NEGATIVE_SLOPE * fmin(v, (floatv)0.0f))
-#else
-#define ACTIVATE(v) (v)
-#endif
+#include "common.cl"
 
 // dst[n, y, c, x] = src[n, c, y − top, x − left], zero outside src; dst is contiguous
 // [N, dst_height, C, dst_width] (rows outermost, so the correlation walks the channels of a

@@ -2,6 +2,8 @@
 // library's convention: (buffer, element offset). Every kernel guards its index, so the host
 // may round the global size up to a multiple of the work-group size.
 
+#include "common.cl"
+
 __kernel void fill(__global float* restrict out, const int out_offset, const int count, const float value) {
   const int i = get_global_id(0);
   if (i >= count) return;
@@ -33,12 +35,6 @@ __kernel void scale(__global float* out, const int out_offset,
 // concatenation has stride > sample; a contiguous call folds the batch into one row (batch 1).
 // Only dimension 0 is rounded up to the work-group size, so only i needs a guard.
 
-#ifndef ACTIVATION
-#define ACTIVATION 0
-#endif
-#ifndef NEGATIVE_SLOPE
-#define NEGATIVE_SLOPE 0.1f
-#endif
 
 __kernel void fill_rows(__global float* restrict out, const int out_offset, const int out_stride,
                         const int sample, const float value) {
@@ -79,7 +75,7 @@ __kernel void copy_rows(__global float* restrict out, const int out_offset, cons
 }
 
 // Standalone activation, built with -DACTIVATION=<1 ReLU | 2 LeakyReLU> -DNEGATIVE_SLOPE=<s>f.
-// The comparisons keep NaN as NaN, like PyTorch.
+// ACTIVATE's comparisons keep NaN as NaN, like PyTorch.
 __kernel void activation_rows(__global float* out, const int out_offset, const int out_stride,
                               __global const float* a, const int a_offset, const int a_stride,
                               const int sample) {
@@ -87,12 +83,5 @@ __kernel void activation_rows(__global float* out, const int out_offset, const i
   if (i >= sample) return;
   const int n = get_global_id(1);
   const float x = a[a_offset + n * a_stride + i];
-#if ACTIVATION == 1
-  const float y = x < 0.0f ? 0.0f : x;
-#elif ACTIVATION == 2
-  const float y = x > 0.0f ? x : x * NEGATIVE_SLOPE;
-#else
-  const float y = x;
-#endif
-  out[out_offset + n * out_stride + i] = y;
+  out[out_offset + n * out_stride + i] = ACTIVATE(x);
 }

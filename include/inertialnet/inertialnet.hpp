@@ -4,6 +4,7 @@
 // core
 #include "inertialnet/core/constants.hpp"
 #include "inertialnet/core/random.hpp"
+#include "inertialnet/core/tensor_spec.hpp"
 #include "inertialnet/core/vec3.hpp"
 
 // runtime
@@ -13,6 +14,7 @@
 #include "inertialnet/runtime/device_info.hpp"
 #include "inertialnet/runtime/device_selection.hpp"
 #include "inertialnet/runtime/error.hpp"
+#include "inertialnet/runtime/kernel_defines.hpp"
 #include "inertialnet/runtime/opencl.hpp"
 #include "inertialnet/runtime/program_cache.hpp"
 #include "inertialnet/runtime/queue.hpp"
@@ -20,6 +22,7 @@
 
 // ops
 #include "inertialnet/ops/activation.hpp"
+#include "inertialnet/ops/bias_activation.hpp"
 #include "inertialnet/ops/channel_norm.hpp"
 #include "inertialnet/ops/concat.hpp"
 #include "inertialnet/ops/conv2d.hpp"
@@ -51,6 +54,8 @@
 #include "inertialnet/io/image_io.hpp"
 #include "inertialnet/io/rates_csv.hpp"
 #include "inertialnet/io/safetensors.hpp"
+#include "inertialnet/io/safetensors_writer.hpp"
+#include "inertialnet/io/weight_fit.hpp"
 
 // synth
 #include "inertialnet/synth/synthetic_sequence.hpp"

@@ -1,13 +1,8 @@
 #include "inertialnet/io/flow_io.hpp"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <array>
-#include <atomic>
-#include <cerrno>
 #include <cmath>
-#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <string>
@@ -18,6 +13,8 @@
 
 #include "inertialnet/core/constants.hpp"
 #include "inertialnet/runtime/error.hpp"
+#include "io/input_file.hpp"
+#include "runtime/atomic_file.hpp"
 
 namespace fs = std::filesystem;
 
@@ -25,12 +22,12 @@ namespace inertialnet {
 
 namespace {
 
+using io_detail::quoted;
+
 constexpr char kFloMagic[4] = {'P', 'I', 'E', 'H'};  // 202021.25f in little-endian bytes
 constexpr std::uint64_t kFloHeaderBytes = 12;
 // Middlebury's own reader refuses more than 99999; beyond this a size is a corrupt header.
 constexpr std::int64_t kMaxFlowDimension = 100000;
-
-std::string quoted(const fs::path& path) { return "\"" + path.string() + "\""; }
 
 // Byte-wise so that the file format stays little-endian on any host.
 std::uint32_t load_le32(const unsigned char* p) {
@@ -64,39 +61,6 @@ std::string printable_bytes(const unsigned char* p, std::size_t n) {
     s += hex[p[i] & 15];
   }
   return s;
-}
-
-[[noreturn]] void throw_io(const std::string& what, const fs::path& path, int err) {
-  const std::string message = "Cannot " + what + " " + quoted(path) + ": " + std::strerror(err) + ".";
-  // Problems the user fixes by choosing another path are bad input; the rest are the machine's.
-  if (err == ENOENT || err == ENOTDIR || err == EACCES || err == EPERM || err == EROFS || err == EISDIR) {
-    throw invalid_input(message);
-  }
-  throw runtime_error(message);
-}
-
-// Writes the whole file under a temporary name beside `path` and renames it into place, so a
-// reader (or a crash) never leaves a half-written file under the final name.
-void write_file_atomically(const fs::path& path, const unsigned char* data, std::size_t size) {
-  static std::atomic<unsigned> counter{0};
-  fs::path temporary = path;
-  temporary += ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
-
-  std::FILE* file = std::fopen(temporary.c_str(), "wb");
-  if (!file) throw_io("create", temporary, errno);
-  const bool written = std::fwrite(data, 1, size, file) == size;
-  const int write_errno = errno;
-  const bool closed = std::fclose(file) == 0;
-  const int close_errno = errno;
-  if (!written || !closed) {
-    std::remove(temporary.c_str());
-    throw_io("write", temporary, written ? close_errno : write_errno);
-  }
-  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
-    const int err = errno;
-    std::remove(temporary.c_str());
-    throw_io("rename a temporary file to", path, err);
-  }
 }
 
 }  // namespace
@@ -140,16 +104,8 @@ void FlowField::validate() const {
 }
 
 FlowField read_flo(const fs::path& path) {
+  std::ifstream in = io_detail::open_input_file(path, "The flow file");
   std::error_code ec;
-  const fs::file_status status = fs::status(path, ec);
-  if (ec && ec != std::errc::no_such_file_or_directory) {
-    throw invalid_input("The flow file " + quoted(path) + " cannot be accessed: " + ec.message() + ".");
-  }
-  if (!fs::exists(status)) throw invalid_input("The flow file " + quoted(path) + " does not exist.");
-  if (!fs::is_regular_file(status)) throw invalid_input("The flow file " + quoted(path) + " is not a regular file.");
-
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw invalid_input("The flow file " + quoted(path) + " cannot be opened for reading.");
   const std::uint64_t file_bytes = fs::file_size(path, ec);
   if (ec) throw invalid_input("The size of the flow file " + quoted(path) + " cannot be read: " + ec.message() + ".");
 

@@ -11,6 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "inertialnet/runtime/error.hpp"
+#include "io/input_file.hpp"
 #include "io/image_mat.hpp"
 
 namespace fs = std::filesystem;
@@ -19,9 +20,9 @@ namespace inertialnet {
 
 namespace {
 
-using Bytes = std::vector<unsigned char>;
+using io_detail::quoted;
 
-std::string quoted(const fs::path& path) { return "\"" + path.string() + "\""; }
+using Bytes = std::vector<unsigned char>;
 
 std::uint32_t load_be32(const unsigned char* p) {
   return static_cast<std::uint32_t>(p[0]) << 24 | static_cast<std::uint32_t>(p[1]) << 16 |
@@ -90,15 +91,7 @@ std::string truncation(const Bytes& bytes) {
 }
 
 Bytes read_whole_file(const fs::path& path) {
-  std::error_code ec;
-  const fs::file_status status = fs::status(path, ec);
-  if (ec && ec != std::errc::no_such_file_or_directory) {
-    throw invalid_input("The image " + quoted(path) + " cannot be accessed: " + ec.message() + ".");
-  }
-  if (!fs::exists(status)) throw invalid_input("The image " + quoted(path) + " does not exist.");
-  if (!fs::is_regular_file(status)) throw invalid_input("The image " + quoted(path) + " is not a regular file.");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw invalid_input("The image " + quoted(path) + " cannot be opened for reading.");
+  std::ifstream in = io_detail::open_input_file(path, "The image");
   Bytes bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (in.bad()) throw invalid_input("The image " + quoted(path) + " could not be read to its end.");
   if (bytes.empty()) throw invalid_input("The image " + quoted(path) + " is empty.");

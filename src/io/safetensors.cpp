@@ -93,17 +93,6 @@ float half_to_float(uint16_t h) {
   return value;
 }
 
-// numel of `shape`, or false when it overflows int64.
-bool checked_numel(const std::vector<int64_t>& shape, int64_t& numel) {
-  numel = 1;
-  for (int64_t dim : shape) {
-    if (dim < 0) return false;
-    if (dim != 0 && numel > std::numeric_limits<int64_t>::max() / dim) return false;
-    numel *= dim;
-  }
-  return true;
-}
-
 // A read-only private mapping of a whole file.
 class MappedFile {
  public:
@@ -160,24 +149,7 @@ class MappedFile {
 
 const char* dtype_name(DType dtype) { return dtype_entry(dtype).name; }
 std::size_t dtype_size(DType dtype) { return dtype_entry(dtype).size; }
-
-int64_t TensorInfo::numel() const {
-  int64_t n = 0;
-  checked_numel(shape, n);
-  return n;
-}
-
-std::string shape_to_string(const std::vector<int64_t>& shape) {
-  std::string out = "[";
-  for (std::size_t i = 0; i < shape.size(); ++i) {
-    if (i > 0) out += ",";
-    out += std::to_string(shape[i]);
-  }
-  return out + "]";
-}
-
-// ---------------------------------------------------------------------------------------------
-// Reader
+bool reads_as_float32(DType dtype) { return dtype == DType::F32 || dtype == DType::F16; }
 
 struct SafetensorsFile::Impl {
   std::string path;
@@ -244,16 +216,15 @@ void SafetensorsFile::Impl::parse_tensor(const std::string& name, const nlohmann
          std::to_string(data_size) + " bytes; the file may be truncated)");
   }
 
-  int64_t numel = 0;
+  const auto numel = checked_numel(info.shape);
   const std::size_t item = dtype_size(info.dtype);
-  if (!checked_numel(info.shape, numel) ||
-      static_cast<uint64_t>(numel) > std::numeric_limits<uint64_t>::max() / item) {
-    fail(where + " has a shape " + shape_to_string(info.shape) + " too large to address");
+  if (!numel || static_cast<uint64_t>(*numel) > std::numeric_limits<uint64_t>::max() / item) {
+    fail(where + " has a shape " + to_string(info.shape) + " too large to address");
   }
-  const uint64_t expected = static_cast<uint64_t>(numel) * item;
+  const uint64_t expected = static_cast<uint64_t>(*numel) * item;
   if (info.data_end - info.data_begin != expected) {
     fail(where + " has data_offsets " + offsets_text + " (" + std::to_string(info.data_end - info.data_begin) +
-         " bytes) but shape " + shape_to_string(info.shape) + " of " + dtype_text + " needs " +
+         " bytes) but shape " + to_string(info.shape) + " of " + dtype_text + " needs " +
          std::to_string(expected) + " bytes");
   }
   tensors.emplace(name, std::move(info));
@@ -386,186 +357,6 @@ std::vector<float> SafetensorsFile::to_float32(const std::string& name) const {
                   "; only F32 and F16 weights can be read as float32 (convert the checkpoint to float32)");
   }
   return out;
-}
-
-// ---------------------------------------------------------------------------------------------
-// Writer
-
-namespace {
-
-[[noreturn]] void throw_io(const std::string& what, const std::string& path, int err) {
-  const std::string message = "cannot " + what + " " + path + ": " + errno_text(err);
-  // Problems the user can fix by choosing another path are bad input, the rest are the machine's.
-  if (err == ENOENT || err == ENOTDIR || err == EACCES || err == EPERM || err == EROFS || err == EISDIR) {
-    throw invalid_input(message);
-  }
-  throw runtime_error(message);
-}
-
-// Owns the temporary file until it is renamed into place; removes it on every other exit.
-class TempFile {
- public:
-  explicit TempFile(std::string final_path) : final_path_(std::move(final_path)) {
-    path_ = final_path_ + ".tmp-" + std::to_string(::getpid());
-    fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (fd_ < 0) throw_io("create", path_, errno);
-  }
-  TempFile(const TempFile&) = delete;
-  TempFile& operator=(const TempFile&) = delete;
-  ~TempFile() {
-    if (fd_ >= 0) ::close(fd_);
-    if (!committed_) ::unlink(path_.c_str());
-  }
-
-  void write(const void* data, std::size_t size) {
-    const char* p = static_cast<const char*>(data);
-    while (size > 0) {
-      const ssize_t n = ::write(fd_, p, size);
-      if (n < 0) {
-        if (errno == EINTR) continue;
-        throw_io("write", path_, errno);
-      }
-      p += n;
-      size -= static_cast<std::size_t>(n);
-    }
-  }
-
-  void commit() {
-    if (::fsync(fd_) != 0) throw_io("flush", path_, errno);
-    const int fd = fd_;
-    fd_ = -1;
-    if (::close(fd) != 0) throw_io("close", path_, errno);
-    if (::rename(path_.c_str(), final_path_.c_str()) != 0) throw_io("rename the temporary file to", final_path_, errno);
-    committed_ = true;
-  }
-
- private:
-  std::string final_path_;
-  std::string path_;
-  int fd_ = -1;
-  bool committed_ = false;
-};
-
-}  // namespace
-
-void write_safetensors(const std::string& path, const std::vector<TensorDeclaration>& tensors,
-                       const TensorProducer& produce, const std::map<std::string, std::string>& metadata) {
-  nlohmann::ordered_json header = nlohmann::ordered_json::object();
-  if (!metadata.empty()) {
-    nlohmann::ordered_json meta = nlohmann::ordered_json::object();
-    for (const auto& kv : metadata) meta[kv.first] = kv.second;
-    header["__metadata__"] = std::move(meta);
-  }
-  std::vector<int64_t> numels;
-  numels.reserve(tensors.size());
-  uint64_t offset = 0;
-  std::set<std::string> seen;
-  for (const auto& t : tensors) {
-    const std::string where = "cannot write " + path + ": tensor '" + t.name + "'";
-    if (t.name.empty()) throw invalid_input("cannot write " + path + ": a tensor has an empty name");
-    if (t.name == "__metadata__") throw invalid_input(where + " uses the reserved name");
-    if (!seen.insert(t.name).second) throw invalid_input(where + " appears twice");
-    int64_t numel = 0;
-    if (!checked_numel(t.shape, numel)) {
-      throw invalid_input(where + " has an invalid shape " + shape_to_string(t.shape));
-    }
-    numels.push_back(numel);
-    const uint64_t end = offset + static_cast<uint64_t>(numel) * sizeof(float);
-    header[t.name] = {{"dtype", "F32"}, {"shape", t.shape}, {"data_offsets", {offset, end}}};
-    offset = end;
-  }
-  std::string text = header.dump();
-  text.append((8 - text.size() % 8) % 8, ' ');
-
-  TempFile file(path);
-  unsigned char length[8];
-  uint64_t n = text.size();
-  for (auto& byte : length) {
-    byte = static_cast<unsigned char>(n & 0xFFu);
-    n >>= 8;
-  }
-  file.write(length, sizeof length);
-  file.write(text.data(), text.size());
-  std::vector<float> buffer;
-  for (std::size_t i = 0; i < tensors.size(); ++i) {
-    if (numels[i] == 0) continue;
-    buffer.assign(static_cast<std::size_t>(numels[i]), 0.0f);
-    produce(i, buffer.data());
-    file.write(buffer.data(), buffer.size() * sizeof(float));
-  }
-  file.commit();
-}
-
-void write_safetensors(const std::string& path, const std::vector<HostTensor>& tensors,
-                       const std::map<std::string, std::string>& metadata) {
-  std::vector<TensorDeclaration> declarations;
-  declarations.reserve(tensors.size());
-  for (const auto& t : tensors) {
-    int64_t numel = 0;
-    if (!checked_numel(t.shape, numel)) {
-      throw invalid_input("cannot write " + path + ": tensor '" + t.name + "' has an invalid shape " +
-                          shape_to_string(t.shape));
-    }
-    if (static_cast<std::size_t>(numel) != t.data.size()) {
-      throw invalid_input("cannot write " + path + ": tensor '" + t.name + "' has shape " + shape_to_string(t.shape) +
-                          " (" + std::to_string(numel) + " elements) but " + std::to_string(t.data.size()) +
-                          " values");
-    }
-    declarations.push_back({t.name, t.shape});
-  }
-  write_safetensors(
-      path, declarations,
-      [&](std::size_t index, float* out) {
-        std::copy(tensors[index].data.begin(), tensors[index].data.end(), out);
-      },
-      metadata);
-}
-
-// ---------------------------------------------------------------------------------------------
-// Model fit
-
-void check_tensors_fit(const SafetensorsFile& file, const std::vector<ExpectedTensor>& expected,
-                       const std::string& model_name) {
-  std::vector<std::string> missing, wrong_shape, wrong_dtype, unexpected;
-  std::set<std::string> expected_names;
-  for (const auto& e : expected) {
-    expected_names.insert(e.name);
-    if (!file.contains(e.name)) {
-      missing.push_back(e.name);
-      continue;
-    }
-    const TensorInfo& info = file.info(e.name);
-    if (info.shape != e.shape) {
-      wrong_shape.push_back(e.name + ": file " + shape_to_string(info.shape) + ", model " + shape_to_string(e.shape));
-    }
-    if (info.dtype != DType::F32 && info.dtype != DType::F16) {
-      wrong_dtype.push_back(e.name + ": " + dtype_name(info.dtype));
-    }
-  }
-  for (const auto& name : file.names()) {
-    if (expected_names.count(name) == 0) unexpected.push_back(name);
-  }
-  if (missing.empty() && wrong_shape.empty() && wrong_dtype.empty() && unexpected.empty()) return;
-
-  auto join = [](const std::vector<std::string>& items) {
-    std::string out;
-    for (const auto& item : items) {
-      if (!out.empty()) out += ", ";
-      out += item;
-    }
-    return out;
-  };
-  auto plural = [](std::size_t n, const char* one, const char* many) {
-    return std::to_string(n) + " " + (n == 1 ? one : many);
-  };
-  std::vector<std::string> parts;
-  if (!missing.empty()) parts.push_back("missing " + plural(missing.size(), "tensor", "tensors") + " (" + join(missing) + ")");
-  if (!unexpected.empty()) parts.push_back(std::to_string(unexpected.size()) + " unexpected (" + join(unexpected) + ")");
-  if (!wrong_shape.empty()) parts.push_back(std::to_string(wrong_shape.size()) + " with wrong shape (" + join(wrong_shape) + ")");
-  if (!wrong_dtype.empty()) {
-    parts.push_back(std::to_string(wrong_dtype.size()) + " with a dtype other than F32/F16 (" + join(wrong_dtype) + ")");
-  }
-  throw invalid_input(file.path() + " does not fit " + model_name + ": " + join(parts));
 }
 
 }  // namespace inertialnet

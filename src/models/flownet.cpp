@@ -36,8 +36,8 @@ void FlowNet::prepare(std::int64_t batch, std::int64_t height, std::int64_t widt
   graph::ValueId f1 = g.input("frame1", frame), f2 = g.input("frame2", frame);
   const bool resized = plan->network_height != height || plan->network_width != width;
   if (resized) {
-    f1 = g.resize("frame1_resize", f1, plan->network_height, plan->network_width, Interpolation::Bilinear, 1.0f);
-    f2 = g.resize("frame2_resize", f2, plan->network_height, plan->network_width, Interpolation::Bilinear, 1.0f);
+    f1 = g.resize("frame1_resize", f1, plan->network_height, plan->network_width, {Interpolation::Bilinear, 1.0f});
+    f2 = g.resize("frame2_resize", f2, plan->network_height, plan->network_width, {Interpolation::Bilinear, 1.0f});
   }
   graph::build_flow_model(g, kind_, f1, f2);
   const graph::ValueId flow = g.outputs().at("flow");

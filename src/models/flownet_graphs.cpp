@@ -14,23 +14,41 @@ const ActivationSpec kLinear = ActivationSpec::none();
 
 std::int64_t channels(const Graph& g, ValueId v) { return g.shape(v)[1]; }
 
+Conv2dOptions convolution(int stride, int padding, ActivationSpec activation) {
+  Conv2dOptions options;
+  options.stride = stride;
+  options.padding = padding;
+  options.activation = activation;
+  return options;
+}
+// FlowNet's up-convolutions are all 4×4, stride 2, padding 1.
+ConvTranspose2dOptions up_convolution(ActivationSpec activation) {
+  ConvTranspose2dOptions options;
+  options.stride = 2;
+  options.padding = 1;
+  options.activation = activation;
+  return options;
+}
+
 // "conv(ci→co, k, s)": Conv2d + LeakyReLU(0.1), padding (k−1)/2, parameters under `L.0`.
 ValueId conv(Graph& g, const std::string& layer, ValueId in, int stride, ValueId into = kNone) {
   const Shape& w = g.parameters().count(layer + ".0.weight") ? g.parameters().at(layer + ".0.weight") : Shape{};
   if (w.size() != 4) throw invalid_input("the network needs parameter '" + layer + ".0.weight', which is missing");
-  return g.conv2d(layer + ".0", in, stride, static_cast<int>((w[2] - 1) / 2), kLeaky, into);
+  return g.conv2d(layer + ".0", in, convolution(stride, static_cast<int>((w[2] - 1) / 2), kLeaky), into);
 }
 // "iconv": 3×3 convolution without activation.
-ValueId iconv(Graph& g, const std::string& layer, ValueId in) { return g.conv2d(layer + ".0", in, 1, 1, kLinear); }
+ValueId iconv(Graph& g, const std::string& layer, ValueId in) {
+  return g.conv2d(layer + ".0", in, convolution(1, 1, kLinear));
+}
 // "deconv": 4×4/2 up-convolution + LeakyReLU.
 ValueId deconv(Graph& g, const std::string& layer, ValueId in, ValueId into) {
-  return g.conv_transpose2d(layer + ".0", in, kLeaky, into);
+  return g.conv_transpose2d(layer + ".0", in, up_convolution(kLeaky), into);
 }
 // "pred": 3×3 convolution to 2 channels, no activation, parameters under `L` itself.
-ValueId pred(Graph& g, const std::string& layer, ValueId in) { return g.conv2d(layer, in, 1, 1, kLinear); }
+ValueId pred(Graph& g, const std::string& layer, ValueId in) { return g.conv2d(layer, in, convolution(1, 1, kLinear)); }
 // "up": 4×4/2 up-convolution of a flow, no activation.
 ValueId up(Graph& g, const std::string& layer, ValueId in, ValueId into) {
-  return g.conv_transpose2d(layer, in, kLinear, into);
+  return g.conv_transpose2d(layer, in, up_convolution(kLinear), into);
 }
 
 // The concatenation [features (c), deconv (d), up-sampled flow (2)] of the decoders, allocated
@@ -124,7 +142,7 @@ ValueId build_flownetc(Graph& g, const std::string& p, ValueId x6) {
   redir_shape[1] = 32 + 441;
   const ValueId in3_1 = g.tensor(p + "concat_corr", redir_shape);
   conv(g, p + "conv_redir", a3, 1, g.slice(in3_1, 0, 32));
-  CorrelationParams corr = CorrelationParams::flownetc();
+  CorrelationOptions corr = CorrelationOptions::flownetc();
   corr.activation = kLeaky;
   g.correlation(p + "corr", a3, b3, corr, g.slice(in3_1, 32, 441));
 
@@ -211,7 +229,7 @@ void build_flow_model(Graph& g, ModelKind kind, ValueId frame1, ValueId frame2) 
   auto standalone = [&](auto build) {
     const ValueId x6 = g.normalize("normalize", frame1, frame2);
     const ValueId flow2 = build(g, "", x6);
-    g.mark_output("flow", g.resize("upsample", flow2, h, w, Interpolation::Bilinear, kDivFlow));
+    g.mark_output("flow", g.resize("upsample", flow2, h, w, {Interpolation::Bilinear, kDivFlow}));
   };
   switch (kind) {
     case ModelKind::FlowNet2C: return standalone(build_flownetc);
@@ -231,7 +249,7 @@ void build_flow_model(Graph& g, ModelKind kind, ValueId frame1, ValueId frame2) 
 
   // Step 2: fC = bilinear×4(flownetc(x6).flow2 · 20).
   const ValueId c_flow2 = build_flownetc(g, "flownetc.", x6);
-  const ValueId f_c = g.resize("flownetc.upsample", c_flow2, h, w, Interpolation::Bilinear, kDivFlow);
+  const ValueId f_c = g.resize("flownetc.upsample", c_flow2, h, w, {Interpolation::Bilinear, kDivFlow});
   g.mark_output("flownetc", f_c);
 
   // Step 3: concat1 = [x6, warp(x2, fC), fC/20, ‖x1 − warp‖] → fS1.
@@ -239,7 +257,7 @@ void build_flow_model(Graph& g, ModelKind kind, ValueId frame1, ValueId frame2) 
   g.scale("flownetc.flow_div", f_c, 1.0f / kDivFlow, g.slice(concat1, 9, 2));
   g.channel_norm_difference("error_c", x1, w_c, g.slice(concat1, 11, 1));
   const ValueId s1_flow2 = build_flownets(g, "flownets_1.", concat1);
-  const ValueId f_s1 = g.resize("flownets_1.upsample", s1_flow2, h, w, Interpolation::Bilinear, kDivFlow);
+  const ValueId f_s1 = g.resize("flownets_1.upsample", s1_flow2, h, w, {Interpolation::Bilinear, kDivFlow});
   g.mark_output("flownets_1", f_s1);
   if (kind == ModelKind::FlowNet2CS) {
     g.mark_output("flow", f_s1);
@@ -254,7 +272,7 @@ void build_flow_model(Graph& g, ModelKind kind, ValueId frame1, ValueId frame2) 
   g.channel_norm_difference("error_s1", x1, w_s1, g.slice(concat2, 11, 1));
   const ValueId s2_flow2 = build_flownets(g, "flownets_2.", concat2);
   if (kind == ModelKind::FlowNet2CSS) {
-    g.mark_output("flownets_2", g.resize("flownets_2.upsample", s2_flow2, h, w, Interpolation::Nearest, kDivFlow));
+    g.mark_output("flownets_2", g.resize("flownets_2.upsample", s2_flow2, h, w, {Interpolation::Nearest, kDivFlow}));
     g.mark_output("flow", g.outputs().at("flownets_2"));
     return;
   }
@@ -264,11 +282,11 @@ void build_flow_model(Graph& g, ModelKind kind, ValueId frame1, ValueId frame2) 
   // with fSD and fS2 up-sampled straight into their slices.
   const ValueId concat3 = g.tensor("concat3", {n, 11, h, w});
   g.copy("x1_copy", x1, g.slice(concat3, 0, 3));
-  const ValueId f_s2 = g.resize("flownets_2.upsample", s2_flow2, h, w, Interpolation::Nearest, kDivFlow,
+  const ValueId f_s2 = g.resize("flownets_2.upsample", s2_flow2, h, w, {Interpolation::Nearest, kDivFlow},
                                 g.slice(concat3, 5, 2));
   const ValueId sd_flow2 = build_flownetsd(g, "flownets_d.", x6);
   // flownet2-pytorch divides fSD by div_flow here where the others multiply (docs/model_spec.md step 5).
-  const ValueId f_sd = g.resize("flownets_d.upsample", sd_flow2, h, w, Interpolation::Nearest, 1.0f / kDivFlow,
+  const ValueId f_sd = g.resize("flownets_d.upsample", sd_flow2, h, w, {Interpolation::Nearest, 1.0f / kDivFlow},
                                 g.slice(concat3, 3, 2));
   g.mark_output("flownets_2", f_s2);
   g.mark_output("flownets_d", f_sd);

@@ -66,147 +66,91 @@ ValueId Graph::output_value(const std::string& name, const Shape& shape, ValueId
   return into;
 }
 
-ValueId Graph::add(Node node) {
+ValueId Graph::add(OpKind kind, const std::string& name, std::vector<ValueId> inputs, const Shape& shape,
+                   ValueId into, NodeOptions options) {
+  Node node;
+  node.kind = kind;
+  node.name = name;
+  node.inputs = std::move(inputs);
+  node.options = std::move(options);
+  node.output = output_value(name, shape, into);
   nodes_.push_back(std::move(node));
   return nodes_.back().output;
 }
 
-ValueId Graph::conv2d(const std::string& layer, ValueId in, int stride, int padding, ActivationSpec act, ValueId into) {
-  Node node;
-  node.kind = OpKind::Conv2d;
-  node.name = layer;
-  node.inputs = {in};
+ValueId Graph::add_layer(OpKind kind, const std::string& layer, ValueId in, const Shape& shape, ValueId into,
+                         NodeOptions options) {
+  const ValueId out = add(kind, layer, {in}, shape, into, std::move(options));
+  Node& node = nodes_.back();
   node.weight = layer + ".weight";
   if (has_parameter(layer + ".bias")) node.bias = layer + ".bias";
-  node.stride = stride;
-  node.padding = padding;
-  node.activation = act;
-  node.output = output_value(layer, conv2d_output_shape(shape(in), parameter(node.weight), stride, padding), into);
-  return add(std::move(node));
+  return out;
 }
 
-ValueId Graph::conv_transpose2d(const std::string& layer, ValueId in, ActivationSpec act, ValueId into) {
-  Node node;
-  node.kind = OpKind::ConvTranspose2d;
-  node.name = layer;
-  node.inputs = {in};
-  node.weight = layer + ".weight";
-  if (has_parameter(layer + ".bias")) node.bias = layer + ".bias";
-  node.stride = 2;  // FlowNet's up-convolutions: 4×4, stride 2, padding 1
-  node.padding = 1;
-  node.activation = act;
-  node.output = output_value(
-      layer, conv_transpose2d_output_shape(shape(in), parameter(node.weight), node.stride, node.padding), into);
-  return add(std::move(node));
+void Graph::require_same_shape(const std::string& name, ValueId a, ValueId b) const {
+  if (shape(a) != shape(b)) {
+    throw invalid_input(name + ": operands differ: " + to_string(shape(a)) + " vs " + to_string(shape(b)));
+  }
+}
+
+ValueId Graph::conv2d(const std::string& layer, ValueId in, const Conv2dOptions& options, ValueId into) {
+  const Shape out = conv2d_output_shape(shape(in), parameter(layer + ".weight"), options.stride, options.padding);
+  return add_layer(OpKind::Conv2d, layer, in, out, into, options);
+}
+
+ValueId Graph::conv_transpose2d(const std::string& layer, ValueId in, const ConvTranspose2dOptions& options,
+                                ValueId into) {
+  const Shape out =
+      conv_transpose2d_output_shape(shape(in), parameter(layer + ".weight"), options.stride, options.padding);
+  return add_layer(OpKind::ConvTranspose2d, layer, in, out, into, options);
 }
 
 ValueId Graph::linear(const std::string& layer, ValueId in, ActivationSpec act, ValueId into) {
-  Node node;
-  node.kind = OpKind::Linear;
-  node.name = layer;
-  node.inputs = {in};
-  node.weight = layer + ".weight";
-  if (has_parameter(layer + ".bias")) node.bias = layer + ".bias";
-  node.activation = act;
-  node.output = output_value(layer, linear_output_shape(shape(in), parameter(node.weight)), into);
-  return add(std::move(node));
+  return add_layer(OpKind::Linear, layer, in, linear_output_shape(shape(in), parameter(layer + ".weight")), into, act);
 }
 
-ValueId Graph::correlation(const std::string& name, ValueId a, ValueId b, const CorrelationParams& params,
+ValueId Graph::correlation(const std::string& name, ValueId a, ValueId b, const CorrelationOptions& options,
                            ValueId into) {
   if (shape(a) != shape(b)) {
     throw invalid_input(name + ": correlation inputs differ: " + to_string(shape(a)) + " vs " + to_string(shape(b)));
   }
-  Node node;
-  node.kind = OpKind::Correlation;
-  node.name = name;
-  node.inputs = {a, b};
-  node.correlation = params;
-  node.output = output_value(name, correlation_output_shape(shape(a), params), into);
-  return add(std::move(node));
+  return add(OpKind::Correlation, name, {a, b}, correlation_output_shape(shape(a), options), into, options);
 }
 
 ValueId Graph::warp(const std::string& name, ValueId image, ValueId flow, ValueId into) {
-  Node node;
-  node.kind = OpKind::Warp;
-  node.name = name;
-  node.inputs = {image, flow};
-  node.output = output_value(name, warp_output_shape(shape(image), shape(flow)), into);
-  return add(std::move(node));
+  return add(OpKind::Warp, name, {image, flow}, warp_output_shape(shape(image), shape(flow)), into);
 }
 
 ValueId Graph::channel_norm(const std::string& name, ValueId in, ValueId into) {
-  Node node;
-  node.kind = OpKind::ChannelNorm;
-  node.name = name;
-  node.inputs = {in};
-  node.output = output_value(name, channel_norm_output_shape(shape(in)), into);
-  return add(std::move(node));
+  return add(OpKind::ChannelNorm, name, {in}, channel_norm_output_shape(shape(in)), into);
 }
 
 ValueId Graph::channel_norm_difference(const std::string& name, ValueId a, ValueId b, ValueId into) {
-  if (shape(a) != shape(b)) {
-    throw invalid_input(name + ": operands differ: " + to_string(shape(a)) + " vs " + to_string(shape(b)));
-  }
-  Node node;
-  node.kind = OpKind::ChannelNormDifference;
-  node.name = name;
-  node.inputs = {a, b};
-  node.output = output_value(name, channel_norm_output_shape(shape(a)), into);
-  return add(std::move(node));
+  require_same_shape(name, a, b);
+  return add(OpKind::ChannelNormDifference, name, {a, b}, channel_norm_output_shape(shape(a)), into);
 }
 
 ValueId Graph::resize(const std::string& name, ValueId in, std::int64_t height, std::int64_t width,
-                      Interpolation mode, float factor, ValueId into) {
-  Node node;
-  node.kind = OpKind::Resize;
-  node.name = name;
-  node.inputs = {in};
-  node.interpolation = mode;
-  node.scale = factor;
-  node.output = output_value(name, with_spatial(shape(in), height, width), into);
-  return add(std::move(node));
+                      const ResizeOptions& options, ValueId into) {
+  return add(OpKind::Resize, name, {in}, with_spatial(shape(in), height, width), into, options);
 }
 
 ValueId Graph::resize_flow(const std::string& name, ValueId flow, std::int64_t height, std::int64_t width,
                            ValueId into) {
-  Node node;
-  node.kind = OpKind::ResizeFlow;
-  node.name = name;
-  node.inputs = {flow};
-  node.output = output_value(name, with_spatial(shape(flow), height, width), into);
-  return add(std::move(node));
+  return add(OpKind::ResizeFlow, name, {flow}, with_spatial(shape(flow), height, width), into);
 }
 
 ValueId Graph::scale(const std::string& name, ValueId in, float factor, ValueId into) {
-  Node node;
-  node.kind = OpKind::Scale;
-  node.name = name;
-  node.inputs = {in};
-  node.scale = factor;
-  node.output = output_value(name, shape(in), into);
-  return add(std::move(node));
+  return add(OpKind::Scale, name, {in}, shape(in), into, factor);
 }
 
 ValueId Graph::sub(const std::string& name, ValueId a, ValueId b, ValueId into) {
-  if (shape(a) != shape(b)) {
-    throw invalid_input(name + ": operands differ: " + to_string(shape(a)) + " vs " + to_string(shape(b)));
-  }
-  Node node;
-  node.kind = OpKind::Sub;
-  node.name = name;
-  node.inputs = {a, b};
-  node.output = output_value(name, shape(a), into);
-  return add(std::move(node));
+  require_same_shape(name, a, b);
+  return add(OpKind::Sub, name, {a, b}, shape(a), into);
 }
 
 ValueId Graph::copy(const std::string& name, ValueId in, ValueId into) {
-  Node node;
-  node.kind = OpKind::Copy;
-  node.name = name;
-  node.inputs = {in};
-  node.output = output_value(name, shape(in), into);
-  return add(std::move(node));
+  return add(OpKind::Copy, name, {in}, shape(in), into);
 }
 
 ValueId Graph::normalize(const std::string& name, ValueId frame1, ValueId frame2, ValueId into) {
@@ -216,32 +160,15 @@ ValueId Graph::normalize(const std::string& name, ValueId frame1, ValueId frame2
   }
   Shape out = shape(frame1);
   out[1] *= 2;
-  Node node;
-  node.kind = OpKind::Normalize;
-  node.name = name;
-  node.inputs = {frame1, frame2};
-  node.output = output_value(name, out, into);
-  return add(std::move(node));
+  return add(OpKind::Normalize, name, {frame1, frame2}, out, into);
 }
 
 ValueId Graph::activation(const std::string& name, ValueId in, ActivationSpec act) {
-  Node node;
-  node.kind = OpKind::Activation;
-  node.name = name;
-  node.inputs = {in};
-  node.activation = act;
-  node.output = in;
-  return add(std::move(node));
+  return add(OpKind::Activation, name, {in}, shape(in), in, act);  // in place
 }
 
-ValueId Graph::max_pool(const std::string& name, ValueId in, const PoolSpec& pool, ValueId into) {
-  Node node;
-  node.kind = OpKind::MaxPool;
-  node.name = name;
-  node.inputs = {in};
-  node.pool = pool;
-  node.output = output_value(name, max_pool_output_shape(shape(in), pool), into);
-  return add(std::move(node));
+ValueId Graph::max_pool(const std::string& name, ValueId in, const MaxPool2dOptions& options, ValueId into) {
+  return add(OpKind::MaxPool, name, {in}, max_pool_output_shape(shape(in), options), into, options);
 }
 
 void Graph::mark_output(const std::string& name, ValueId id) { outputs_[name] = id; }
@@ -368,35 +295,28 @@ void Executor::run(Queue& queue, const std::map<std::string, Tensor>& inputs, co
     for (const ValueId id : node.inputs) in.push_back(resolve(id));
     const Tensor out = resolve(node.output);
     switch (node.kind) {
-      case OpKind::Conv2d: {
-        Conv2dOptions options;
-        options.stride = node.stride;
-        options.padding = node.padding;
-        options.activation = node.activation;
-        conv2d(queue, in[0], param(node.weight), param(node.bias), out, options);
+      case OpKind::Conv2d:
+        conv2d(queue, in[0], param(node.weight), param(node.bias), out, node.options_as<Conv2dOptions>());
         break;
-      }
-      case OpKind::ConvTranspose2d: {
-        ConvTranspose2dOptions options;
-        options.stride = node.stride;
-        options.padding = node.padding;
-        options.activation = node.activation;
-        conv_transpose2d(queue, in[0], param(node.weight), param(node.bias), out, options);
+      case OpKind::ConvTranspose2d:
+        conv_transpose2d(queue, in[0], param(node.weight), param(node.bias), out,
+                         node.options_as<ConvTranspose2dOptions>());
         break;
-      }
-      case OpKind::Linear: linear(queue, in[0], param(node.weight), param(node.bias), out, node.activation); break;
-      case OpKind::Correlation: correlation(queue, in[0], in[1], out, node.correlation); break;
+      case OpKind::Linear:
+        linear(queue, in[0], param(node.weight), param(node.bias), out, node.options_as<ActivationSpec>());
+        break;
+      case OpKind::Correlation: correlation(queue, in[0], in[1], out, node.options_as<CorrelationOptions>()); break;
       case OpKind::Warp: warp(queue, in[0], in[1], out); break;
       case OpKind::ChannelNorm: channel_norm(queue, in[0], out); break;
       case OpKind::ChannelNormDifference: channel_norm_difference(queue, in[0], in[1], out); break;
-      case OpKind::Resize: resize(queue, in[0], out, node.interpolation, node.scale); break;
-      case OpKind::ResizeFlow: resize_flow(queue, in[0], out, node.scale); break;
-      case OpKind::Scale: inertialnet::scale(queue, in[0], node.scale, out); break;
+      case OpKind::Resize: resize(queue, in[0], out, node.options_as<ResizeOptions>()); break;
+      case OpKind::ResizeFlow: resize_flow(queue, in[0], out); break;
+      case OpKind::Scale: inertialnet::scale(queue, in[0], out, node.options_as<float>()); break;
       case OpKind::Sub: inertialnet::sub(queue, in[0], in[1], out); break;
       case OpKind::Copy: inertialnet::copy(queue, in[0], out); break;
       case OpKind::Normalize: normalize_frames(queue, in[0], in[1], out); break;
-      case OpKind::Activation: apply_activation(queue, in[0], out, node.activation); break;
-      case OpKind::MaxPool: max_pool2d(queue, in[0], out, node.pool); break;
+      case OpKind::Activation: apply_activation(queue, in[0], out, node.options_as<ActivationSpec>()); break;
+      case OpKind::MaxPool: max_pool2d(queue, in[0], out, node.options_as<MaxPool2dOptions>()); break;
     }
     if (stop) {
       queue.finish();

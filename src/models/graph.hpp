@@ -13,10 +13,13 @@
 #include <functional>
 #include <map>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "inertialnet/runtime/device.hpp"
 #include "inertialnet/ops/activation.hpp"
+#include "inertialnet/ops/conv2d.hpp"
+#include "inertialnet/ops/conv_transpose2d.hpp"
 #include "inertialnet/ops/correlation.hpp"
 #include "inertialnet/ops/pool.hpp"
 #include "inertialnet/ops/upsample.hpp"
@@ -44,15 +47,21 @@ enum class OpKind {
   Warp,
   ChannelNorm,
   ChannelNormDifference,
-  Resize,      // bilinear or nearest to the output's size, times `scale`
-  ResizeFlow,  // bilinear, vectors rescaled to the new grid, times `scale`
-  Scale,
+  Resize,      // bilinear or nearest to the output's size (ResizeOptions)
+  ResizeFlow,  // bilinear, vectors rescaled to the new grid
+  Scale,       // times a float factor
   Sub,
   Copy,
   Normalize,   // FlowNet2 step 1: two frames → x6
   Activation,
   MaxPool,
 };
+
+// A node's options are the op's own option struct, passed to the op as they are: Conv2dOptions,
+// ConvTranspose2dOptions, CorrelationOptions, ResizeOptions, MaxPool2dOptions; ActivationSpec for
+// Linear and Activation; the factor (float) for Scale; nothing (monostate) for the others.
+using NodeOptions = std::variant<std::monostate, Conv2dOptions, ConvTranspose2dOptions, CorrelationOptions,
+                                 ResizeOptions, MaxPool2dOptions, ActivationSpec, float>;
 
 struct Node {
   OpKind kind = OpKind::Copy;
@@ -61,13 +70,12 @@ struct Node {
   ValueId output = kNone;
   std::string weight;  // parameter names (empty when the op has none)
   std::string bias;
-  int stride = 1;
-  int padding = 0;
-  ActivationSpec activation{};
-  float scale = 1.0f;
-  Interpolation interpolation = Interpolation::Bilinear;
-  CorrelationParams correlation{};
-  PoolSpec pool{};
+  NodeOptions options;
+
+  template <class T>
+  const T& options_as() const {
+    return std::get<T>(options);
+  }
 };
 
 // Parameter shapes by name: what the builder needs to infer output shapes and to know whether
@@ -89,17 +97,17 @@ class Graph {
 
   // Layers read their parameters as `<layer>.weight` and, when present, `<layer>.bias`. Each
   // op writes a new value, or `into` (a slice of a concatenation) when given.
-  ValueId conv2d(const std::string& layer, ValueId input, int stride, int padding, ActivationSpec activation,
-                 ValueId into = kNone);
-  ValueId conv_transpose2d(const std::string& layer, ValueId input, ActivationSpec activation, ValueId into = kNone);
+  ValueId conv2d(const std::string& layer, ValueId input, const Conv2dOptions& options, ValueId into = kNone);
+  ValueId conv_transpose2d(const std::string& layer, ValueId input, const ConvTranspose2dOptions& options,
+                           ValueId into = kNone);
   ValueId linear(const std::string& layer, ValueId input, ActivationSpec activation, ValueId into = kNone);
-  ValueId correlation(const std::string& name, ValueId a, ValueId b, const CorrelationParams& params,
+  ValueId correlation(const std::string& name, ValueId a, ValueId b, const CorrelationOptions& options,
                       ValueId into = kNone);
   ValueId warp(const std::string& name, ValueId image, ValueId flow, ValueId into = kNone);
   ValueId channel_norm(const std::string& name, ValueId input, ValueId into = kNone);
   ValueId channel_norm_difference(const std::string& name, ValueId a, ValueId b, ValueId into = kNone);
   ValueId resize(const std::string& name, ValueId input, std::int64_t height, std::int64_t width,
-                 Interpolation mode, float scale, ValueId into = kNone);
+                 const ResizeOptions& options, ValueId into = kNone);
   ValueId resize_flow(const std::string& name, ValueId flow, std::int64_t height, std::int64_t width,
                       ValueId into = kNone);
   ValueId scale(const std::string& name, ValueId input, float factor, ValueId into = kNone);
@@ -107,7 +115,7 @@ class Graph {
   ValueId copy(const std::string& name, ValueId input, ValueId into);
   ValueId normalize(const std::string& name, ValueId frame1, ValueId frame2, ValueId into = kNone);
   ValueId activation(const std::string& name, ValueId input, ActivationSpec activation);  // in place
-  ValueId max_pool(const std::string& name, ValueId input, const PoolSpec& pool, ValueId into = kNone);
+  ValueId max_pool(const std::string& name, ValueId input, const MaxPool2dOptions& options, ValueId into = kNone);
 
   // Values the caller reads after run(): they live to the end of the graph.
   void mark_output(const std::string& name, ValueId value);
@@ -121,7 +129,14 @@ class Graph {
   bool has_parameter(const std::string& name) const { return parameters_.count(name) != 0; }
   // The value an op writes: `into` after checking its shape, else a new one.
   ValueId output_value(const std::string& name, const Shape& shape, ValueId into);
-  ValueId add(Node node);
+  // Appends the node of `kind` writing `shape` (into `into` when given); returns its output.
+  ValueId add(OpKind kind, const std::string& name, std::vector<ValueId> inputs, const Shape& shape, ValueId into,
+              NodeOptions options = {});
+  // The same for a layer with parameters `<layer>.weight` and, when present, `<layer>.bias`.
+  ValueId add_layer(OpKind kind, const std::string& layer, ValueId input, const Shape& shape, ValueId into,
+                    NodeOptions options);
+  // Refuses a binary op whose operands differ in shape.
+  void require_same_shape(const std::string& name, ValueId a, ValueId b) const;
 
   ParameterShapes parameters_;
   std::vector<Value> values_;

@@ -49,12 +49,19 @@ Tensor InertialNetHead::compute(Queue& queue, const Tensor& flow, const std::ato
     graph::ValueId x = g.input("flow", flow.shape());
     if (config_.flow_scale != 1.0) x = g.scale("head.flow_scale", x, static_cast<float>(config_.flow_scale));
     const auto relu = ActivationSpec::relu();
-    const PoolSpec pool{static_cast<int>(config_.pool), static_cast<int>(config_.pool)};
-    x = g.conv2d("head.conv1", x, 1, static_cast<int>((config_.conv1_kernel - 1) / 2), relu);
+    // Stride 1, padding (k − 1)/2: the head's convolutions keep the spatial size.
+    auto same_size = [&](std::int64_t kernel) {
+      Conv2dOptions options;
+      options.padding = static_cast<int>((kernel - 1) / 2);
+      options.activation = relu;
+      return options;
+    };
+    const MaxPool2dOptions pool{static_cast<int>(config_.pool), static_cast<int>(config_.pool)};
+    x = g.conv2d("head.conv1", x, same_size(config_.conv1_kernel));
     x = g.max_pool("head.pool1", x, pool);
-    x = g.conv2d("head.conv2", x, 1, static_cast<int>((config_.conv2_kernel - 1) / 2), relu);
+    x = g.conv2d("head.conv2", x, same_size(config_.conv2_kernel));
     x = g.max_pool("head.pool2", x, pool);
-    x = g.conv2d("head.conv3", x, 1, static_cast<int>((config_.conv3_kernel - 1) / 2), relu);
+    x = g.conv2d("head.conv3", x, same_size(config_.conv3_kernel));
     g.mark_output("features", x);
     // Dropout is the identity at inference; fc1 flattens NCHW as torch.flatten(x, 1) does.
     x = g.linear("head.fc1", x, relu);

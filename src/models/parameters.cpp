@@ -25,7 +25,7 @@ class TableBuilder {
   void deconv(const std::string& layer, int64_t ci, int64_t co) {
     add(layer + ".0", {ci, co, 4, 4}, LayerKind::ConvTranspose2d, transposed_fan_in(ci), 1.0, true);
   }
-  // predict_flow: a bare Conv2d(ci -> 2, 3x3) -> "L.weight", "L.bias". Small gain (docs/model_spec.md).
+  // predict_flow: a bare Conv2d(ci -> 2, 3x3) -> "L.weight", "L.bias". Flow gain (docs/model_spec.md).
   void predict(const std::string& layer, int64_t ci) {
     add(layer, {2, ci, 3, 3}, LayerKind::Conv2d, ci * 9, kFlowGain, true);
   }
@@ -39,6 +39,16 @@ class TableBuilder {
   }
   void linear(const std::string& layer, int64_t in, int64_t out) {
     add(layer, {out, in}, LayerKind::Linear, in, 1.0, true);
+  }
+
+  // conv4 … conv6_1, the end of the encoder FlowNetC, -S and -SD share.
+  void flownet_encoder_tail() {
+    conv("conv4", 256, 512, 3);
+    conv("conv4_1", 512, 512, 3);
+    conv("conv5", 512, 512, 3);
+    conv("conv5_1", 512, 512, 3);
+    conv("conv6", 512, 1024, 3);
+    conv("conv6_1", 1024, 1024, 3);
   }
 
   // The decoder FlowNetC and FlowNetS share (docs/model_spec.md "Decoder").
@@ -61,7 +71,10 @@ class TableBuilder {
   std::vector<ParameterSpec> take() { return std::move(specs_); }
 
  private:
-  static constexpr double kFlowGain = 0.1;
+  // The flow-predicting layers' gain. 0.1 (the first choice) made the whole FlowNet2 output
+  // ≈ 0.1 px of flow at 128×96, too little to exercise warps and image borders; at 0.7 the
+  // fixture pair gets a mean |flow| of ≈ 6 px and a maximum of ≈ 19 px (docs/model_spec.md).
+  static constexpr double kFlowGain = 0.7;
 
   // A stride-2 transposed convolution with a 4x4 kernel: each output sees ci·16/4 inputs.
   static int64_t transposed_fan_in(int64_t ci) { return ci * 16 / 4; }
@@ -112,12 +125,6 @@ const char* to_string(LayerKind kind) {
     case LayerKind::Linear: return "Linear";
   }
   return "?";
-}
-
-int64_t ParameterSpec::numel() const {
-  int64_t n = 1;
-  for (int64_t d : shape) n *= d;
-  return n;
 }
 
 const char* to_string(ModelKind kind) {
@@ -267,12 +274,7 @@ std::vector<ParameterSpec> flownetc_parameters(const std::string& prefix) {
   b.conv("conv3", 128, 256, 5);
   b.conv("conv_redir", 256, 32, 1);
   b.conv("conv3_1", 32 + 441, 256, 3);
-  b.conv("conv4", 256, 512, 3);
-  b.conv("conv4_1", 512, 512, 3);
-  b.conv("conv5", 512, 512, 3);
-  b.conv("conv5_1", 512, 512, 3);
-  b.conv("conv6", 512, 1024, 3);
-  b.conv("conv6_1", 1024, 1024, 3);
+  b.flownet_encoder_tail();
   b.flownet_decoder(/*upsample_bias=*/true);
   return b.take();
 }
@@ -286,12 +288,7 @@ std::vector<ParameterSpec> flownets_parameters(int64_t input_channels, const std
   b.conv("conv2", 64, 128, 5);
   b.conv("conv3", 128, 256, 5);
   b.conv("conv3_1", 256, 256, 3);
-  b.conv("conv4", 256, 512, 3);
-  b.conv("conv4_1", 512, 512, 3);
-  b.conv("conv5", 512, 512, 3);
-  b.conv("conv5_1", 512, 512, 3);
-  b.conv("conv6", 512, 1024, 3);
-  b.conv("conv6_1", 1024, 1024, 3);
+  b.flownet_encoder_tail();
   b.flownet_decoder(/*upsample_bias=*/false);
   return b.take();
 }
@@ -305,12 +302,7 @@ std::vector<ParameterSpec> flownetsd_parameters(const std::string& prefix) {
   b.conv("conv2_1", 128, 128, 3);
   b.conv("conv3", 128, 256, 3);
   b.conv("conv3_1", 256, 256, 3);
-  b.conv("conv4", 256, 512, 3);
-  b.conv("conv4_1", 512, 512, 3);
-  b.conv("conv5", 512, 512, 3);
-  b.conv("conv5_1", 512, 512, 3);
-  b.conv("conv6", 512, 1024, 3);
-  b.conv("conv6_1", 1024, 1024, 3);
+  b.flownet_encoder_tail();
   b.deconv("deconv5", 1024, 512);
   b.deconv("deconv4", 1026, 256);
   b.deconv("deconv3", 770, 128);

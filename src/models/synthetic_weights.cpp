@@ -67,11 +67,8 @@ std::map<std::string, std::string> synthetic_metadata(ModelKind kind, uint64_t s
 
 void write_synthetic_weights(const std::string& path, ModelKind kind, uint64_t seed, const HeadConfig& head) {
   const std::vector<ParameterSpec> specs = model_parameters(kind, head);
-  std::vector<TensorDeclaration> declarations;
-  declarations.reserve(specs.size());
-  for (const auto& spec : specs) declarations.push_back({spec.name, spec.shape});
   write_safetensors(
-      path, declarations, [&](std::size_t index, float* out) { fill_synthetic_tensor(specs[index], seed, out); },
+      path, std::vector<TensorSpec>(specs.begin(), specs.end()), [&](std::size_t index, float* out) { fill_synthetic_tensor(specs[index], seed, out); },
       synthetic_metadata(kind, seed, head));
 }
 

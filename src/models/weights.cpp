@@ -1,24 +1,16 @@
 #include "inertialnet/models/weights.hpp"
 
 #include <filesystem>
-#include <set>
-#include <sstream>
 
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/models/synthetic_weights.hpp"
 #include "inertialnet/runtime/queue.hpp"
 #include "inertialnet/io/safetensors.hpp"
+#include "inertialnet/io/weight_fit.hpp"
 
 namespace inertialnet {
 
 namespace {
-
-std::string list(const std::vector<std::string>& items, std::size_t most = 8) {
-  std::ostringstream out;
-  for (std::size_t i = 0; i < items.size() && i < most; ++i) out << (i ? ", " : "") << items[i];
-  if (items.size() > most) out << ", … " << items.size() - most << " more";
-  return out.str();
-}
 
 bool is_head_name(const std::string& name) { return name.rfind("head.", 0) == 0; }
 
@@ -64,8 +56,7 @@ WeightSet WeightSet::load(Device& device, const std::vector<std::string>& paths)
       set.has_head_config_ = true;
     }
     for (const auto& name : file.names()) {
-      const auto& shape = file.shape(name);
-      set.add(device, name, Shape(shape.begin(), shape.end()), file.to_float32(name), source);
+      set.add(device, name, file.shape(name), file.to_float32(name), source);
     }
   }
   device.queue().finish();
@@ -86,7 +77,7 @@ WeightSet WeightSet::synthetic(Device& device, ModelKind kind, std::uint64_t see
   for (const auto& spec : model_parameters(kind, head)) {
     data.resize(static_cast<std::size_t>(spec.numel()));
     fill_synthetic_tensor(spec, seed, data.data());
-    set.add(device, spec.name, Shape(spec.shape.begin(), spec.shape.end()), data, source);
+    set.add(device, spec.name, spec.shape, data, source);
   }
   device.queue().finish();
   return set;
@@ -100,38 +91,10 @@ const Tensor& WeightSet::get(const std::string& name) const {
 
 void WeightSet::check(const std::string& model, const std::vector<ParameterSpec>& parameters) const {
   const bool head_model = !parameters.empty() && is_head_name(parameters.front().name);
-  std::vector<std::string> missing, mismatched, unexpected;
-  std::set<std::string> expected;
-  for (const auto& spec : parameters) {
-    expected.insert(spec.name);
-    const auto found = shapes_.find(spec.name);
-    const Shape want(spec.shape.begin(), spec.shape.end());
-    if (found == shapes_.end()) {
-      missing.push_back(spec.name);
-    } else if (found->second != want) {
-      mismatched.push_back(spec.name + ": file " + to_string(found->second) + ", model " + to_string(want));
-    }
-  }
-  for (const auto& [name, shape] : shapes_) {
-    if (is_head_name(name) == head_model && !expected.count(name)) unexpected.push_back(name);
-  }
-  if (missing.empty() && mismatched.empty() && unexpected.empty()) return;
-  std::ostringstream message;
-  message << "weights " << sources() << " do not fit " << model << ":";
-  const char* separator = " ";
-  if (!missing.empty()) {
-    message << separator << "missing " << missing.size() << " tensors (" << list(missing) << ")";
-    separator = "; ";
-  }
-  if (!unexpected.empty()) {
-    message << separator << unexpected.size() << " unexpected (" << list(unexpected) << ")";
-    separator = "; ";
-  }
-  if (!mismatched.empty()) message << separator << mismatched.size() << " with wrong shape (" << list(mismatched) << ")";
-  if (missing.size() == parameters.size()) {
-    message << ". Is this a weight file of another model? Convert checkpoints with tools/convert_checkpoint.py";
-  }
-  throw invalid_input(message.str());
+  WeightFitOptions options;
+  options.owns = [head_model](const std::string& name) { return is_head_name(name) == head_model; };
+  check_weights_fit("weights " + sources(), shapes_, std::vector<TensorSpec>(parameters.begin(), parameters.end()),
+                    model, options);
 }
 
 std::string WeightSet::sources() const {

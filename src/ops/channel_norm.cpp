@@ -10,12 +10,10 @@ namespace inertialnet {
 
 namespace {
 
-void check_defined(const Tensor& t, const char* name) {
-  if (!t.defined()) throw invalid_input(std::string("channel norm ") + name + " is an undefined tensor");
-}
+const std::string kOp = "channel norm";
 
 void check_output(const Tensor& output, const Shape& expected) {
-  check_defined(output, "output");
+  detail::require_defined(output, kOp, "output");
   if (output.shape() != expected) {
     throw invalid_input("channel norm output must have shape " + to_string(expected) + ", got " +
                         to_string(output.shape()));
@@ -40,26 +38,25 @@ Shape channel_norm_output_shape(const Shape& input) {
 }
 
 void channel_norm(Queue& queue, const Tensor& input, const Tensor& output) {
-  check_defined(input, "input");
+  detail::require_defined(input, kOp, "input");
   const Shape expected = channel_norm_output_shape(input.shape());
   check_output(output, expected);
   if (output.overlaps(input)) throw invalid_input("channel norm output overlaps its input");
   Kernel& kernel = queue.kernel("channel_norm", "channel_norm");
-  kernel.set_args(input, static_cast<int>(input.batch_stride()), output, static_cast<int>(output.batch_stride()),
-                  static_cast<int>(input.c()), static_cast<int>(input.h() * input.w()));
+  kernel.set_args(input, input.batch_stride(), output, output.batch_stride(), input.c(), input.h() * input.w());
   launch(queue, kernel, output);
 }
 
 Tensor channel_norm(Queue& queue, const Tensor& input) {
-  check_defined(input, "input");
+  detail::require_defined(input, kOp, "input");
   Tensor output = Tensor::empty(queue, channel_norm_output_shape(input.shape()));
   channel_norm(queue, input, output);
   return output;
 }
 
 void channel_norm_difference(Queue& queue, const Tensor& a, const Tensor& b, const Tensor& output) {
-  check_defined(a, "input a");
-  check_defined(b, "input b");
+  detail::require_defined(a, kOp, "input a");
+  detail::require_defined(b, kOp, "input b");
   const Shape expected = channel_norm_output_shape(a.shape());
   if (a.shape() != b.shape()) {
     throw invalid_input("channel norm of a difference: the operands have shapes " + to_string(a.shape()) + " and " +
@@ -70,13 +67,12 @@ void channel_norm_difference(Queue& queue, const Tensor& a, const Tensor& b, con
     throw invalid_input("channel norm output overlaps one of its inputs");
   }
   Kernel& kernel = queue.kernel("channel_norm", "channel_norm_difference");
-  kernel.set_args(a, static_cast<int>(a.batch_stride()), b, static_cast<int>(b.batch_stride()), output,
-                  static_cast<int>(output.batch_stride()), static_cast<int>(a.c()), static_cast<int>(a.h() * a.w()));
+  kernel.set_args(a, a.batch_stride(), b, b.batch_stride(), output, output.batch_stride(), a.c(), a.h() * a.w());
   launch(queue, kernel, output);
 }
 
 Tensor channel_norm_difference(Queue& queue, const Tensor& a, const Tensor& b) {
-  check_defined(a, "input a");
+  detail::require_defined(a, kOp, "input a");
   Tensor output = Tensor::empty(queue, channel_norm_output_shape(a.shape()));
   channel_norm_difference(queue, a, b, output);
   return output;

@@ -12,9 +12,7 @@ namespace inertialnet {
 
 namespace {
 
-void require_defined(const Tensor& t, const char* what) {
-  if (!t.defined()) throw invalid_input(std::string("conv_transpose2d: the ") + what + " tensor is undefined (empty)");
-}
+const std::string kOp = "conv_transpose2d";
 
 }  // namespace
 
@@ -26,20 +24,9 @@ Shape conv_transpose2d_output_shape(const Shape& input, const Shape& weight, int
     throw invalid_input("conv_transpose2d: the weight must be [ci, co, kh, kw] (rank 4), got shape " +
                         to_string(weight));
   }
-  for (const auto d : input) {
-    if (d <= 0) {
-      throw invalid_input("conv_transpose2d: the input shape " + to_string(input) + " has a zero or negative size");
-    }
-  }
-  for (const auto d : weight) {
-    if (d <= 0) {
-      throw invalid_input("conv_transpose2d: the weight shape " + to_string(weight) + " has a zero or negative size");
-    }
-  }
-  if (stride < 1) throw invalid_input("conv_transpose2d: the stride must be at least 1, got " + std::to_string(stride));
-  if (padding < 0) {
-    throw invalid_input("conv_transpose2d: the padding must not be negative, got " + std::to_string(padding));
-  }
+  detail::require_positive_sizes(input, kOp, "input");
+  detail::require_positive_sizes(weight, kOp, "weight");
+  detail::require_stride_padding(stride, padding, kOp);
   if (input[1] != weight[0]) {
     throw invalid_input("conv_transpose2d: the input has " + std::to_string(input[1]) + " channels (shape " +
                         to_string(input) + ") but the weight " + to_string(weight) + " expects " +
@@ -57,17 +44,11 @@ Shape conv_transpose2d_output_shape(const Shape& input, const Shape& weight, int
 
 void conv_transpose2d(Queue& queue, const Tensor& input, const Tensor& weight, const Tensor& bias,
                       const Tensor& output, const ConvTranspose2dOptions& options) {
-  require_defined(input, "input");
-  require_defined(weight, "weight");
-  require_defined(output, "output");
+  detail::require_defined(input, kOp, "input");
+  detail::require_defined(weight, kOp, "weight");
+  detail::require_defined(output, kOp, "output");
   const Shape expected = conv_transpose2d_output_shape(input.shape(), weight.shape(), options.stride, options.padding);
-  if (!weight.contiguous()) {
-    throw invalid_input("conv_transpose2d: the weight " + to_string(weight.shape()) + " must be contiguous");
-  }
-  if (bias.defined() && (bias.rank() != 1 || bias.dim(0) != weight.dim(1))) {
-    throw invalid_input("conv_transpose2d: the bias has shape " + to_string(bias.shape()) + ", expected [" +
-                        std::to_string(weight.dim(1)) + "] for the weight " + to_string(weight.shape()));
-  }
+  detail::require_layer_parameters(weight, bias, weight.dim(1), kOp);
   if (output.shape() != expected) {
     throw invalid_input("conv_transpose2d: the output has shape " + to_string(output.shape()) + " but the input " +
                         to_string(input.shape()) + " with weight " + to_string(weight.shape()) + " (stride " +
@@ -90,11 +71,14 @@ void conv_transpose2d(Queue& queue, const Tensor& input, const Tensor& weight, c
   const bool has_bias = bias.defined();
   // col2im addresses the bias of a channel block through a [1, co] view of it.
   const Tensor bias_row = has_bias ? bias.reshaped({1, static_cast<std::int64_t>(out_channels)}) : Tensor();
-  Kernel& gather = queue.kernel(
-      "col2im", "col2im",
-      "-DKH=" + std::to_string(kh) + " -DKW=" + std::to_string(kw) + " -DSTRIDE=" + std::to_string(options.stride) +
-          " -DPAD=" + std::to_string(options.padding) + " -DHAS_BIAS=" + (has_bias ? "1 " : "0 ") +
-          activation_defines(options.activation));
+  Kernel& gather = queue.kernel("col2im", "col2im",
+                                KernelDefines()
+                                    .add("KH", kh)
+                                    .add("KW", kw)
+                                    .add("STRIDE", options.stride)
+                                    .add("PAD", options.padding)
+                                    .add("HAS_BIAS", has_bias)
+                                    .add(activation_defines(options.activation)));
   const Range local(detail::work_group_size(device, 64), 1);
 
   for (std::int64_t n = 0; n < input.n(); ++n) {
@@ -112,8 +96,7 @@ void conv_transpose2d(Queue& queue, const Tensor& input, const Tensor& weight, c
       const Tensor out_block = out_n.channels(first_channel, channel_count);
       // Without a bias the kernel never reads its bias argument; any valid buffer will do.
       const Tensor bias_block = has_bias ? bias_row.channels(first_channel, channel_count) : out_block;
-      gather.set_args(columns, out_block, bias_block, static_cast<int>(count), static_cast<int>(input.h()),
-                      static_cast<int>(input.w()), static_cast<int>(expected[2]), static_cast<int>(expected[3]));
+      gather.set_args(columns, out_block, bias_block, count, input.h(), input.w(), expected[2], expected[3]);
       queue.launch(gather, Range(out_pixels, count), local);
     }
   }
@@ -121,8 +104,8 @@ void conv_transpose2d(Queue& queue, const Tensor& input, const Tensor& weight, c
 
 Tensor conv_transpose2d(Queue& queue, const Tensor& input, const Tensor& weight, const Tensor& bias,
                         const ConvTranspose2dOptions& options) {
-  require_defined(input, "input");
-  require_defined(weight, "weight");
+  detail::require_defined(input, kOp, "input");
+  detail::require_defined(weight, kOp, "weight");
   Tensor output = Tensor::empty(queue, conv_transpose2d_output_shape(input.shape(), weight.shape(),
                                                                                options.stride, options.padding));
   conv_transpose2d(queue, input, weight, bias, output, options);

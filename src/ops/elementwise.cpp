@@ -17,14 +17,10 @@ void require_same_shape(const Tensor& t, const Tensor& reference, const std::str
   }
 }
 
-Range rows_range(const detail::RowLayout& layout) {
-  return Range(static_cast<std::size_t>(layout.sample), static_cast<std::size_t>(layout.batch));
-}
-
 Range rows_local(Queue& queue) { return Range(detail::work_group_size(queue.device()), 1); }
 
-void binary(Queue& queue, const std::string& op, float alpha, const Tensor& a, float beta, const Tensor& b,
-            const Tensor& out) {
+void binary(Queue& queue, const std::string& op, const Tensor& a, const Tensor& b, const Tensor& out, float alpha,
+            float beta) {
   detail::require_defined(a, op, "first input");
   require_same_shape(b, a, op, "second input", "first input");
   require_same_shape(out, a, op, "output", "first input");
@@ -33,13 +29,13 @@ void binary(Queue& queue, const std::string& op, float alpha, const Tensor& a, f
   const auto layout = detail::row_layout({&out, &a, &b});
   Kernel& kernel = queue.kernel("elementwise", "axpby_rows");
   kernel.set_args(out, layout.stride(out), a, layout.stride(a), b, layout.stride(b), layout.sample, alpha, beta);
-  queue.launch(kernel, rows_range(layout), rows_local(queue));
+  queue.launch(kernel, layout.range(), rows_local(queue));
 }
 
 }  // namespace
 
 void add(Queue& queue, const Tensor& a, const Tensor& b, const Tensor& out) {
-  binary(queue, "add", 1.0f, a, 1.0f, b, out);
+  binary(queue, "add", a, b, out, 1.0f, 1.0f);
 }
 
 Tensor add(Queue& queue, const Tensor& a, const Tensor& b) {
@@ -50,7 +46,7 @@ Tensor add(Queue& queue, const Tensor& a, const Tensor& b) {
 }
 
 void sub(Queue& queue, const Tensor& a, const Tensor& b, const Tensor& out) {
-  binary(queue, "sub", 1.0f, a, -1.0f, b, out);
+  binary(queue, "sub", a, b, out, 1.0f, -1.0f);
 }
 
 Tensor sub(Queue& queue, const Tensor& a, const Tensor& b) {
@@ -60,18 +56,18 @@ Tensor sub(Queue& queue, const Tensor& a, const Tensor& b) {
   return out;
 }
 
-void axpby(Queue& queue, float alpha, const Tensor& a, float beta, const Tensor& b, const Tensor& out) {
-  binary(queue, "axpby", alpha, a, beta, b, out);
+void axpby(Queue& queue, const Tensor& a, const Tensor& b, const Tensor& out, float alpha, float beta) {
+  binary(queue, "axpby", a, b, out, alpha, beta);
 }
 
-void scale(Queue& queue, const Tensor& a, float s, const Tensor& out) {
+void scale(Queue& queue, const Tensor& a, const Tensor& out, float s) {
   detail::require_defined(a, "scale", "input");
   require_same_shape(out, a, "scale", "output", "input");
   detail::require_no_partial_alias(out, a, "scale", "input", true);
   const auto layout = detail::row_layout({&out, &a});
   Kernel& kernel = queue.kernel("elementwise", "scale_rows");
   kernel.set_args(out, layout.stride(out), a, layout.stride(a), layout.sample, s);
-  queue.launch(kernel, rows_range(layout), rows_local(queue));
+  queue.launch(kernel, layout.range(), rows_local(queue));
 }
 
 void fill(Queue& queue, const Tensor& out, float value) {
@@ -79,7 +75,7 @@ void fill(Queue& queue, const Tensor& out, float value) {
   const auto layout = detail::row_layout({&out});
   Kernel& kernel = queue.kernel("elementwise", "fill_rows");
   kernel.set_args(out, layout.stride(out), layout.sample, value);
-  queue.launch(kernel, rows_range(layout), rows_local(queue));
+  queue.launch(kernel, layout.range(), rows_local(queue));
 }
 
 void copy(Queue& queue, const Tensor& src, const Tensor& dst) {
@@ -90,7 +86,7 @@ void copy(Queue& queue, const Tensor& src, const Tensor& dst) {
   const auto layout = detail::row_layout({&dst, &src});
   Kernel& kernel = queue.kernel("elementwise", "copy_rows");
   kernel.set_args(dst, layout.stride(dst), src, layout.stride(src), layout.sample);
-  queue.launch(kernel, rows_range(layout), rows_local(queue));
+  queue.launch(kernel, layout.range(), rows_local(queue));
 }
 
 void apply_activation(Queue& queue, const Tensor& in, const Tensor& out, const ActivationSpec& activation) {
@@ -114,7 +110,7 @@ void apply_activation(Queue& queue, const Tensor& in, const Tensor& out, const A
   const ActivationSpec spec = activation.kind == Activation::ReLU ? ActivationSpec::relu() : activation;
   Kernel& kernel = queue.kernel("elementwise", "activation_rows", activation_defines(spec));
   kernel.set_args(out, layout.stride(out), in, layout.stride(in), layout.sample);
-  queue.launch(kernel, rows_range(layout), rows_local(queue));
+  queue.launch(kernel, layout.range(), rows_local(queue));
 }
 
 }  // namespace inertialnet

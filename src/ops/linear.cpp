@@ -4,16 +4,15 @@
 #include <string>
 
 #include "inertialnet/runtime/device.hpp"
-#include "inertialnet/ops/conv2d.hpp"
+#include "inertialnet/ops/bias_activation.hpp"
 #include "inertialnet/ops/gemm.hpp"
+#include "ops/op_support.hpp"
 
 namespace inertialnet {
 
 namespace {
 
-void require_defined(const Tensor& t, const char* what) {
-  if (!t.defined()) throw invalid_input(std::string("linear: the ") + what + " tensor is undefined (empty)");
-}
+const std::string kOp = "linear";
 
 }  // namespace
 
@@ -22,12 +21,8 @@ Shape linear_output_shape(const Shape& input, const Shape& weight) {
     throw invalid_input("linear: the input must be [N, features…] (rank 2 or more), got shape " + to_string(input));
   }
   if (weight.size() != 2) throw invalid_input("linear: the weight must be [out, in], got shape " + to_string(weight));
-  for (const auto d : input) {
-    if (d <= 0) throw invalid_input("linear: the input shape " + to_string(input) + " has a zero or negative size");
-  }
-  for (const auto d : weight) {
-    if (d <= 0) throw invalid_input("linear: the weight shape " + to_string(weight) + " has a zero or negative size");
-  }
+  detail::require_positive_sizes(input, kOp, "input");
+  detail::require_positive_sizes(weight, kOp, "weight");
   const std::int64_t features = element_count(input) / input[0];
   if (features != weight[1]) {
     throw invalid_input("linear: the input " + to_string(input) + " has " + std::to_string(features) +
@@ -39,15 +34,11 @@ Shape linear_output_shape(const Shape& input, const Shape& weight) {
 
 void linear(Queue& queue, const Tensor& input, const Tensor& weight, const Tensor& bias, const Tensor& output,
             const ActivationSpec& activation) {
-  require_defined(input, "input");
-  require_defined(weight, "weight");
-  require_defined(output, "output");
+  detail::require_defined(input, kOp, "input");
+  detail::require_defined(weight, kOp, "weight");
+  detail::require_defined(output, kOp, "output");
   const Shape expected = linear_output_shape(input.shape(), weight.shape());
-  if (!weight.contiguous()) throw invalid_input("linear: the weight " + to_string(weight.shape()) + " must be contiguous");
-  if (bias.defined() && (bias.rank() != 1 || bias.dim(0) != weight.dim(0))) {
-    throw invalid_input("linear: the bias has shape " + to_string(bias.shape()) + ", expected [" +
-                        std::to_string(weight.dim(0)) + "] for the weight " + to_string(weight.shape()));
-  }
+  detail::require_layer_parameters(weight, bias, weight.dim(0), kOp);
   if (output.shape() != expected) {
     throw invalid_input("linear: the output has shape " + to_string(output.shape()) + " but the input " +
                         to_string(input.shape()) + " with weight " + to_string(weight.shape()) + " gives " +
@@ -66,8 +57,8 @@ void linear(Queue& queue, const Tensor& input, const Tensor& weight, const Tenso
 
 Tensor linear(Queue& queue, const Tensor& input, const Tensor& weight, const Tensor& bias,
               const ActivationSpec& activation) {
-  require_defined(input, "input");
-  require_defined(weight, "weight");
+  detail::require_defined(input, kOp, "input");
+  detail::require_defined(weight, kOp, "weight");
   Tensor output = Tensor::empty(queue, linear_output_shape(input.shape(), weight.shape()));
   linear(queue, input, weight, bias, output, activation);
   return output;

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "inertialnet/runtime/device.hpp"
+#include "inertialnet/runtime/kernel_defines.hpp"
 #include "ops/op_support.hpp"
 
 namespace inertialnet {
@@ -58,7 +59,7 @@ constexpr MomentsLayout moments_layout(MotionFieldMode mode) {
 
 // The layout as the kernel's build options: -DNQ=… and one -DQ_<NAME>=<offset> per quantity of
 // the mode (the absent ones are left undefined, so a kernel that used one would not compile).
-std::string layout_defines(const MomentsLayout& l) {
+KernelDefines layout_defines(const MomentsLayout& l) {
   const std::pair<const char*, int> entries[] = {
       {"NQ", l.quantities},
       {"Q_NORMAL", l.normal},
@@ -74,9 +75,9 @@ std::string layout_defines(const MomentsLayout& l) {
       {"Q_PARALLEL_SUM", l.parallel_sum},
       {"Q_PARALLEL_SQ", l.parallel_sq},
   };
-  std::string defines;
+  KernelDefines defines;
   for (const auto& [name, value] : entries) {
-    if (value >= 0) defines += std::string(" -D") + name + "=" + std::to_string(value);
+    if (value >= 0) defines.add(name, value);
   }
   return defines;
 }
@@ -170,8 +171,11 @@ MotionFieldMoments motion_field_moments(Queue& queue, const Tensor& flow, const 
   const std::size_t groups = std::clamp<std::size_t>((samples + 8 * local - 1) / (8 * local), 1, 64);
   const std::size_t floats = groups * static_cast<std::size_t>(layout.quantities);
   const Tensor partials = Tensor::empty(queue, {static_cast<std::int64_t>(floats)});
-  const std::string defines = "-DWG_SIZE=" + std::to_string(local) + " -DMODE=" + std::to_string(general ? 1 : 0) +
-                              " -DLOSS=" + std::to_string(static_cast<int>(params.loss)) + layout_defines(layout);
+  const KernelDefines defines = KernelDefines()
+                                    .add("WG_SIZE", local)
+                                    .add("MODE", general ? 1 : 0)
+                                    .add("LOSS", static_cast<int>(params.loss))
+                                    .add(layout_defines(layout));
   Kernel& kernel = queue.kernel("motion_field", "moments", defines);
   const float inv_scale = params.loss == RobustLoss::LeastSquares ? 0.0f : static_cast<float>(1.0 / params.scale);
   const Vec3 t = general ? params.translation : Vec3{0, 0, 0};

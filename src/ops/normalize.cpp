@@ -35,19 +35,17 @@ int partial_groups(std::int64_t plane, std::size_t local) {
 
 void enqueue_means(Queue& queue, const Tensor& frame1, const Tensor& frame2, const Tensor& means) {
   const std::size_t local = detail::work_group_size(queue.device(), 256);
-  const int channels = static_cast<int>(frame1.c());
+  const std::int64_t channels = frame1.c();
   const std::int64_t rows = frame1.n() * frame1.c();
   const std::int64_t plane64 = frame1.h() * frame1.w();
-  const int plane = static_cast<int>(plane64);
   const int groups = partial_groups(plane64, local);
-  const std::string defines = "-DWG_SIZE=" + std::to_string(local);
+  const KernelDefines defines = KernelDefines().add("WG_SIZE", local);
 
   // The partial sums live only until the means pass, which this in-order queue runs next; the
   // buffer goes back to the pool on return, and a later user on this queue runs after us.
   Tensor partial = Tensor::empty(queue, {rows * groups});
   Kernel& sums = queue.kernel("normalize", "channel_partial_sums", defines);
-  sums.set_args(frame1, static_cast<int>(frame1.batch_stride()), frame2, static_cast<int>(frame2.batch_stride()),
-                channels, plane, groups, partial);
+  sums.set_args(frame1, frame1.batch_stride(), frame2, frame2.batch_stride(), channels, plane64, groups, partial);
   queue.launch(sums, Range(static_cast<std::size_t>(groups) * local, static_cast<std::size_t>(rows)), Range(local, 1));
 
   Kernel& finish = queue.kernel("normalize", "channel_means", defines);
@@ -110,10 +108,10 @@ void normalize_frames(Queue& queue, const Tensor& frame1, const Tensor& frame2, 
 
   // The same build options as the reduction kernels: one program for the whole family.
   const std::size_t local = detail::work_group_size(queue.device(), 256);
-  Kernel& kernel = queue.kernel("normalize", "normalize_pair", "-DWG_SIZE=" + std::to_string(local));
-  const int plane = static_cast<int>(frame1.h() * frame1.w());
-  kernel.set_args(output, static_cast<int>(output.batch_stride()), frame1, static_cast<int>(frame1.batch_stride()),
-                  frame2, static_cast<int>(frame2.batch_stride()), means, static_cast<int>(channels), plane, rgb_max);
+  Kernel& kernel = queue.kernel("normalize", "normalize_pair", KernelDefines().add("WG_SIZE", local));
+  const std::int64_t plane = frame1.h() * frame1.w();
+  kernel.set_args(output, output.batch_stride(), frame1, frame1.batch_stride(), frame2, frame2.batch_stride(), means,
+                  channels, plane, rgb_max);
   queue.launch(kernel,
                Range(static_cast<std::size_t>(plane), static_cast<std::size_t>(channels),
                      static_cast<std::size_t>(frame1.n())),

@@ -1,15 +1,17 @@
 // Helpers shared by the host code of the ops: work-group sizes, the GEMM ops' column budget,
-// aliasing checks and the two-level (sample, batch) launch layout that lets every tensor be a
-// channel slice.
+// tensor and aliasing checks and the two-level (sample, batch) launch layout that lets every
+// tensor be a channel slice.
 #pragma once
 
 #include <algorithm>
 #include <cstddef>
+#include <cstdint>
 #include <initializer_list>
 #include <string>
 
 #include "inertialnet/runtime/device.hpp"
 #include "inertialnet/runtime/error.hpp"
+#include "inertialnet/runtime/queue.hpp"
 #include "inertialnet/runtime/tensor.hpp"
 
 namespace inertialnet::detail {
@@ -41,14 +43,39 @@ inline bool same_view(const Tensor& a, const Tensor& b) {
          (a.batch_stride() == b.batch_stride() || a.dim(0) == 1);
 }
 
+// The one check for a missing tensor (a default-constructed Tensor has no storage).
 inline void require_defined(const Tensor& t, const std::string& op, const std::string& role) {
-  if (!t.defined()) throw invalid_input(op + ": the " + role + " tensor is empty (no storage)");
+  if (!t.defined()) throw invalid_input(op + ": the " + role + " tensor is undefined (no storage)");
 }
 
 inline void require_rank4(const Tensor& t, const std::string& op, const std::string& role) {
   require_defined(t, op, role);
   if (t.rank() != 4) {
     throw invalid_input(op + ": the " + role + " must be an NCHW tensor (rank 4), got shape " + to_string(t.shape()));
+  }
+}
+
+// Every dimension of `shape` at least 1.
+inline void require_positive_sizes(const Shape& shape, const std::string& op, const std::string& role) {
+  for (const auto d : shape) {
+    if (d <= 0) throw invalid_input(op + ": the " + role + " shape " + to_string(shape) + " has a zero or negative size");
+  }
+}
+
+// A convolution's stride (at least 1) and zero padding (not negative).
+inline void require_stride_padding(int stride, int padding, const std::string& op) {
+  if (stride < 1) throw invalid_input(op + ": the stride must be at least 1, got " + std::to_string(stride));
+  if (padding < 0) throw invalid_input(op + ": the padding must not be negative, got " + std::to_string(padding));
+}
+
+// The parameters of a weighted layer (conv2d, conv_transpose2d, linear): a contiguous weight
+// (the GEMM reads it as one matrix) and a bias of [out_channels] or none.
+inline void require_layer_parameters(const Tensor& weight, const Tensor& bias, std::int64_t out_channels,
+                                     const std::string& op) {
+  if (!weight.contiguous()) throw invalid_input(op + ": the weight " + to_string(weight.shape()) + " must be contiguous");
+  if (bias.defined() && (bias.rank() != 1 || bias.dim(0) != out_channels)) {
+    throw invalid_input(op + ": the bias has shape " + to_string(bias.shape()) + ", expected [" +
+                        std::to_string(out_channels) + "] for the weight " + to_string(weight.shape()));
   }
 }
 
@@ -67,10 +94,12 @@ inline void require_no_partial_alias(const Tensor& output, const Tensor& input, 
 // tensor starting at offset + n·stride. When every tensor is contiguous the batch is folded into
 // one long row (fewer, fuller work-groups for small samples).
 struct RowLayout {
-  int sample = 0;
-  int batch = 0;
+  std::int64_t sample = 0;
+  std::int64_t batch = 0;
   bool folded = false;
-  int stride(const Tensor& t) const { return folded ? sample : static_cast<int>(t.batch_stride()); }
+  std::int64_t stride(const Tensor& t) const { return folded ? sample : static_cast<std::int64_t>(t.batch_stride()); }
+  // One work-item per element: (element within the row, row).
+  Range range() const { return Range(static_cast<std::size_t>(sample), static_cast<std::size_t>(batch)); }
 };
 
 inline RowLayout row_layout(std::initializer_list<const Tensor*> tensors) {
@@ -79,12 +108,12 @@ inline RowLayout row_layout(std::initializer_list<const Tensor*> tensors) {
   for (const Tensor* t : tensors) all_contiguous = all_contiguous && t->contiguous();
   RowLayout layout;
   if (all_contiguous) {
-    layout.sample = static_cast<int>(first.numel());
+    layout.sample = first.numel();
     layout.batch = 1;
     layout.folded = true;
   } else {
-    layout.sample = static_cast<int>(first.sample_size());
-    layout.batch = static_cast<int>(first.dim(0));
+    layout.sample = static_cast<std::int64_t>(first.sample_size());
+    layout.batch = first.dim(0);
   }
   for (const Tensor* t : tensors) t->offset_int();  // every view must fit 32-bit indexing
   return layout;

@@ -39,9 +39,9 @@ void resample(Queue& queue, const Tensor& input, const Tensor& output, Interpola
   const float ratio_y = static_cast<float>(in_h) / static_cast<float>(out_h);
   const float ratio_x = static_cast<float>(in_w) / static_cast<float>(out_w);
   Kernel& kernel =
-      queue.kernel("upsample", mode == Interpolation::Bilinear ? "upsample_bilinear" : "upsample_nearest");
-  kernel.set_args(input, static_cast<int>(input.batch_stride()), output, static_cast<int>(output.batch_stride()),
-                  static_cast<int>(input.c()), in_h, in_w, out_h, out_w, ratio_y, ratio_x, scale0, scale1);
+      queue.kernel("upsample", "resample", KernelDefines().add("NEAREST", mode == Interpolation::Nearest));
+  kernel.set_args(input, input.batch_stride(), output, output.batch_stride(), input.c(), in_h, in_w, out_h, out_w,
+                  ratio_y, ratio_x, scale0, scale1);
   const std::size_t local =
       detail::work_group_size(queue.device(), 64);
   queue.launch(kernel, Range(static_cast<std::size_t>(out_w), static_cast<std::size_t>(out_h),
@@ -62,24 +62,24 @@ Shape upsample_output_shape(const Shape& input, int factor) {
   return {input[0], input[1], input[2] * factor, input[3] * factor};
 }
 
-void resize(Queue& queue, const Tensor& input, const Tensor& output, Interpolation mode, float scale) {
-  resample(queue, input, output, mode, scale, scale, std::string(name(mode)) + " resize");
+void resize(Queue& queue, const Tensor& input, const Tensor& output, const ResizeOptions& options) {
+  resample(queue, input, output, options.mode, options.scale, options.scale, std::string(name(options.mode)) + " resize");
 }
 
-Tensor resize(Queue& queue, const Tensor& input, std::int64_t height, std::int64_t width, Interpolation mode,
-              float scale) {
-  const std::string what = std::string(name(mode)) + " resize";
+Tensor resize(Queue& queue, const Tensor& input, std::int64_t height, std::int64_t width, const ResizeOptions& options) {
+  const std::string what = std::string(name(options.mode)) + " resize";
   check_nchw(input, what + " input");
   check_size(height, width, what);
   Tensor output = Tensor::empty(queue, {input.n(), input.c(), height, width});
-  resample(queue, input, output, mode, scale, scale, what);
+  resample(queue, input, output, options.mode, options.scale, options.scale, what);
   return output;
 }
 
-Tensor upsample(Queue& queue, const Tensor& input, int factor, Interpolation mode, float scale) {
-  check_nchw(input, std::string(name(mode)) + " upsample input");
+Tensor upsample(Queue& queue, const Tensor& input, int factor, const ResizeOptions& options) {
+  const std::string what = std::string(name(options.mode)) + " upsample";
+  check_nchw(input, what + " input");
   Tensor output = Tensor::empty(queue, upsample_output_shape(input.shape(), factor));
-  resample(queue, input, output, mode, scale, scale, std::string(name(mode)) + " upsample ×" + std::to_string(factor));
+  resample(queue, input, output, options.mode, options.scale, options.scale, what + " ×" + std::to_string(factor));
   return output;
 }
 

@@ -10,9 +10,7 @@ namespace inertialnet {
 
 namespace {
 
-void check_defined(const Tensor& t, const char* name) {
-  if (!t.defined()) throw invalid_input(std::string("warp ") + name + " is an undefined tensor");
-}
+const std::string kOp = "warp";
 
 }  // namespace
 
@@ -33,9 +31,9 @@ Shape warp_output_shape(const Shape& image, const Shape& flow) {
 }
 
 void warp(Queue& queue, const Tensor& image, const Tensor& flow, const Tensor& output) {
-  check_defined(image, "image");
-  check_defined(flow, "flow");
-  check_defined(output, "output");
+  detail::require_defined(image, kOp, "image");
+  detail::require_defined(flow, kOp, "flow");
+  detail::require_defined(output, kOp, "output");
   const Shape expected = warp_output_shape(image.shape(), flow.shape());
   if (output.shape() != expected) {
     throw invalid_input("warp output must have the image's shape " + to_string(expected) + ", got " +
@@ -44,10 +42,10 @@ void warp(Queue& queue, const Tensor& image, const Tensor& flow, const Tensor& o
   if (output.overlaps(image) || output.overlaps(flow)) {
     throw invalid_input("warp output overlaps its image or flow; it must be a separate tensor");
   }
-  const int height = static_cast<int>(image.h()), width = static_cast<int>(image.w());
+  const std::int64_t height = image.h(), width = image.w();
   Kernel& kernel = queue.kernel("warp", "warp_bilinear");
-  kernel.set_args(image, static_cast<int>(image.batch_stride()), flow, static_cast<int>(flow.batch_stride()), output,
-                  static_cast<int>(output.batch_stride()), static_cast<int>(image.c()), height, width);
+  kernel.set_args(image, image.batch_stride(), flow, flow.batch_stride(), output, output.batch_stride(), image.c(),
+                  height, width);
   // Rows of up to 64 pixels per group: contiguous flow reads, vectorisable on CPUs.
   const std::size_t local =
       detail::work_group_size(queue.device(), 64);
@@ -57,8 +55,8 @@ void warp(Queue& queue, const Tensor& image, const Tensor& flow, const Tensor& o
 }
 
 Tensor warp(Queue& queue, const Tensor& image, const Tensor& flow) {
-  check_defined(image, "image");
-  check_defined(flow, "flow");
+  detail::require_defined(image, kOp, "image");
+  detail::require_defined(flow, kOp, "flow");
   Tensor output = Tensor::empty(queue, warp_output_shape(image.shape(), flow.shape()));
   warp(queue, image, flow, output);
   return output;

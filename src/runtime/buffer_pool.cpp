@@ -50,7 +50,8 @@ std::shared_ptr<Buffer> BufferPool::acquire(std::size_t bytes) {
       trim();
       memory = MemHandle(clCreateBuffer(state_->context, CL_MEM_READ_WRITE, bytes, nullptr, &status));
     }
-    check_cl(status, ("clCreateBuffer(" + std::to_string(bytes) + " bytes)").c_str(), ClSite{state_->device_name, {}});
+    check_cl(status, (INERTIALNET_CL_NAME(clCreateBuffer) + ("(" + std::to_string(bytes) + " bytes)")).c_str(),
+             ClSite{state_->device_name, {}});
     std::lock_guard<std::mutex> lock(state_->mutex);
     ++state_->stats.allocations;
   }

@@ -29,7 +29,7 @@ Device::Device(const DeviceInfo& info, DeviceOptions options) : info_(info) {
       CL_CONTEXT_PLATFORM, reinterpret_cast<cl_context_properties>(info_.platform_id), 0};
   cl_int status = CL_SUCCESS;
   context_ = ContextHandle(clCreateContext(properties, 1, &info_.device_id, report_context_error, nullptr, &status));
-  check_cl(status, "clCreateContext", site());
+  check_cl(status, INERTIALNET_CL_NAME(clCreateContext), site());
 
   std::filesystem::path directory =
       options.cache_directory.empty() ? default_cache_directory() : options.cache_directory;

@@ -2,6 +2,8 @@
 
 #include <sstream>
 
+#include <clblast.h>
+
 namespace inertialnet {
 
 std::string cl_error_name(cl_int code) {
@@ -83,36 +85,40 @@ std::string cl_error_name(cl_int code) {
 std::string clblast_status_name(int code) {
   // Codes above -1000 are OpenCL's own; CLBlast adds clBLAS-compatible and private ones.
   if (code > -1000) return cl_error_name(code);
-  switch (code) {
-    case -1024: return "kNotImplemented";
-    case -1022: return "kInvalidMatrixA";
-    case -1021: return "kInvalidMatrixB";
-    case -1020: return "kInvalidMatrixC";
-    case -1019: return "kInvalidVectorX";
-    case -1018: return "kInvalidVectorY";
-    case -1017: return "kInvalidDimension";
-    case -1016: return "kInvalidLeadDimA";
-    case -1015: return "kInvalidLeadDimB";
-    case -1014: return "kInvalidLeadDimC";
-    case -1013: return "kInvalidIncrementX";
-    case -1012: return "kInvalidIncrementY";
-    case -1011: return "kInsufficientMemoryA";
-    case -1010: return "kInsufficientMemoryB";
-    case -1009: return "kInsufficientMemoryC";
-    case -1008: return "kInsufficientMemoryX";
-    case -1007: return "kInsufficientMemoryY";
-    case -2050: return "kInsufficientMemoryTemp";
-    case -2049: return "kInvalidBatchCount";
-    case -2048: return "kInvalidOverrideKernel";
-    case -2047: return "kMissingOverrideParameter";
-    case -2046: return "kInvalidLocalMemUsage";
-    case -2045: return "kNoHalfPrecision";
-    case -2044: return "kNoDoublePrecision";
-    case -2043: return "kInvalidVectorScalar";
-    case -2042: return "kInsufficientMemoryScalar";
-    case -2041: return "kDatabaseError";
-    case -2040: return "kUnknownError";
-    case -2039: return "kUnexpectedError";
+  switch (static_cast<clblast::StatusCode>(code)) {
+#define INERTIALNET_CLBLAST_STATUS(name)  \
+  case clblast::StatusCode::name: \
+    return #name;
+    INERTIALNET_CLBLAST_STATUS(kNotImplemented)
+    INERTIALNET_CLBLAST_STATUS(kInvalidMatrixA)
+    INERTIALNET_CLBLAST_STATUS(kInvalidMatrixB)
+    INERTIALNET_CLBLAST_STATUS(kInvalidMatrixC)
+    INERTIALNET_CLBLAST_STATUS(kInvalidVectorX)
+    INERTIALNET_CLBLAST_STATUS(kInvalidVectorY)
+    INERTIALNET_CLBLAST_STATUS(kInvalidDimension)
+    INERTIALNET_CLBLAST_STATUS(kInvalidLeadDimA)
+    INERTIALNET_CLBLAST_STATUS(kInvalidLeadDimB)
+    INERTIALNET_CLBLAST_STATUS(kInvalidLeadDimC)
+    INERTIALNET_CLBLAST_STATUS(kInvalidIncrementX)
+    INERTIALNET_CLBLAST_STATUS(kInvalidIncrementY)
+    INERTIALNET_CLBLAST_STATUS(kInsufficientMemoryA)
+    INERTIALNET_CLBLAST_STATUS(kInsufficientMemoryB)
+    INERTIALNET_CLBLAST_STATUS(kInsufficientMemoryC)
+    INERTIALNET_CLBLAST_STATUS(kInsufficientMemoryX)
+    INERTIALNET_CLBLAST_STATUS(kInsufficientMemoryY)
+    INERTIALNET_CLBLAST_STATUS(kInsufficientMemoryTemp)
+    INERTIALNET_CLBLAST_STATUS(kInvalidBatchCount)
+    INERTIALNET_CLBLAST_STATUS(kInvalidOverrideKernel)
+    INERTIALNET_CLBLAST_STATUS(kMissingOverrideParameter)
+    INERTIALNET_CLBLAST_STATUS(kInvalidLocalMemUsage)
+    INERTIALNET_CLBLAST_STATUS(kNoHalfPrecision)
+    INERTIALNET_CLBLAST_STATUS(kNoDoublePrecision)
+    INERTIALNET_CLBLAST_STATUS(kInvalidVectorScalar)
+    INERTIALNET_CLBLAST_STATUS(kInsufficientMemoryScalar)
+    INERTIALNET_CLBLAST_STATUS(kDatabaseError)
+    INERTIALNET_CLBLAST_STATUS(kUnknownError)
+    INERTIALNET_CLBLAST_STATUS(kUnexpectedError)
+#undef INERTIALNET_CLBLAST_STATUS
     default: break;
   }
   return "CLBLAST_UNKNOWN_STATUS(" + std::to_string(code) + ")";

@@ -16,7 +16,7 @@ std::string platform_string(cl_platform_id platform, cl_platform_info what) {
   std::size_t size = 0;
   if (clGetPlatformInfo(platform, what, 0, nullptr, &size) != CL_SUCCESS || size == 0) return {};
   std::string value(size, '\0');
-  check_cl(clGetPlatformInfo(platform, what, size, value.data(), nullptr), "clGetPlatformInfo");
+  INERTIALNET_CHECK_CL(ClSite(), clGetPlatformInfo, platform, what, size, value.data(), nullptr);
   value.resize(value.find('\0') == std::string::npos ? value.size() : value.find('\0'));
   return value;
 }
@@ -25,7 +25,7 @@ std::string device_string(cl_device_id device, cl_device_info what) {
   std::size_t size = 0;
   if (clGetDeviceInfo(device, what, 0, nullptr, &size) != CL_SUCCESS || size == 0) return {};
   std::string value(size, '\0');
-  check_cl(clGetDeviceInfo(device, what, size, value.data(), nullptr), "clGetDeviceInfo");
+  INERTIALNET_CHECK_CL(ClSite(), clGetDeviceInfo, device, what, size, value.data(), nullptr);
   value.resize(value.find('\0') == std::string::npos ? value.size() : value.find('\0'));
   // Some drivers pad names with spaces.
   const auto last = value.find_last_not_of(' ');
@@ -36,7 +36,7 @@ std::string device_string(cl_device_id device, cl_device_info what) {
 template <class T>
 T device_value(cl_device_id device, cl_device_info what) {
   T value{};
-  check_cl(clGetDeviceInfo(device, what, sizeof(T), &value, nullptr), "clGetDeviceInfo");
+  INERTIALNET_CHECK_CL(ClSite(), clGetDeviceInfo, device, what, sizeof(T), &value, nullptr);
   return value;
 }
 
@@ -81,9 +81,9 @@ std::vector<DeviceInfo> discover_devices() {
   const cl_int status = clGetPlatformIDs(0, nullptr, &platform_count);
   // The ICD loader answers CL_PLATFORM_NOT_FOUND_KHR (-1001) when no driver is installed.
   if (status == -1001 || platform_count == 0) return {};
-  check_cl(status, "clGetPlatformIDs");
+  check_cl(status, INERTIALNET_CL_NAME(clGetPlatformIDs));
   std::vector<cl_platform_id> platforms(platform_count);
-  check_cl(clGetPlatformIDs(platform_count, platforms.data(), nullptr), "clGetPlatformIDs");
+  INERTIALNET_CHECK_CL(ClSite(), clGetPlatformIDs, platform_count, platforms.data(), nullptr);
 
   std::vector<DeviceInfo> devices;
   for (cl_uint p = 0; p < platform_count; ++p) {

@@ -1,9 +1,6 @@
 #include "inertialnet/runtime/program_cache.hpp"
 
-#include <unistd.h>
-
 #include <algorithm>
-#include <atomic>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -11,6 +8,7 @@
 #include <sstream>
 
 #include "inertialnet/runtime/error.hpp"
+#include "runtime/atomic_file.hpp"
 #include "runtime/embedded_kernels.hpp"
 #include "runtime/hash.hpp"
 
@@ -131,7 +129,7 @@ ProgramHandle ProgramCache::build(const std::string& name, const std::string& so
   const std::size_t length = source.size();
   cl_int status = CL_SUCCESS;
   ProgramHandle program(clCreateProgramWithSource(context_, 1, &text, &length, &status));
-  check_cl(status, "clCreateProgramWithSource", ClSite{device_.name, name});
+  check_cl(status, INERTIALNET_CL_NAME(clCreateProgramWithSource), ClSite{device_.name, name});
   status = clBuildProgram(program.get(), 1, &device_.device_id, options.c_str(), nullptr, nullptr);
   if (status != CL_SUCCESS) {
     const std::string log = build_log(program.get(), device_.device_id);
@@ -196,30 +194,19 @@ void ProgramCache::store_binary(cl_program program, const std::filesystem::path&
   std::error_code error;
   std::filesystem::create_directories(directory_, error);
   if (error) return;
-  static std::atomic<unsigned> counter{0};
-  const std::filesystem::path temporary =
-      file.string() + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++);
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    const std::uint32_t key_length = static_cast<std::uint32_t>(key.size());
-    const std::uint64_t binary_length = binary.size();
-    const std::uint64_t checksum = hash_bytes(binary.data(), binary.size());
+  const std::uint32_t key_length = static_cast<std::uint32_t>(key.size());
+  const std::uint64_t binary_length = binary.size();
+  const std::uint64_t checksum = hash_bytes(binary.data(), binary.size());
+  try {
+    AtomicFile out(file);
     out.write(kMagic, sizeof kMagic);
-    out.write(reinterpret_cast<const char*>(&key_length), sizeof key_length);
-    out.write(key.data(), static_cast<std::streamsize>(key.size()));
-    out.write(reinterpret_cast<const char*>(&binary_length), sizeof binary_length);
-    out.write(reinterpret_cast<const char*>(binary.data()), static_cast<std::streamsize>(binary.size()));
-    out.write(reinterpret_cast<const char*>(&checksum), sizeof checksum);
-    if (!out.flush()) {
-      out.close();
-      std::filesystem::remove(temporary, error);
-      return;
-    }
-  }
-  // rename() is atomic within a file system: readers see the old file or the whole new one.
-  std::filesystem::rename(temporary, file, error);
-  if (error) {
-    std::filesystem::remove(temporary, error);
+    out.write(&key_length, sizeof key_length);
+    out.write(key.data(), key.size());
+    out.write(&binary_length, sizeof binary_length);
+    out.write(binary.data(), binary.size());
+    out.write(&checksum, sizeof checksum);
+    out.commit();
+  } catch (const Error&) {
     return;
   }
   ++stats_.disk_writes;

@@ -1,5 +1,7 @@
 #include "inertialnet/runtime/queue.hpp"
 
+#include <limits>
+
 #include "inertialnet/runtime/device.hpp"
 
 namespace inertialnet {
@@ -7,24 +9,36 @@ namespace inertialnet {
 void Event::wait() const {
   if (!handle_) return;
   const cl_event event = handle_.get();
-  check_cl(clWaitForEvents(1, &event), "clWaitForEvents", ClSite{{}, what_});
+  const ClSite site{{}, what_};
+  INERTIALNET_CHECK_CL(site, clWaitForEvents, 1, &event);
 }
 
 std::uint64_t Event::duration_ns() const {
   if (!handle_) return 0;
   wait();
   cl_ulong start = 0, end = 0;
-  check_cl(clGetEventProfilingInfo(handle_.get(), CL_PROFILING_COMMAND_START, sizeof start, &start, nullptr),
-           "clGetEventProfilingInfo(CL_PROFILING_COMMAND_START)", ClSite{{}, what_});
-  check_cl(clGetEventProfilingInfo(handle_.get(), CL_PROFILING_COMMAND_END, sizeof end, &end, nullptr),
-           "clGetEventProfilingInfo(CL_PROFILING_COMMAND_END)", ClSite{{}, what_});
+  const ClSite site{{}, what_};
+  INERTIALNET_CHECK_CL(site, clGetEventProfilingInfo, handle_.get(), CL_PROFILING_COMMAND_START, sizeof start, &start,
+                       nullptr);
+  INERTIALNET_CHECK_CL(site, clGetEventProfilingInfo, handle_.get(), CL_PROFILING_COMMAND_END, sizeof end, &end, nullptr);
   return end > start ? end - start : 0;
+}
+
+cl_int Kernel::narrow(cl_uint index, bool is_signed, long long value, unsigned long long unsigned_value) const {
+  const bool fits = is_signed ? value >= std::numeric_limits<cl_int>::min() && value <= std::numeric_limits<cl_int>::max()
+                              : unsigned_value <= static_cast<unsigned long long>(std::numeric_limits<cl_int>::max());
+  if (!fits) {
+    throw invalid_input("kernel " + label_ + ": argument " + std::to_string(index) + " = " +
+                        (is_signed ? std::to_string(value) : std::to_string(unsigned_value)) +
+                        " does not fit the kernel's 32-bit int");
+  }
+  return static_cast<cl_int>(is_signed ? value : static_cast<long long>(unsigned_value));
 }
 
 void Kernel::set_raw(cl_uint index, std::size_t size, const void* value) {
   const cl_int status = clSetKernelArg(handle_.get(), index, size, value);
   if (status != CL_SUCCESS) {
-    check_cl(status, ("clSetKernelArg(" + std::to_string(index) + ")").c_str(), site_);
+    check_cl(status, (INERTIALNET_CL_NAME(clSetKernelArg) + ("(" + std::to_string(index) + ")")).c_str(), site_);
   }
 }
 
@@ -32,13 +46,17 @@ Queue::Queue(Device& device, bool profiling) : device_(device), profiling_(profi
   cl_int status = CL_SUCCESS;
   const cl_command_queue_properties properties = profiling ? CL_QUEUE_PROFILING_ENABLE : 0;
   queue_ = QueueHandle(clCreateCommandQueue(device.context(), device.id(), properties, &status));
-  check_cl(status, "clCreateCommandQueue", device.site());
+  check_cl(status, INERTIALNET_CL_NAME(clCreateCommandQueue), device.site());
   buffers_ = std::make_unique<BufferPool>(device.context(), device.info().name, device.info().max_alloc_bytes);
 }
 
 Queue::~Queue() {
   // Pending work may still use buffers of this queue's pool: drain before they are freed.
   if (queue_) clFinish(queue_.get());
+}
+
+Kernel& Queue::kernel(const std::string& family, const std::string& name, const KernelDefines& defines) {
+  return kernel(family, name, defines.str());
 }
 
 Kernel& Queue::kernel(const std::string& family, const std::string& name, const std::string& defines) {
@@ -50,7 +68,7 @@ Kernel& Queue::kernel(const std::string& family, const std::string& name, const 
   const std::string label = family + "/" + name;
   cl_int status = CL_SUCCESS;
   KernelHandle handle(clCreateKernel(program, name.c_str(), &status));
-  check_cl(status, "clCreateKernel", device_.site(label));
+  check_cl(status, INERTIALNET_CL_NAME(clCreateKernel), device_.site(label));
   auto kernel = std::make_unique<Kernel>(std::move(handle), label, device_.site(label));
   return *kernels_.emplace(key, std::move(kernel)).first->second;
 }
@@ -73,10 +91,9 @@ Event Queue::launch(Kernel& kernel, Range global, Range local, bool want_event) 
     }
   }
   EventHandle event;
-  check_cl(clEnqueueNDRangeKernel(queue_.get(), kernel.handle(), dims, nullptr, global_size,
-                                  with_local ? local_size : nullptr, 0, nullptr,
-                                  want_event ? event.reset_and_get_address() : nullptr),
-           "clEnqueueNDRangeKernel", kernel.site());
+  INERTIALNET_CHECK_CL(kernel.site(), clEnqueueNDRangeKernel, queue_.get(), kernel.handle(), dims, nullptr, global_size,
+                       with_local ? local_size : nullptr, 0, nullptr,
+                       want_event ? event.reset_and_get_address() : nullptr);
   return want_event ? Event(std::move(event), kernel.label()) : Event();
 }
 
@@ -85,19 +102,19 @@ void Queue::wait_for(const Event& event) {
   const cl_event handle = event.handle();
   // A marker with a wait list makes every later command of an in-order queue wait for it.
   EventHandle marker;
-  check_cl(clEnqueueMarkerWithWaitList(queue_.get(), 1, &handle, marker.reset_and_get_address()),
-           "clEnqueueMarkerWithWaitList", device_.site());
+  INERTIALNET_CHECK_CL(device_.site(), clEnqueueMarkerWithWaitList, queue_.get(), 1, &handle,
+                       marker.reset_and_get_address());
 }
 
 Event Queue::marker() {
   EventHandle event;
-  check_cl(clEnqueueMarkerWithWaitList(queue_.get(), 0, nullptr, event.reset_and_get_address()),
-           "clEnqueueMarkerWithWaitList", device_.site());
+  INERTIALNET_CHECK_CL(device_.site(), clEnqueueMarkerWithWaitList, queue_.get(), 0, nullptr,
+                       event.reset_and_get_address());
   return Event(std::move(event), "marker");
 }
 
-void Queue::flush() { check_cl(clFlush(queue_.get()), "clFlush", device_.site()); }
+void Queue::flush() { INERTIALNET_CHECK_CL(device_.site(), clFlush, queue_.get()); }
 
-void Queue::finish() { check_cl(clFinish(queue_.get()), "clFinish", device_.site()); }
+void Queue::finish() { INERTIALNET_CHECK_CL(device_.site(), clFinish, queue_.get()); }
 
 }  // namespace inertialnet

@@ -1,20 +1,11 @@
 #include "inertialnet/runtime/tensor.hpp"
 
 #include <limits>
-#include <sstream>
 
 #include "inertialnet/runtime/device.hpp"
 #include "inertialnet/runtime/queue.hpp"
 
 namespace inertialnet {
-
-std::string to_string(const Shape& shape) {
-  std::ostringstream out;
-  out << '[';
-  for (std::size_t i = 0; i < shape.size(); ++i) out << (i ? ", " : "") << shape[i];
-  out << ']';
-  return out.str();
-}
 
 std::int64_t element_count(const Shape& shape) {
   std::int64_t count = 1;
@@ -33,6 +24,18 @@ Tensor allocate(BufferPool& pool, const Shape& shape) {
     throw invalid_input("tensor shape " + to_string(shape) + " has more than 2^31 elements");
   }
   return Tensor::wrap(pool.acquire(static_cast<std::size_t>(count) * sizeof(float)), shape);
+}
+
+// How a host transfer walks a tensor: a contiguous view is one row of all its elements, a
+// strided view (a channel slice) one row per sample, `batch_stride` apart on the device.
+struct Rows {
+  std::size_t count;
+  std::size_t length;
+};
+
+Rows transfer_rows(const Tensor& t) {
+  if (t.contiguous()) return {1, static_cast<std::size_t>(t.numel())};
+  return {static_cast<std::size_t>(t.dim(0)), t.sample_size()};
 }
 }  // namespace
 
@@ -151,19 +154,12 @@ void Tensor::upload(Queue& queue, const float* data, std::size_t count) {
   if (count != static_cast<std::size_t>(numel())) {
     throw invalid_input("uploading " + std::to_string(count) + " values into a tensor of shape " + to_string(shape_));
   }
-  const std::size_t batch = static_cast<std::size_t>(dim(0));
-  const std::size_t sample = sample_size();
   const ClSite site = queue.device().site();
-  if (contiguous()) {
-    check_cl(clEnqueueWriteBuffer(queue.handle(), buffer(), CL_TRUE, offset_ * sizeof(float), count * sizeof(float),
-                                  data, 0, nullptr, nullptr),
-             "clEnqueueWriteBuffer", site);
-    return;
-  }
-  for (std::size_t b = 0; b < batch; ++b) {
-    check_cl(clEnqueueWriteBuffer(queue.handle(), buffer(), CL_TRUE, (offset_ + b * batch_stride_) * sizeof(float),
-                                  sample * sizeof(float), data + b * sample, 0, nullptr, nullptr),
-             "clEnqueueWriteBuffer", site);
+  const Rows rows = transfer_rows(*this);
+  for (std::size_t r = 0; r < rows.count; ++r) {
+    INERTIALNET_CHECK_CL(site, clEnqueueWriteBuffer, queue.handle(), buffer(), CL_TRUE,
+                         (offset_ + r * batch_stride_) * sizeof(float), rows.length * sizeof(float),
+                         data + r * rows.length, 0, nullptr, nullptr);
   }
 }
 
@@ -172,19 +168,12 @@ void Tensor::download(Queue& queue, float* data, std::size_t count) const {
     throw invalid_input("downloading a tensor of shape " + to_string(shape_) + " into " + std::to_string(count) +
                         " values");
   }
-  const std::size_t batch = static_cast<std::size_t>(dim(0));
-  const std::size_t sample = sample_size();
   const ClSite site = queue.device().site();
-  if (contiguous()) {
-    check_cl(clEnqueueReadBuffer(queue.handle(), buffer(), CL_TRUE, offset_ * sizeof(float), count * sizeof(float),
-                                 data, 0, nullptr, nullptr),
-             "clEnqueueReadBuffer", site);
-    return;
-  }
-  for (std::size_t b = 0; b < batch; ++b) {
-    check_cl(clEnqueueReadBuffer(queue.handle(), buffer(), CL_TRUE, (offset_ + b * batch_stride_) * sizeof(float),
-                                 sample * sizeof(float), data + b * sample, 0, nullptr, nullptr),
-             "clEnqueueReadBuffer", site);
+  const Rows rows = transfer_rows(*this);
+  for (std::size_t r = 0; r < rows.count; ++r) {
+    INERTIALNET_CHECK_CL(site, clEnqueueReadBuffer, queue.handle(), buffer(), CL_TRUE,
+                         (offset_ + r * batch_stride_) * sizeof(float), rows.length * sizeof(float),
+                         data + r * rows.length, 0, nullptr, nullptr);
   }
 }
 

@@ -1,6 +1,8 @@
 // The safetensors reader and writer: round trips, every malformed-file error (files written byte
 // by byte here), exact F16 conversion, and the model-fit check's single error message.
 #include "inertialnet/io/safetensors.hpp"
+#include "inertialnet/io/safetensors_writer.hpp"
+#include "inertialnet/io/weight_fit.hpp"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -15,6 +17,7 @@
 #include <initializer_list>
 #include <iterator>
 #include <limits>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -33,6 +36,15 @@ class SafetensorsTest : public ::testing::Test {
   void TearDown() override {
     for (const auto& file : created_) std::remove(file.c_str());
     ::rmdir(dir_.c_str());
+  }
+
+  // True when the atomic writer left a temporary file beside `file`.
+  bool temporary_left_beside(const std::string& file) const {
+    const std::string prefix = std::filesystem::path(file).filename().string() + ".tmp";
+    for (const auto& entry : std::filesystem::directory_iterator(dir_)) {
+      if (entry.path().filename().string().rfind(prefix, 0) == 0) return true;
+    }
+    return false;
   }
 
   std::string path(const std::string& name) {
@@ -120,7 +132,7 @@ TEST_F(SafetensorsTest, RoundTripKeepsNamesShapesValuesAndMetadata) {
   std::memcpy(&first, file.data("a.second"), sizeof first);
   EXPECT_EQ(first, 7.0f);
   EXPECT_FALSE(file.contains("missing"));
-  EXPECT_FALSE(exists(p + ".tmp-" + std::to_string(::getpid())));
+  EXPECT_FALSE(temporary_left_beside(p));
 }
 
 TEST_F(SafetensorsTest, WriterPadsHeaderWithSpacesToAMultipleOfEight) {
@@ -144,7 +156,7 @@ TEST_F(SafetensorsTest, WriterPadsHeaderWithSpacesToAMultipleOfEight) {
 
 TEST_F(SafetensorsTest, WriterStreamsProducedTensors) {
   const std::string p = path("stream.safetensors");
-  std::vector<TensorDeclaration> decl = {{"a", {2, 2}}, {"b", {3}}};
+  std::vector<TensorSpec> decl = {{"a", {2, 2}}, {"b", {3}}};
   std::vector<std::size_t> calls;
   write_safetensors(p, decl, [&](std::size_t index, float* out) {
     calls.push_back(index);
@@ -162,7 +174,7 @@ TEST_F(SafetensorsTest, WriterRejectsBadDeclarationsAndLeavesNoFiles) {
   expect_invalid_input([&] { write_safetensors(p, std::vector<HostTensor>{{"a", {1}, {1}}, {"a", {1}, {2}}}); },
                        {p, "'a'", "twice"});
   expect_invalid_input([&] { write_safetensors(p, std::vector<HostTensor>{{"a", {2, 2}, {1, 2, 3}}}); },
-                       {p, "'a'", "[2,2]", "4 elements", "3 values"});
+                       {p, "'a'", "[2, 2]", "4 elements", "3 values"});
   expect_invalid_input([&] { write_safetensors(p, std::vector<HostTensor>{{"a", {-1}, {}}}); }, {"'a'", "[-1]"});
   expect_invalid_input([&] { write_safetensors(p, std::vector<HostTensor>{{"__metadata__", {1}, {1}}}); },
                        {"reserved"});
@@ -173,14 +185,14 @@ TEST_F(SafetensorsTest, WriterRejectsBadDeclarationsAndLeavesNoFiles) {
                        {"no/such/dir", "No such file"});
 
   // A producer that fails half way must not leave a partial file, under either name.
-  EXPECT_THROW(write_safetensors(p, std::vector<TensorDeclaration>{{"a", {1}}, {"b", {1}}},
+  EXPECT_THROW(write_safetensors(p, std::vector<TensorSpec>{{"a", {1}}, {"b", {1}}},
                                  [](std::size_t index, float* out) {
                                    if (index == 1) throw std::runtime_error("producer failed");
                                    out[0] = 1;
                                  }),
                std::runtime_error);
   EXPECT_FALSE(exists(p));
-  EXPECT_FALSE(exists(p + ".tmp-" + std::to_string(::getpid())));
+  EXPECT_FALSE(temporary_left_beside(p));
 }
 
 TEST_F(SafetensorsTest, MoveKeepsTheMappingAlive) {
@@ -326,7 +338,7 @@ TEST_F(SafetensorsTest, OverlappingTensors) {
 TEST_F(SafetensorsTest, MisSizedTensor) {
   const std::string h = R"({"w":{"dtype":"F32","shape":[2,3],"data_offsets":[0,16]}})";
   expect_invalid_input([&] { SafetensorsFile f(write_file("size.safetensors", h, std::string(24, '\0'))); },
-                       {"size.safetensors", "'w'", "16 bytes", "[2,3]", "needs 24 bytes"});
+                       {"size.safetensors", "'w'", "16 bytes", "[2, 3]", "needs 24 bytes"});
 }
 
 TEST_F(SafetensorsTest, NonIntegerShapes) {
@@ -391,7 +403,7 @@ TEST_F(SafetensorsTest, HandWrittenValidFileReadsBack) {
 
 // ---- model fit ----------------------------------------------------------------------------------
 
-TEST_F(SafetensorsTest, CheckTensorsFitListsEveryProblemInOneError) {
+TEST_F(SafetensorsTest, CheckWeightsFitListsEveryProblemInOneError) {
   const std::string p = path("weights.safetensors");
   write_safetensors(p, std::vector<HostTensor>{
                            {"conv1.weight", {64, 6, 7, 7}, std::vector<float>(64 * 6 * 49)},
@@ -400,34 +412,55 @@ TEST_F(SafetensorsTest, CheckTensorsFitListsEveryProblemInOneError) {
                            {"extra.b", {1}, {0}},
                        });
   SafetensorsFile file(p);
-  const std::vector<ExpectedTensor> model = {
+  const std::vector<TensorSpec> model = {
       {"conv1.weight", {64, 12, 7, 7}},
       {"conv1.bias", {64}},
       {"conv2.weight", {128, 64, 5, 5}},
       {"conv2.bias", {128}},
   };
   try {
-    check_tensors_fit(file, model, "FlowNet2");
+    check_weights_fit(file, model, "FlowNet2");
     ADD_FAILURE() << "no error";
   } catch (const Error& e) {
     EXPECT_EQ(e.kind(), ErrorKind::InvalidInput);
     EXPECT_EQ(std::string(e.what()),
-              p + " does not fit FlowNet2: missing 2 tensors (conv2.weight, conv2.bias), 2 unexpected (extra.a, "
-                  "extra.b), 1 with wrong shape (conv1.weight: file [64,6,7,7], model [64,12,7,7])");
+              "weights " + p +
+                  " do not fit FlowNet2: missing 2 tensors (conv2.weight, conv2.bias); 2 unexpected (extra.a, "
+                  "extra.b); 1 with wrong shape (conv1.weight: file [64, 6, 7, 7], model [64, 12, 7, 7])");
   }
 
-  EXPECT_NO_THROW(check_tensors_fit(file, {{"conv1.weight", {64, 6, 7, 7}}, {"conv1.bias", {64}},
+  EXPECT_NO_THROW(check_weights_fit(file, {{"conv1.weight", {64, 6, 7, 7}}, {"conv1.bias", {64}},
                                            {"extra.a", {1}}, {"extra.b", {1}}},
                                     "M"));
-  expect_invalid_input([&] { check_tensors_fit(file, {{"conv1.bias", {64}}}, "M"); },
-                       {"does not fit M: 3 unexpected (conv1.weight, extra.a, extra.b)"});
+  expect_invalid_input([&] { check_weights_fit(file, {{"conv1.bias", {64}}}, "M"); },
+                       {"do not fit M: 3 unexpected (conv1.weight, extra.a, extra.b)"});
 }
 
-TEST_F(SafetensorsTest, CheckTensorsFitRejectsUnreadableDTypes) {
+TEST_F(SafetensorsTest, CheckWeightsFitRejectsUnreadableDTypes) {
   const std::string h = R"({"w":{"dtype":"F64","shape":[1],"data_offsets":[0,8]}})";
   SafetensorsFile f(write_file("f64.safetensors", h, std::string(8, '\0')));
-  expect_invalid_input([&] { check_tensors_fit(f, {{"w", {1}}}, "Head"); },
-                       {"f64.safetensors does not fit Head", "1 with a dtype other than F32/F16 (w: F64)"});
+  expect_invalid_input([&] { check_weights_fit(f, {{"w", {1}}}, "Head"); },
+                       {"f64.safetensors do not fit Head", "1 with a dtype other than F32/F16 (w: F64)"});
+}
+
+// The check WeightSet::check uses: only the names the model owns can be unexpected, long lists are
+// cut, and a set holding none of the model's tensors is called another model's.
+TEST(WeightFit, HeldShapesOwnedNamesCutListsAndTheOtherModelHint) {
+  const std::map<std::string, Shape> held = {{"a", {2}}, {"head.x", {1}}, {"stray", {1}}};
+  WeightFitOptions flow_only;
+  flow_only.owns = [](const std::string& name) { return name.rfind("head.", 0) != 0; };
+  EXPECT_NO_THROW(check_weights_fit("weights w", {{"a", {2}}, {"stray", {1}}}, {{"a", {2}}, {"stray", {1}}}, "M",
+                                    flow_only));
+  expect_invalid_input([&] { check_weights_fit("weights w", held, {{"a", {2}}}, "M", flow_only); },
+                       {"weights w do not fit M: 1 unexpected (stray)"});
+
+  std::vector<TensorSpec> many;
+  for (int i = 0; i < 10; ++i) many.push_back({"t" + std::to_string(i), {1}});
+  expect_invalid_input([&] { check_weights_fit("weights w", {}, many, "Big"); },
+                       {"missing 10 tensors (t0, t1, t2, t3, t4, t5, t6, t7, … 2 more)",
+                        "Is this a weight file of another model?"});
+  expect_invalid_input([&] { check_weights_fit("weights w", held, {{"a", {3}}, {"b", {1}}}, "M", flow_only); },
+                       {"missing 1 tensor (b); 1 unexpected (stray); 1 with wrong shape (a: file [2], model [3])"});
 }
 
 // ---- files written by the reference implementation ------------------------------------------------

@@ -156,7 +156,7 @@ TEST(Parameters, FanInKindAndGainFollowTheSpecification) {
   for (const auto& p : model_parameters(ModelKind::FlowNet2)) {
     const bool flow_layer =
         p.name.find(".predict_flow") != std::string::npos || p.name.find(".upsampled_flow") != std::string::npos;
-    EXPECT_EQ(p.gain, flow_layer ? 0.1 : 1.0) << p.name;
+    EXPECT_EQ(p.gain, flow_layer ? 0.7 : 1.0) << p.name;
     EXPECT_EQ(p.is_bias, ends_with(p.name, ".bias")) << p.name;
     if (p.is_bias) {
       EXPECT_EQ(p.shape.size(), 1u) << p.name;

@@ -23,6 +23,7 @@
 
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/io/safetensors.hpp"
+#include "inertialnet/io/weight_fit.hpp"
 #include "support/sha256.hpp"
 
 namespace inertialnet {
@@ -99,10 +100,10 @@ const std::vector<HandComputed>& hand_computed() {
        {"-0x1.1c4bf00000000p-3", "0x1.5869e60000000p-5", "-0x1.2fa5040000000p-3", "0x1.4dd8ac0000000p-3"}},
       {1, "flownetc.conv1.0.bias", "5102633bfb4d559d156ba5dfdbb48df5e462bf0680b71e95115830e943bb9e18",
        {"0x1.36e2520000000p-8", "0x1.1779480000000p-10", "0x1.8875ec0000000p-8", "0x1.7bc3d80000000p-13"}},
-      {1, "flownets_1.upsampled_flow6_to_5.weight", "d85cd585dcee98f086b90e106354639e02235842c22fdcc6b55ad2a5447b2ad4",
-       {"-0x1.456de20000000p-4", "0x1.e15a940000000p-5", "0x1.991d7a0000000p-6", "-0x1.d745f40000000p-6"}},
-      {1, "flownetfusion.predict_flow0.weight", "4f8545c760dca46652f442bde6393ac93468a0cf8889e75ba17eee0707006704",
-       {"-0x1.293f460000000p-8", "0x1.d4771a0000000p-9", "-0x1.20993e0000000p-7", "0x1.74b9280000000p-7"}},
+      {1, "flownets_1.upsampled_flow6_to_5.weight", "d04ddde15329f95dcb1ebb46bb3820b0dc58488b1aef73c1295d8cf8636e1173",
+       {"-0x1.1cc0240000000p-1", "0x1.a52f420000000p-2", "0x1.65f9ca0000000p-3", "-0x1.9c5d360000000p-3"}},
+      {1, "flownetfusion.predict_flow0.weight", "d95bd2a658c598f473c378b2537054c2e391a4eb4b30072a565bf017a1295674",
+       {"-0x1.04175e0000000p-5", "0x1.99e8360000000p-6", "-0x1.f90c2e0000000p-5", "0x1.4622040000000p-4"}},
       {1, "flownets_d.deconv2.0.weight", "fe352de62263629d50bc72e3c7c122c4196cf2e39d4d14b2edbb5752b4ef9393",
        {"0x1.10a1700000000p-5", "0x1.38db140000000p-6", "-0x1.10e0520000000p-6", "0x1.8bc67e0000000p-7"}},
       {1, "head.fc2.weight", "92e04335e7a10dbcf1aecf8772d07995b2a0ecaeb75fceb121b5c5c1dec94321",
@@ -114,10 +115,10 @@ const std::vector<HandComputed>& hand_computed() {
       {12345, "flownetc.conv1.0.bias", "cf7c0561d2738c5fa56a29c0b8844137c578e9112ca6c20132a212093eddcac7",
        {"0x1.3b74f60000000p-11", "-0x1.44e37a0000000p-8", "-0x1.1d84c60000000p-7", "-0x1.10e2140000000p-10"}},
       {12345, "flownets_1.upsampled_flow6_to_5.weight",
-       "27de2d7d8d44302f737ac251e15ad91a5387669ba2fe18c8a87a24e3675042c6",
-       {"0x1.a2b6ee0000000p-5", "-0x1.3c7cf40000000p-4", "-0x1.0768e00000000p-5", "0x1.601e520000000p-4"}},
-      {12345, "flownetfusion.predict_flow0.weight", "4e203313efc8c26d43f62f463bb7e57584341f181e51f4be75808e0d78dfce13",
-       {"0x1.206eba0000000p-7", "-0x1.e180c60000000p-9", "0x1.a0fd400000000p-8", "0x1.e0d8060000000p-7"}},
+       "42f0e4fbd08fc2bedc9d210accc7eca6ca9ef579a553b7ffa3aca38c0ddae6db",
+       {"0x1.6e60100000000p-2", "-0x1.14ed560000000p-1", "-0x1.ccf7880000000p-3", "0x1.341a880000000p-1"}},
+      {12345, "flownetfusion.predict_flow0.weight", "015b3225835cc87d4fa887f58a3d024b243e6bd730a0efe68aaff0355bd8365f",
+       {"0x1.f8c1c40000000p-5", "-0x1.a550ae0000000p-6", "0x1.6cdd980000000p-5", "0x1.a4bd060000000p-4"}},
       {12345, "flownets_d.deconv2.0.weight", "b1ca908a2d6ca59c6fa675d155cc1a363724f446f27218e42964726b3ba4b767",
        {"0x1.f3f4520000000p-5", "0x1.cf99920000000p-5", "-0x1.7abe1e0000000p-5", "0x1.234cc60000000p-5"}},
       {12345, "head.fc2.weight", "40a63e88fbd4fd3f6997f0f28e2a8ad30b6c922f276872e5c69b6572d7ac2798",
@@ -192,9 +193,8 @@ TEST(SyntheticWeights, WholeModelAndWrittenFileAgree) {
   write_synthetic_weights(path, ModelKind::InertialNetHead, 99, head);
   {
     SafetensorsFile file(path);
-    std::vector<ExpectedTensor> expected;
-    for (const auto& s : specs) expected.push_back({s.name, s.shape});
-    EXPECT_NO_THROW(check_tensors_fit(file, expected, "InertialNetHead"));
+    const std::vector<TensorSpec> expected(specs.begin(), specs.end());
+    EXPECT_NO_THROW(check_weights_fit(file, expected, "InertialNetHead"));
     for (std::size_t i = 0; i < specs.size(); ++i) {
       EXPECT_EQ(tensors[i].name, specs[i].name);
       EXPECT_EQ(tensors[i].data, synthetic_tensor(specs[i], 99));

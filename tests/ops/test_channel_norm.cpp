@@ -5,6 +5,7 @@
 
 #include "inertialnet/ops/channel_norm.hpp"
 #include "reference/flow_ops.hpp"
+#include "ops/op_testing.hpp"
 #include "support/testing.hpp"
 
 namespace inertialnet {
@@ -12,7 +13,7 @@ namespace {
 
 using reference::Dims;
 using reference::shape_of;
-using reference::slice_channels;
+using testing::slice_channels;
 
 
 
@@ -69,16 +70,16 @@ TEST(ChannelNorm, SlicedInputsAndOutputLeaveTheRestUntouched) {
   channel_norm_difference(queue, x6_t.channels(0, 3), warped_t, concat_t.channels(9, 1));
 
   const auto after = concat_t.to_host(queue);
-  EXPECT_TRUE(testing::all_close(slice_channels(after, concat, 7, 1),
-                                 reference::channel_norm(slice_channels(concat_data, concat, 3, 2), {2, 2, 23, 37}),
+  EXPECT_TRUE(testing::all_close(slice_channels(after, shape_of(concat), 7, 1),
+                                 reference::channel_norm(slice_channels(concat_data, shape_of(concat), 3, 2), {2, 2, 23, 37}),
                                  kTolerance));
-  const auto frame1 = slice_channels(x6_data, x6, 0, 3);
+  const auto frame1 = slice_channels(x6_data, shape_of(x6), 0, 3);
   std::vector<float> diff(frame1.size());
   for (std::size_t i = 0; i < diff.size(); ++i) diff[i] = frame1[i] - warped_data[i];
-  EXPECT_TRUE(testing::all_close(slice_channels(after, concat, 9, 1), reference::channel_norm(diff, warped), kTolerance));
-  EXPECT_EQ(slice_channels(after, concat, 0, 7), slice_channels(concat_data, concat, 0, 7));
-  EXPECT_EQ(slice_channels(after, concat, 8, 1), slice_channels(concat_data, concat, 8, 1));
-  EXPECT_EQ(slice_channels(after, concat, 10, 1), slice_channels(concat_data, concat, 10, 1));
+  EXPECT_TRUE(testing::all_close(slice_channels(after, shape_of(concat), 9, 1), reference::channel_norm(diff, warped), kTolerance));
+  EXPECT_EQ(slice_channels(after, shape_of(concat), 0, 7), slice_channels(concat_data, shape_of(concat), 0, 7));
+  EXPECT_EQ(slice_channels(after, shape_of(concat), 8, 1), slice_channels(concat_data, shape_of(concat), 8, 1));
+  EXPECT_EQ(slice_channels(after, shape_of(concat), 10, 1), slice_channels(concat_data, shape_of(concat), 10, 1));
 }
 
 

@@ -2,7 +2,7 @@
 // sliced sources and destinations, FlowNet2's concatenation shapes at a 64×64 input.
 #include "inertialnet/ops/concat.hpp"
 
-#include "ops/basic_ops_testing.hpp"
+#include "ops/op_testing.hpp"
 #include "reference/basic_ops.hpp"
 
 namespace inertialnet {

@@ -9,6 +9,7 @@
 
 #include "inertialnet/ops/conv2d.hpp"
 #include "reference/conv.hpp"
+#include "ops/op_testing.hpp"
 #include "support/testing.hpp"
 
 namespace inertialnet {
@@ -31,8 +32,6 @@ struct Placement {
   std::size_t max_column_floats = 0;
 };
 
-constexpr float kSentinel = 123.25f;  // fills the wide output around the slice; must survive
-
 // FlowNet's layer kinds (docs/model_spec.md): conv = k×k, stride s, padding (k−1)/2, bias, LeakyReLU(0.1);
 // iconv = 3×3 stride 1 no activation; pred = 3×3 → 2 channels, no activation.
 ConvCase conv(const char* name, int ci, int co, int size, int k, int s = 1) {
@@ -48,45 +47,24 @@ void expect_conv_matches(const ConvCase& c, const Placement& p) {
   Queue& queue = testing::test_queue();
   reference::ConvShape s{p.batch, c.ci, c.h, c.w, c.co, c.k, c.k, c.stride, c.padding};
   const int oh = s.conv_out_h(), ow = s.conv_out_w();
-  const std::size_t in_plane = static_cast<std::size_t>(c.h) * c.w, out_plane = static_cast<std::size_t>(oh) * ow;
-  const int in_total = p.in_before + c.ci + p.in_after, out_total = p.out_before + c.co + p.out_after;
+  const std::size_t in_plane = static_cast<std::size_t>(c.h) * c.w;
 
   const auto input = testing::random_vector(static_cast<std::size_t>(p.batch) * c.ci * in_plane, 101);
   const auto weight = testing::random_vector(static_cast<std::size_t>(c.co) * c.ci * c.k * c.k, 102);
   const auto bias = c.bias ? testing::random_vector(static_cast<std::size_t>(c.co), 103) : std::vector<float>{};
   const auto expected = reference::conv2d(s, input, weight, bias, c.activation);
 
-  // The input inside a wider tensor whose other channels hold unrelated values.
-  auto wide_input = testing::random_vector(static_cast<std::size_t>(p.batch) * in_total * in_plane, 104);
-  for (int n = 0; n < p.batch; ++n) {
-    std::copy_n(input.begin() + static_cast<std::ptrdiff_t>(n * c.ci * in_plane), c.ci * in_plane,
-                wide_input.begin() + static_cast<std::ptrdiff_t>((n * in_total + p.in_before) * in_plane));
-  }
-  Tensor in_wide = Tensor::from_host(queue, {p.batch, in_total, c.h, c.w}, wide_input);
-  Tensor out_wide =
-      Tensor::from_host(queue, {p.batch, out_total, oh, ow},
-                        std::vector<float>(static_cast<std::size_t>(p.batch) * out_total * out_plane, kSentinel));
+  // The input and the output as channel slices of wider tensors whose other channels must survive.
+  const testing::Sliced in =
+      testing::embed_sliced(queue, input, {p.batch, c.ci, c.h, c.w}, p.in_before, p.in_before + p.in_after, 104);
+  const testing::Sliced out =
+      testing::make_sliced(queue, {p.batch, c.co, oh, ow}, p.out_before, p.out_before + p.out_after, 105);
   Tensor w = Tensor::from_host(queue, {c.co, c.ci, c.k, c.k}, weight);
   Tensor b = c.bias ? Tensor::from_host(queue, {c.co}, bias) : Tensor();
   Conv2dOptions options{c.stride, c.padding, c.activation, p.max_column_floats};
-  conv2d(queue, in_wide.channels(p.in_before, c.ci), w, b, out_wide.channels(p.out_before, c.co), options);
-
-  const auto got_wide = out_wide.to_host(queue);
-  std::vector<float> got;
-  std::size_t clobbered = 0;
-  for (int n = 0; n < p.batch; ++n) {
-    for (int ch = 0; ch < out_total; ++ch) {
-      const bool inside = ch >= p.out_before && ch < p.out_before + c.co;
-      const auto first = got_wide.begin() + static_cast<std::ptrdiff_t>((n * out_total + ch) * out_plane);
-      const auto last = first + static_cast<std::ptrdiff_t>(out_plane);
-      if (inside) {
-        got.insert(got.end(), first, last);
-      } else {
-        clobbered += static_cast<std::size_t>(std::count_if(first, last, [](float v) { return v != kSentinel; }));
-      }
-    }
-  }
-  EXPECT_EQ(clobbered, 0u) << "elements outside the output slice were written";
+  conv2d(queue, in.view, w, b, out.view, options);
+  EXPECT_TRUE(testing::untouched_outside(queue, out)) << "elements outside the output slice were written";
+  const auto got = testing::view_values(queue, out);
   // float32 accumulation of K = ci·k·k products of magnitude ≲ 1 against a double reference:
   // the error grows with the reduction length, so the absolute floor is sqrt(K) (the typical
   // output magnitude) and 1e-5 relative to that leaves ~10× margin over K·eps at K ≈ 10^4.

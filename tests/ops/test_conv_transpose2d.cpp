@@ -9,6 +9,7 @@
 
 #include "inertialnet/ops/conv_transpose2d.hpp"
 #include "reference/conv.hpp"
+#include "ops/op_testing.hpp"
 #include "support/testing.hpp"
 
 namespace inertialnet {
@@ -29,8 +30,6 @@ struct Placement {
   std::size_t max_column_floats = 0;
 };
 
-constexpr float kSentinel = -77.5f;  // fills the wide output around the slice; must survive
-
 // docs/model_spec.md: deconv = ConvTranspose2d(4, 2, 1) + bias + LeakyReLU(0.1); up = ConvTranspose2d(2→2,
 // 4, 2, 1) without activation, with a bias in FlowNetC/SD/Fusion and without in FlowNetS.
 DeconvCase deconv(const char* name, int ci, int co, int size) {
@@ -43,44 +42,24 @@ void expect_deconv_matches(const DeconvCase& c, const Placement& p) {
   Queue& queue = testing::test_queue();
   reference::ConvShape s{p.batch, c.ci, c.h, c.w, c.co, c.k, c.k, c.stride, c.padding};
   const int oh = s.deconv_out_h(), ow = s.deconv_out_w();
-  const std::size_t in_plane = static_cast<std::size_t>(c.h) * c.w, out_plane = static_cast<std::size_t>(oh) * ow;
-  const int in_total = p.in_before + c.ci + p.in_after, out_total = p.out_before + c.co + p.out_after;
+  const std::size_t in_plane = static_cast<std::size_t>(c.h) * c.w;
 
   const auto input = testing::random_vector(static_cast<std::size_t>(p.batch) * c.ci * in_plane, 201);
   const auto weight = testing::random_vector(static_cast<std::size_t>(c.ci) * c.co * c.k * c.k, 202);
   const auto bias = c.bias ? testing::random_vector(static_cast<std::size_t>(c.co), 203) : std::vector<float>{};
   const auto expected = reference::conv_transpose2d(s, input, weight, bias, c.activation);
 
-  auto wide_input = testing::random_vector(static_cast<std::size_t>(p.batch) * in_total * in_plane, 204);
-  for (int n = 0; n < p.batch; ++n) {
-    std::copy_n(input.begin() + static_cast<std::ptrdiff_t>(n * c.ci * in_plane), c.ci * in_plane,
-                wide_input.begin() + static_cast<std::ptrdiff_t>((n * in_total + p.in_before) * in_plane));
-  }
-  Tensor in_wide = Tensor::from_host(queue, {p.batch, in_total, c.h, c.w}, wide_input);
-  Tensor out_wide =
-      Tensor::from_host(queue, {p.batch, out_total, oh, ow},
-                        std::vector<float>(static_cast<std::size_t>(p.batch) * out_total * out_plane, kSentinel));
+  // The input and the output as channel slices of wider tensors whose other channels must survive.
+  const testing::Sliced in =
+      testing::embed_sliced(queue, input, {p.batch, c.ci, c.h, c.w}, p.in_before, p.in_before + p.in_after, 204);
+  const testing::Sliced out =
+      testing::make_sliced(queue, {p.batch, c.co, oh, ow}, p.out_before, p.out_before + p.out_after, 205);
   Tensor w = Tensor::from_host(queue, {c.ci, c.co, c.k, c.k}, weight);
   Tensor b = c.bias ? Tensor::from_host(queue, {c.co}, bias) : Tensor();
   ConvTranspose2dOptions options{c.stride, c.padding, c.activation, p.max_column_floats};
-  conv_transpose2d(queue, in_wide.channels(p.in_before, c.ci), w, b, out_wide.channels(p.out_before, c.co), options);
-
-  const auto got_wide = out_wide.to_host(queue);
-  std::vector<float> got;
-  std::size_t clobbered = 0;
-  for (int n = 0; n < p.batch; ++n) {
-    for (int ch = 0; ch < out_total; ++ch) {
-      const bool inside = ch >= p.out_before && ch < p.out_before + c.co;
-      const auto first = got_wide.begin() + static_cast<std::ptrdiff_t>((n * out_total + ch) * out_plane);
-      const auto last = first + static_cast<std::ptrdiff_t>(out_plane);
-      if (inside) {
-        got.insert(got.end(), first, last);
-      } else {
-        clobbered += static_cast<std::size_t>(std::count_if(first, last, [](float v) { return v != kSentinel; }));
-      }
-    }
-  }
-  EXPECT_EQ(clobbered, 0u) << "elements outside the output slice were written";
+  conv_transpose2d(queue, in.view, w, b, out.view, options);
+  EXPECT_TRUE(testing::untouched_outside(queue, out)) << "elements outside the output slice were written";
+  const auto got = testing::view_values(queue, out);
   // Each output sums at most ci·ceil(k/s)² float32 products of magnitude ≲ 1 (ci per GEMM
   // entry, then the taps that land on the pixel): as for conv2d, an absolute floor of sqrt(K)
   // for that reduction length K and 1e-5 relative to it.

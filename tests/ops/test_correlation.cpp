@@ -5,6 +5,7 @@
 
 #include "inertialnet/ops/correlation.hpp"
 #include "reference/flow_ops.hpp"
+#include "ops/op_testing.hpp"
 #include "support/testing.hpp"
 
 namespace inertialnet {
@@ -12,7 +13,7 @@ namespace {
 
 using reference::Dims;
 using reference::shape_of;
-using reference::slice_channels;
+using testing::slice_channels;
 
 
 
@@ -40,7 +41,7 @@ TEST_P(CorrelationTest, MatchesTheReference) {
   Queue& queue = testing::test_queue();
   const auto a = testing::random_vector(static_cast<std::size_t>(p.in.count()), 101);
   const auto b = testing::random_vector(static_cast<std::size_t>(p.in.count()), 102);
-  CorrelationParams params;
+  CorrelationOptions params;
   params.pad = p.pad;
   params.kernel_size = p.kernel;
   params.max_displacement = p.max_displacement;
@@ -124,7 +125,7 @@ TEST(Correlation, FusedLeakyReluMatchesTheReference) {
   Dims out_dims{};
   auto expected = reference::correlation(a, b, d, 20, 1, 20, 1, 2, out_dims);
   for (auto& v : expected) v = v >= 0 ? v : 0.1f * v;
-  CorrelationParams params;
+  CorrelationOptions params;
   params.activation = ActivationSpec::leaky_relu(0.1f);
   const auto got =
       correlation(queue, Tensor::from_host(queue, shape_of(d), a), Tensor::from_host(queue, shape_of(d), b), params)
@@ -154,12 +155,12 @@ TEST(Correlation, SlicedInputsAndOutputLeaveTheRestUntouched) {
   correlation(queue, t1.channels(5, in.c), t2.channels(1, in.c), to.channels(32, 441));
 
   Dims out_dims{};
-  const auto expected = reference::correlation(slice_channels(p1, parent1, 5, in.c), slice_channels(p2, parent2, 1, in.c),
+  const auto expected = reference::correlation(slice_channels(p1, shape_of(parent1), 5, in.c), slice_channels(p2, shape_of(parent2), 1, in.c),
                                                in, 20, 1, 20, 1, 2, out_dims);
   const auto after = to.to_host(queue);
-  EXPECT_TRUE(close_to_reference(slice_channels(after, parent_out, 32, 441), expected, 1, in.c));
-  EXPECT_EQ(slice_channels(after, parent_out, 0, 32), slice_channels(po, parent_out, 0, 32));
-  EXPECT_EQ(slice_channels(after, parent_out, 473, 3), slice_channels(po, parent_out, 473, 3));
+  EXPECT_TRUE(close_to_reference(slice_channels(after, shape_of(parent_out), 32, 441), expected, 1, in.c));
+  EXPECT_EQ(slice_channels(after, shape_of(parent_out), 0, 32), slice_channels(po, shape_of(parent_out), 0, 32));
+  EXPECT_EQ(slice_channels(after, shape_of(parent_out), 473, 3), slice_channels(po, shape_of(parent_out), 473, 3));
 }
 
 
@@ -179,7 +180,7 @@ TEST(Correlation, BadShapesAndSettingsAreInvalidInput) {
   testing::expect_invalid_input([&] { correlation(queue, out.channels(0, 16), a, out); }, "overlaps");
 
   auto with = [](auto change) {
-    CorrelationParams p;
+    CorrelationOptions p;
     change(p);
     return p;
   };
@@ -218,7 +219,7 @@ TEST(Correlation, BadShapesAndSettingsAreInvalidInput) {
 TEST(Correlation, OutputShapeFollowsFlowNet2PyTorch) {
   // FlowNetC keeps the spatial size; 441 channels.
   EXPECT_EQ(correlation_output_shape({2, 256, 48, 64}), (Shape{2, 441, 48, 64}));
-  CorrelationParams p;
+  CorrelationOptions p;
   p.pad = 4;
   p.kernel_size = 3;
   p.max_displacement = 4;

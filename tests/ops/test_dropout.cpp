@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "ops/basic_ops_testing.hpp"
+#include "ops/op_testing.hpp"
 #include "reference/basic_ops.hpp"
 
 namespace inertialnet {
@@ -16,22 +16,22 @@ using testing::make_sliced;
 using testing::make_tensor;
 using testing::untouched_outside;
 
-DropoutSpec training(float p, std::uint64_t seed) { return DropoutSpec{p, true, seed}; }
+DropoutOptions training(float p, std::uint64_t seed) { return DropoutOptions{p, true, seed}; }
 
 TEST(Dropout, InferenceIsTheIdentityWithoutACopy) {
   Queue& queue = testing::test_queue();
   auto in = make_sliced(queue, {3, 8, 16, 16}, 1, 2, 1);
-  const Tensor same = dropout(queue, in.view, DropoutSpec{0.3f, false, 5});
+  const Tensor same = dropout(queue, in.view, DropoutOptions{0.3f, false, 5});
   EXPECT_EQ(same.buffer(), in.view.buffer());
   EXPECT_EQ(same.offset(), in.view.offset());
   EXPECT_EQ(same.batch_stride(), in.view.batch_stride());
   EXPECT_EQ(same.shape(), in.view.shape());
 
   auto out = make_sliced(queue, {3, 8, 16, 16}, 2, 3, 2);
-  dropout(queue, in.view, out.view, DropoutSpec{0.3f, false, 5});
+  dropout(queue, in.view, out.view, DropoutOptions{0.3f, false, 5});
   EXPECT_TRUE(exactly_equal(out.view.to_host(queue), in.view.to_host(queue)));
   EXPECT_TRUE(untouched_outside(queue, out));
-  dropout(queue, in.view, in.view, DropoutSpec{});  // in place at inference: nothing to do
+  dropout(queue, in.view, in.view, DropoutOptions{});  // in place at inference: nothing to do
   EXPECT_TRUE(exactly_equal(in.whole.to_host(queue), in.original));
 }
 
@@ -121,10 +121,10 @@ TEST(Dropout, BadArgumentsAreInvalidInput) {
   Tensor a = Tensor::empty(device, {1, 8, 4, 4});
   expect_invalid_input([&] { dropout(queue, a, training(1.5f, 0)); }, "must be in [0, 1], got 1.5");
   expect_invalid_input([&] { dropout(queue, a, training(-0.1f, 0)); }, "drop probability");
-  expect_invalid_input([&] { dropout(queue, a, DropoutSpec{NAN, false, 0}); }, "drop probability");
+  expect_invalid_input([&] { dropout(queue, a, DropoutOptions{NAN, false, 0}); }, "drop probability");
   expect_invalid_input([&] { dropout(queue, a, Tensor::empty(device, {1, 8, 4, 5}), training(0.3f, 0)); },
                        "output has shape [1, 8, 4, 5] but the input has shape [1, 8, 4, 4]");
-  expect_invalid_input([&] { dropout(queue, Tensor(), training(0.3f, 0)); }, "input tensor is empty");
+  expect_invalid_input([&] { dropout(queue, Tensor(), training(0.3f, 0)); }, "input tensor is undefined");
   Tensor big = Tensor::empty(device, {1, 8, 4, 4});
   expect_invalid_input([&] { dropout(queue, big.channels(0, 4), big.channels(2, 4), training(0.3f, 0)); },
                        "overlaps the input");

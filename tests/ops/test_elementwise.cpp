@@ -2,7 +2,7 @@
 // contiguous tensors and on channel slices (inputs and outputs).
 #include "inertialnet/ops/elementwise.hpp"
 
-#include "ops/basic_ops_testing.hpp"
+#include "ops/op_testing.hpp"
 #include "reference/basic_ops.hpp"
 
 namespace inertialnet {
@@ -47,13 +47,13 @@ TEST_P(ElementwiseTest, BinaryOpsMatchTheReference) {
   EXPECT_TRUE(exactly_equal(out.view.to_host(queue), reference::sub(ha, hb)));
   EXPECT_TRUE(untouched_outside(queue, out));
 
-  axpby(queue, 1.5f, a.view, -0.25f, b.view, out.view);
+  axpby(queue, a.view, b.view, out.view, 1.5f, -0.25f);
   // Either side may contract α·a + β·b into one FMA: the results differ by at most one rounding
   // of a product, ~6e-8 of O(1) inputs; 1e-6 absolute (floor 1) allows that and nothing more.
   EXPECT_TRUE(testing::all_close(out.view.to_host(queue), reference::axpby(1.5f, ha, -0.25f, hb), 1e-6, 1.0));
   EXPECT_TRUE(untouched_outside(queue, out));
 
-  scale(queue, a.view, -20.0f, out.view);
+  scale(queue, a.view, out.view, -20.0f);
   EXPECT_TRUE(exactly_equal(out.view.to_host(queue), reference::scale(ha, -20.0f)));
   EXPECT_TRUE(untouched_outside(queue, out));
 
@@ -109,9 +109,9 @@ TEST(Elementwise, InPlaceUpdates) {
   auto t = make_sliced(queue, {3, 2, 37, 23}, 1, 4, 6);
   const auto before = t.view.to_host(queue);
 
-  scale(queue, t.view, 20.0f, t.view);
+  scale(queue, t.view, t.view, 20.0f);
   EXPECT_TRUE(exactly_equal(t.view.to_host(queue), reference::scale(before, 20.0f)));
-  scale(queue, t.view, 1.0f / 20.0f, t.view);
+  scale(queue, t.view, t.view, 1.0f / 20.0f);
   apply_activation(queue, t.view, t.view, ActivationSpec::leaky_relu(0.1f));
   const auto expected = reference::activation(reference::scale(reference::scale(before, 20.0f), 1.0f / 20.0f), 2, 0.1f);
   EXPECT_TRUE(exactly_equal(t.view.to_host(queue), expected));
@@ -152,14 +152,14 @@ TEST(Elementwise, BadShapesAndAliasingAreInvalidInput) {
   Tensor big = Tensor::empty(device, {1, 6, 8, 8});
   expect_invalid_input([&] { add(queue, a, b, a); }, "second input has shape [1, 3, 8, 9]");
   expect_invalid_input([&] { sub(queue, a, a, b); }, "output has shape [1, 3, 8, 9]");
-  expect_invalid_input([&] { axpby(queue, 1, a, 1, a, big); }, "do not broadcast");
-  expect_invalid_input([&] { scale(queue, a, 2, b); }, "scale: the output has shape");
+  expect_invalid_input([&] { axpby(queue, a, a, big, 1, 1); }, "do not broadcast");
+  expect_invalid_input([&] { scale(queue, a, b, 2); }, "scale: the output has shape");
   expect_invalid_input([&] { copy(queue, a, b); }, "copy: the destination has shape");
   expect_invalid_input([&] { apply_activation(queue, a, b, ActivationSpec::relu()); }, "activation: the output");
-  expect_invalid_input([&] { add(queue, Tensor(), a, a); }, "first input tensor is empty");
-  expect_invalid_input([&] { fill(queue, Tensor(), 0); }, "fill: the output tensor is empty");
+  expect_invalid_input([&] { add(queue, Tensor(), a, a); }, "first input tensor is undefined");
+  expect_invalid_input([&] { fill(queue, Tensor(), 0); }, "fill: the output tensor is undefined");
   // Channels [0, 3) and [1, 4) of one tensor share two channels: not an in-place update.
-  expect_invalid_input([&] { scale(queue, big.channels(0, 3), 2, big.channels(1, 3)); }, "overlaps the input");
+  expect_invalid_input([&] { scale(queue, big.channels(0, 3), big.channels(1, 3), 2); }, "overlaps the input");
   expect_invalid_input([&] { copy(queue, big.channels(0, 3), big.channels(2, 3)); }, "cannot run in place");
   expect_invalid_input([&] { add(queue, a, big.channels(1, 3), big.channels(0, 3)); }, "overlaps the second input");
   ActivationSpec unknown;

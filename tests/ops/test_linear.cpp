@@ -8,12 +8,11 @@
 
 #include "inertialnet/ops/linear.hpp"
 #include "reference/conv.hpp"
+#include "ops/op_testing.hpp"
 #include "support/testing.hpp"
 
 namespace inertialnet {
 namespace {
-
-constexpr float kSentinel = 55.5f;
 
 // Input [batch, in] stored as channels [in_before, in_before + in) of [batch, in_total] rows (or of
 // an NCHW tensor when `nchw` is given, channels of c·h·w = in features); output the same way.
@@ -26,37 +25,20 @@ struct LinearCase {
 
 void expect_linear_matches(const LinearCase& c) {
   Queue& queue = testing::test_queue();
-  const int in_total = c.in_before + c.in + c.in_after, out_total = c.out_before + c.out + c.out_after;
   const auto input = testing::random_vector(static_cast<std::size_t>(c.batch) * c.in, 301);
   const auto weight = testing::random_vector(static_cast<std::size_t>(c.out) * c.in, 302);
   const auto bias = c.bias ? testing::random_vector(static_cast<std::size_t>(c.out), 303) : std::vector<float>{};
   const auto expected = reference::linear(c.batch, c.in, c.out, input, weight, bias, c.activation);
 
-  auto wide_input = testing::random_vector(static_cast<std::size_t>(c.batch) * in_total, 304);
-  for (int n = 0; n < c.batch; ++n) {
-    std::copy_n(input.begin() + n * c.in, c.in, wide_input.begin() + n * in_total + c.in_before);
-  }
-  Tensor in_wide = Tensor::from_host(queue, {c.batch, in_total}, wide_input);
-  Tensor out_wide = Tensor::from_host(queue, {c.batch, out_total},
-                                      std::vector<float>(static_cast<std::size_t>(c.batch) * out_total, kSentinel));
+  // The input and the output as channel slices of wider rows whose other features must survive.
+  const testing::Sliced in = testing::embed_sliced(queue, input, {c.batch, c.in}, c.in_before, c.in_before + c.in_after, 304);
+  const testing::Sliced out =
+      testing::make_sliced(queue, {c.batch, c.out}, c.out_before, c.out_before + c.out_after, 305);
   Tensor w = Tensor::from_host(queue, {c.out, c.in}, weight);
   Tensor b = c.bias ? Tensor::from_host(queue, {c.out}, bias) : Tensor();
-  linear(queue, in_wide.channels(c.in_before, c.in), w, b, out_wide.channels(c.out_before, c.out), c.activation);
-
-  const auto got_wide = out_wide.to_host(queue);
-  std::vector<float> got;
-  std::size_t clobbered = 0;
-  for (int n = 0; n < c.batch; ++n) {
-    for (int j = 0; j < out_total; ++j) {
-      const float v = got_wide[static_cast<std::size_t>(n) * out_total + j];
-      if (j >= c.out_before && j < c.out_before + c.out) {
-        got.push_back(v);
-      } else if (v != kSentinel) {
-        ++clobbered;
-      }
-    }
-  }
-  EXPECT_EQ(clobbered, 0u) << "elements outside the output slice were written";
+  linear(queue, in.view, w, b, out.view, c.activation);
+  EXPECT_TRUE(testing::untouched_outside(queue, out)) << "elements outside the output slice were written";
+  const auto got = testing::view_values(queue, out);
   // float32 accumulation of `in` products of magnitude ≲ 1 against a double reference: an
   // absolute floor of sqrt(in) (the typical output magnitude) and 1e-5 relative to it.
   EXPECT_TRUE(testing::all_close(got, expected, 1e-5, std::sqrt(static_cast<double>(c.in))));
@@ -87,16 +69,12 @@ TEST(Linear, FlattensAnNchwInputLikeTorchFlatten) {
   // The head's conv3 output [3, 8, 6, 8] read as channels 2..9 of a [3, 12, 6, 8] tensor.
   Queue& queue = testing::test_queue();
   const int batch = 3, c = 8, h = 6, w = 8, in = c * h * w, out = 128;
-  const auto wide = testing::random_vector(static_cast<std::size_t>(batch) * 12 * h * w, 311);
-  std::vector<float> input;  // the slice, flattened per sample as torch.flatten(x, 1) does
-  for (int n = 0; n < batch; ++n) {
-    const auto first = wide.begin() + (n * 12 + 2) * h * w;
-    input.insert(input.end(), first, first + in);
-  }
+  const testing::Sliced x = testing::make_sliced(queue, {batch, c, h, w}, 2, 4, 311);
+  // The slice, flattened per sample as torch.flatten(x, 1) does.
+  const auto input = testing::slice_channels(x.original, x.whole.shape(), x.first, c);
   const auto weight = testing::random_vector(static_cast<std::size_t>(out) * in, 312);
   const auto bias = testing::random_vector(out, 313);
-  Tensor x = Tensor::from_host(queue, {batch, 12, h, w}, wide).channels(2, c);
-  Tensor y = linear(queue, x, Tensor::from_host(queue, {out, in}, weight), Tensor::from_host(queue, {out}, bias),
+  Tensor y = linear(queue, x.view, Tensor::from_host(queue, {out, in}, weight), Tensor::from_host(queue, {out}, bias),
                     ActivationSpec::relu());
   EXPECT_EQ(y.shape(), (Shape{batch, out}));
   EXPECT_EQ(linear_output_shape({batch, c, h, w}, {out, in}), (Shape{batch, out}));

@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "ops/basic_ops_testing.hpp"
+#include "ops/op_testing.hpp"
 #include "reference/basic_ops.hpp"
 
 namespace inertialnet {

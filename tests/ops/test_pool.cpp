@@ -2,7 +2,7 @@
 // semantics), general windows and strides, channel slices in and out, NaN propagation.
 #include "inertialnet/ops/pool.hpp"
 
-#include "ops/basic_ops_testing.hpp"
+#include "ops/op_testing.hpp"
 #include "reference/basic_ops.hpp"
 
 namespace inertialnet {
@@ -17,7 +17,7 @@ using testing::untouched_outside;
 struct Case {
   std::string name;
   Shape shape;
-  PoolSpec spec;
+  MaxPool2dOptions spec;
   bool sliced;
 };
 void PrintTo(const Case& c, std::ostream* os) { *os << c.name; }
@@ -79,7 +79,7 @@ TEST(Pool, NaNPropagatesLikePyTorch) {
   const auto expected = reference::max_pool2d(values, 1, 1, 2, 10, 2, 2);
   EXPECT_TRUE(std::isnan(expected[0]) && std::isnan(expected[1]) && std::isnan(expected[2]) && !std::isnan(expected[3]));
   EXPECT_TRUE(exactly_equal(max_pool2d(queue, wide).to_host(queue), expected));
-  EXPECT_TRUE(exactly_equal(max_pool2d(queue, wide, PoolSpec{2, 1}).to_host(queue),
+  EXPECT_TRUE(exactly_equal(max_pool2d(queue, wide, MaxPool2dOptions{2, 1}).to_host(queue),
                             reference::max_pool2d(values, 1, 1, 2, 10, 2, 1)));
 }
 
@@ -89,9 +89,9 @@ TEST(Pool, BadShapesAreInvalidInput) {
   Tensor in = Tensor::empty(device, {1, 16, 9, 7});
   expect_invalid_input([&] { max_pool2d(queue, Tensor::empty(device, {16, 9, 7})); }, "rank 4");
   expect_invalid_input([&] { max_pool2d(queue, Tensor::empty(device, {1, 1, 1, 7})); }, "window does not fit");
-  expect_invalid_input([&] { max_pool2d(queue, in, PoolSpec{8, 1}); }, "8×8 window does not fit the input [1, 16, 9, 7]");
-  expect_invalid_input([&] { max_pool2d(queue, in, PoolSpec{0, 1}); }, "at least 1");
-  expect_invalid_input([&] { max_pool2d(queue, in, PoolSpec{2, 0}); }, "at least 1");
+  expect_invalid_input([&] { max_pool2d(queue, in, MaxPool2dOptions{8, 1}); }, "8×8 window does not fit the input [1, 16, 9, 7]");
+  expect_invalid_input([&] { max_pool2d(queue, in, MaxPool2dOptions{0, 1}); }, "at least 1");
+  expect_invalid_input([&] { max_pool2d(queue, in, MaxPool2dOptions{2, 0}); }, "at least 1");
   expect_invalid_input([&] { max_pool2d(queue, in, Tensor::empty(device, {1, 16, 5, 4})); },
                        "gives [1, 16, 4, 3]");
   expect_invalid_input([&] { max_pool2d(queue, in, Tensor::empty(device, {1, 8, 4, 3})); }, "output has shape [1, 8, 4, 3]");
@@ -99,7 +99,7 @@ TEST(Pool, BadShapesAreInvalidInput) {
   Tensor big = Tensor::empty(device, {1, 4, 4, 4});
   const Tensor overlapping = big.reshaped({4, 4, 2, 2}).sample(0);
   expect_invalid_input([&] { max_pool2d(queue, big, overlapping); }, "cannot run in place");
-  expect_invalid_input([&] { max_pool2d(queue, Tensor(), in); }, "input tensor is empty");
+  expect_invalid_input([&] { max_pool2d(queue, Tensor(), in); }, "input tensor is undefined");
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 
 #include "inertialnet/ops/upsample.hpp"
 #include "reference/flow_ops.hpp"
+#include "ops/op_testing.hpp"
 #include "support/testing.hpp"
 
 namespace inertialnet {
@@ -12,7 +13,7 @@ namespace {
 
 using reference::Dims;
 using reference::shape_of;
-using reference::slice_channels;
+using testing::slice_channels;
 
 
 
@@ -38,7 +39,7 @@ TEST_P(ResizeTest, MatchesTheReference) {
   const auto input = testing::random_vector(static_cast<std::size_t>(p.in.count()), 401);
   Tensor in = Tensor::from_host(queue, shape_of(p.in), input);
   Tensor out = Tensor::empty(testing::test_device(), {p.in.n, p.in.c, p.out_h, p.out_w});
-  resize(queue, in, out, p.mode, p.scale);
+  resize(queue, in, out, {p.mode, p.scale});
   const auto got = out.to_host(queue);
   if (p.mode == Interpolation::Bilinear) {
     const auto expected = reference::upsample_bilinear(input, p.in, p.out_h, p.out_w, p.scale);
@@ -71,15 +72,15 @@ TEST(Upsample, FollowsPyTorchAlignCornersFalse) {
   // F.interpolate([[0, 1]], scale_factor=2, mode='bilinear', align_corners=False) rows are
   // [0, 0.25, 0.75, 1]: the first source coordinate −0.25 clamps to 0, the last 1.25 to the edge.
   Tensor in = Tensor::from_host(queue, {1, 1, 1, 2}, {0.0f, 1.0f});
-  auto got = upsample(queue, in, 2, Interpolation::Bilinear).to_host(queue);
+  auto got = upsample(queue, in, 2, {Interpolation::Bilinear}).to_host(queue);
   EXPECT_EQ(got, (std::vector<float>{0.0f, 0.25f, 0.75f, 1.0f, 0.0f, 0.25f, 0.75f, 1.0f}));
   // ×4: sources (x + 0.5)/4 − 0.5 = −0.375, −0.125, 0.125, 0.375, 0.625, 0.875, 1.125, 1.375.
-  got = upsample(queue, in, 4, Interpolation::Bilinear, 20.0f).to_host(queue);
+  got = upsample(queue, in, 4, {Interpolation::Bilinear, 20.0f}).to_host(queue);
   const std::vector<float> row{0.0f, 0.0f, 2.5f, 7.5f, 12.5f, 17.5f, 20.0f, 20.0f};
   for (int y = 0; y < 4; ++y)
     for (int x = 0; x < 8; ++x) EXPECT_EQ(got[static_cast<std::size_t>(y * 8 + x)], row[static_cast<std::size_t>(x)]);
   // mode='nearest', 3 → 5 columns: floor(x · 3/5) = 0, 0, 1, 1, 2.
-  got = resize(queue, Tensor::from_host(queue, {1, 1, 1, 3}, {1.0f, 2.0f, 3.0f}), 1, 5, Interpolation::Nearest)
+  got = resize(queue, Tensor::from_host(queue, {1, 1, 1, 3}, {1.0f, 2.0f, 3.0f}), 1, 5, {Interpolation::Nearest})
             .to_host(queue);
   EXPECT_EQ(got, (std::vector<float>{1.0f, 1.0f, 2.0f, 2.0f, 3.0f}));
 }
@@ -117,18 +118,18 @@ TEST(Upsample, SlicedInputAndOutputLeaveTheRestUntouched) {
   const auto concat_data = testing::random_vector(static_cast<std::size_t>(concat.count()), 422);
   Tensor src_t = Tensor::from_host(queue, shape_of(src), src_data);
   Tensor concat_t = Tensor::from_host(queue, shape_of(concat), concat_data);
-  resize(queue, src_t.channels(1, 2), concat_t.channels(3, 2), Interpolation::Nearest, 1.0f / 20.0f);
+  resize(queue, src_t.channels(1, 2), concat_t.channels(3, 2), {Interpolation::Nearest, 1.0f / 20.0f});
   resize_flow(queue, src_t.channels(2, 2), concat_t.channels(5, 2), 20.0f);
 
   const Dims flow{2, 2, 16, 16};
   const auto after = concat_t.to_host(queue);
-  EXPECT_EQ(slice_channels(after, concat, 3, 2),
-            reference::upsample_nearest(slice_channels(src_data, src, 1, 2), flow, 64, 64, 1.0f / 20.0f));
-  EXPECT_TRUE(testing::all_close(slice_channels(after, concat, 5, 2),
-                                 reference::resize_flow(slice_channels(src_data, src, 2, 2), flow, 64, 64, 20.0f),
+  EXPECT_EQ(slice_channels(after, shape_of(concat), 3, 2),
+            reference::upsample_nearest(slice_channels(src_data, shape_of(src), 1, 2), flow, 64, 64, 1.0f / 20.0f));
+  EXPECT_TRUE(testing::all_close(slice_channels(after, shape_of(concat), 5, 2),
+                                 reference::resize_flow(slice_channels(src_data, shape_of(src), 2, 2), flow, 64, 64, 20.0f),
                                  kBilinearTolerance, 80.0));
-  EXPECT_EQ(slice_channels(after, concat, 0, 3), slice_channels(concat_data, concat, 0, 3));
-  EXPECT_EQ(slice_channels(after, concat, 7, 4), slice_channels(concat_data, concat, 7, 4));
+  EXPECT_EQ(slice_channels(after, shape_of(concat), 0, 3), slice_channels(concat_data, shape_of(concat), 0, 3));
+  EXPECT_EQ(slice_channels(after, shape_of(concat), 7, 4), slice_channels(concat_data, shape_of(concat), 7, 4));
 }
 
 
@@ -136,18 +137,18 @@ TEST(Upsample, BadShapesAreInvalidInput) {
   Queue& queue = testing::test_queue();
   Device& device = testing::test_device();
   Tensor in = Tensor::empty(device, {2, 3, 8, 8});
-  testing::expect_invalid_input([&] { upsample(queue, in, 0, Interpolation::Bilinear); }, "factor 0");
-  testing::expect_invalid_input([&] { resize(queue, in, Tensor::empty(device, {2, 2, 32, 32}), Interpolation::Nearest); },
+  testing::expect_invalid_input([&] { upsample(queue, in, 0, {Interpolation::Bilinear}); }, "factor 0");
+  testing::expect_invalid_input([&] { resize(queue, in, Tensor::empty(device, {2, 2, 32, 32}), {Interpolation::Nearest}); },
                  "must have the batch and channels of the input");
-  testing::expect_invalid_input([&] { resize(queue, in, Tensor::empty(device, {1, 3, 32, 32}), Interpolation::Bilinear); },
+  testing::expect_invalid_input([&] { resize(queue, in, Tensor::empty(device, {1, 3, 32, 32}), {Interpolation::Bilinear}); },
                  "must have the batch and channels");
-  testing::expect_invalid_input([&] { resize(queue, in, 0, 16, Interpolation::Bilinear); }, "target size 0×16 is empty");
-  testing::expect_invalid_input([&] { resize(queue, Tensor::empty(device, {3, 8, 8}), 16, 16, Interpolation::Bilinear); },
+  testing::expect_invalid_input([&] { resize(queue, in, 0, 16, {Interpolation::Bilinear}); }, "target size 0×16 is empty");
+  testing::expect_invalid_input([&] { resize(queue, Tensor::empty(device, {3, 8, 8}), 16, 16, {Interpolation::Bilinear}); },
                  "must be NCHW");
   testing::expect_invalid_input([&] { resize_flow(queue, in, 16, 16); }, "must have 2 channels");
   testing::expect_invalid_input([&] { resize_flow(queue, Tensor::empty(device, {2, 2, 8, 8}), 16, -1); }, "is empty");
-  testing::expect_invalid_input([&] { resize(queue, Tensor(), 16, 16, Interpolation::Nearest); }, "undefined");
-  testing::expect_invalid_input([&] { resize(queue, in, in, Interpolation::Nearest); }, "overlaps");
+  testing::expect_invalid_input([&] { resize(queue, Tensor(), 16, 16, {Interpolation::Nearest}); }, "undefined");
+  testing::expect_invalid_input([&] { resize(queue, in, in, {Interpolation::Nearest}); }, "overlaps");
   testing::expect_invalid_input([&] { upsample_output_shape({1, 2, 0, 4}, 4); }, "empty dimension");
   EXPECT_EQ(upsample_output_shape({1, 2, 96, 128}, 4), (Shape{1, 2, 384, 512}));
 }

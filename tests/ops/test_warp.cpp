@@ -6,6 +6,7 @@
 
 #include "inertialnet/ops/warp.hpp"
 #include "reference/flow_ops.hpp"
+#include "ops/op_testing.hpp"
 #include "support/testing.hpp"
 
 namespace inertialnet {
@@ -13,7 +14,7 @@ namespace {
 
 using reference::Dims;
 using reference::shape_of;
-using reference::slice_channels;
+using testing::slice_channels;
 
 
 
@@ -134,11 +135,11 @@ TEST(Warp, SlicedInputsAndOutputLeaveTheRestUntouched) {
   warp(queue, x6_t.channels(3, 3), flows_t.channels(1, 2), concat_t.channels(6, 3));
 
   const Dims image{2, 3, 23, 37};
-  const auto expected = reference::warp(slice_channels(x6_data, x6, 3, 3), slice_channels(flow_data, flows, 1, 2), image);
+  const auto expected = reference::warp(slice_channels(x6_data, shape_of(x6), 3, 3), slice_channels(flow_data, shape_of(flows), 1, 2), image);
   const auto after = concat_t.to_host(queue);
-  EXPECT_TRUE(testing::all_close(slice_channels(after, concat, 6, 3), expected, kTolerance, 1.0));
-  EXPECT_EQ(slice_channels(after, concat, 0, 6), slice_channels(concat_data, concat, 0, 6));
-  EXPECT_EQ(slice_channels(after, concat, 9, 3), slice_channels(concat_data, concat, 9, 3));
+  EXPECT_TRUE(testing::all_close(slice_channels(after, shape_of(concat), 6, 3), expected, kTolerance, 1.0));
+  EXPECT_EQ(slice_channels(after, shape_of(concat), 0, 6), slice_channels(concat_data, shape_of(concat), 0, 6));
+  EXPECT_EQ(slice_channels(after, shape_of(concat), 9, 3), slice_channels(concat_data, shape_of(concat), 9, 3));
 }
 
 

@@ -103,24 +103,21 @@ std::vector<float> channel_norm(const std::vector<float>& input, Dims in) {
   return out;
 }
 
-std::vector<float> upsample_bilinear(const std::vector<float>& input, Dims in, int out_h, int out_w, float scale) {
+// out[n, c, y, x] = sample(plane of (n, c), y, x, ratio_y, ratio_x) · scale over the output grid;
+// the ratios are in/out sizes in float32, as PyTorch computes them.
+template <class Sample>
+std::vector<float> resample(const std::vector<float>& input, Dims in, int out_h, int out_w, float scale,
+                            Sample sample) {
   const Dims out_dims{in.n, in.c, out_h, out_w};
   const float ratio_y = static_cast<float>(in.h) / static_cast<float>(out_h);
   const float ratio_x = static_cast<float>(in.w) / static_cast<float>(out_w);
   std::vector<float> out(static_cast<std::size_t>(out_dims.count()));
   for (int n = 0; n < in.n; ++n) {
     for (int c = 0; c < in.c; ++c) {
+      const auto at = [&](int yy, int xx) { return input[static_cast<std::size_t>(index(in, n, c, yy, xx))]; };
       for (int y = 0; y < out_h; ++y) {
-        const float sy = source_coordinate(ratio_y, y);
-        const int y0 = static_cast<int>(sy), y1 = std::min(y0 + 1, in.h - 1);
-        const float wy1 = sy - static_cast<float>(y0), wy0 = 1 - wy1;
         for (int x = 0; x < out_w; ++x) {
-          const float sx = source_coordinate(ratio_x, x);
-          const int x0 = static_cast<int>(sx), x1 = std::min(x0 + 1, in.w - 1);
-          const float wx1 = sx - static_cast<float>(x0), wx0 = 1 - wx1;
-          const auto at = [&](int yy, int xx) { return input[static_cast<std::size_t>(index(in, n, c, yy, xx))]; };
-          const float value = wy0 * (wx0 * at(y0, x0) + wx1 * at(y0, x1)) + wy1 * (wx0 * at(y1, x0) + wx1 * at(y1, x1));
-          out[static_cast<std::size_t>(index(out_dims, n, c, y, x))] = value * scale;
+          out[static_cast<std::size_t>(index(out_dims, n, c, y, x))] = sample(at, y, x, ratio_y, ratio_x) * scale;
         }
       }
     }
@@ -128,24 +125,24 @@ std::vector<float> upsample_bilinear(const std::vector<float>& input, Dims in, i
   return out;
 }
 
+std::vector<float> upsample_bilinear(const std::vector<float>& input, Dims in, int out_h, int out_w, float scale) {
+  return resample(input, in, out_h, out_w, scale, [&](const auto& at, int y, int x, float ratio_y, float ratio_x) {
+    const float sy = source_coordinate(ratio_y, y);
+    const int y0 = static_cast<int>(sy), y1 = std::min(y0 + 1, in.h - 1);
+    const float wy1 = sy - static_cast<float>(y0), wy0 = 1 - wy1;
+    const float sx = source_coordinate(ratio_x, x);
+    const int x0 = static_cast<int>(sx), x1 = std::min(x0 + 1, in.w - 1);
+    const float wx1 = sx - static_cast<float>(x0), wx0 = 1 - wx1;
+    return wy0 * (wx0 * at(y0, x0) + wx1 * at(y0, x1)) + wy1 * (wx0 * at(y1, x0) + wx1 * at(y1, x1));
+  });
+}
+
 std::vector<float> upsample_nearest(const std::vector<float>& input, Dims in, int out_h, int out_w, float scale) {
-  const Dims out_dims{in.n, in.c, out_h, out_w};
-  const float ratio_y = static_cast<float>(in.h) / static_cast<float>(out_h);
-  const float ratio_x = static_cast<float>(in.w) / static_cast<float>(out_w);
-  std::vector<float> out(static_cast<std::size_t>(out_dims.count()));
-  for (int n = 0; n < in.n; ++n) {
-    for (int c = 0; c < in.c; ++c) {
-      for (int y = 0; y < out_h; ++y) {
-        const int sy = std::min(static_cast<int>(std::floor(static_cast<float>(y) * ratio_y)), in.h - 1);
-        for (int x = 0; x < out_w; ++x) {
-          const int sx = std::min(static_cast<int>(std::floor(static_cast<float>(x) * ratio_x)), in.w - 1);
-          out[static_cast<std::size_t>(index(out_dims, n, c, y, x))] =
-              input[static_cast<std::size_t>(index(in, n, c, sy, sx))] * scale;
-        }
-      }
-    }
-  }
-  return out;
+  return resample(input, in, out_h, out_w, scale, [&](const auto& at, int y, int x, float ratio_y, float ratio_x) {
+    const int sy = std::min(static_cast<int>(std::floor(static_cast<float>(y) * ratio_y)), in.h - 1);
+    const int sx = std::min(static_cast<int>(std::floor(static_cast<float>(x) * ratio_x)), in.w - 1);
+    return at(sy, sx);
+  });
 }
 
 std::vector<float> resize_flow(const std::vector<float>& flow, Dims in, int out_h, int out_w, float scale) {

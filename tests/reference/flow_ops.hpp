@@ -21,17 +21,6 @@ inline std::ostream& operator<<(std::ostream& out, Dims d) {
 }
 inline Shape shape_of(Dims d) { return {d.n, d.c, d.h, d.w}; }
 
-// Channels [first, first + count) of each sample of a contiguous NCHW vector.
-inline std::vector<float> slice_channels(const std::vector<float>& data, Dims d, int first, int count) {
-  const std::size_t plane = static_cast<std::size_t>(d.h) * static_cast<std::size_t>(d.w);
-  std::vector<float> out;
-  for (int n = 0; n < d.n; ++n) {
-    const auto begin = data.begin() + static_cast<std::ptrdiff_t>((static_cast<std::size_t>(n) * static_cast<std::size_t>(d.c) + static_cast<std::size_t>(first)) * plane);
-    out.insert(out.end(), begin, begin + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(count) * plane));
-  }
-  return out;
-}
-
 // flownet2-pytorch's Correlation; accumulated in double. Returns [n, D², h_out, w_out] and sets
 // `out` to those dimensions.
 std::vector<float> correlation(const std::vector<float>& f1, const std::vector<float>& f2, Dims in, int pad,

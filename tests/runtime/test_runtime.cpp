@@ -1,6 +1,8 @@
 // Devices, queues, embedded kernels and tensors on the real OpenCL platform (PoCL in CI).
 #include <algorithm>
+#include <cstdint>
 #include <cstdlib>
+#include <string_view>
 
 #include "support/testing.hpp"
 
@@ -40,6 +42,26 @@ TEST(EmbeddedKernels, AreListedAndCarryTheirSource) {
   EXPECT_NE(std::find(families.begin(), families.end(), "elementwise"), families.end());
   EXPECT_NE(embedded_kernel_source("elementwise").find("__kernel void fill"), std::string::npos);
   EXPECT_THROW(embedded_kernel_source("nosuch"), Error);
+}
+
+// A kernel file's `#include "common.cl"` is replaced by the shared helpers when embedded; the
+// helper file itself is not a family.
+TEST(EmbeddedKernels, InlineTheSharedHelpers) {
+  const auto families = embedded_kernel_families();
+  EXPECT_EQ(std::find(families.begin(), families.end(), "common"), families.end());
+  for (const char* family : {"bias_activation", "col2im", "correlation", "elementwise"}) {
+    const std::string_view source = embedded_kernel_source(family);
+    EXPECT_NE(source.find("#define ACTIVATE"), std::string::npos) << family;
+    EXPECT_EQ(source.find("#include"), std::string::npos) << family;
+  }
+}
+
+TEST(KernelDefines, SpellEachValueOneWay) {
+  EXPECT_EQ(KernelDefines().str(), "");
+  EXPECT_EQ(KernelDefines().add("KH", std::size_t{3}).add("PAD", -1).add("HAS_BIAS", true).str(),
+            "-DKH=3 -DPAD=-1 -DHAS_BIAS=1");
+  EXPECT_EQ(KernelDefines().add("NEGATIVE_SLOPE", 0.5f).add(KernelDefines().add("X", false)).str(),
+            "-DNEGATIVE_SLOPE=0x1p-1f -DX=0");
 }
 
 // An embedded kernel round trip on a size that is not a multiple of the work-group size.
@@ -112,6 +134,19 @@ TEST(Errors, AFailedLaunchNamesTheCallTheErrorTheDeviceAndTheKernel) {
     EXPECT_NE(message.find(test_device().info().name), std::string::npos) << message;
     EXPECT_NE(message.find("elementwise/fill"), std::string::npos) << message;
   }
+}
+
+// Sizes are narrowed to the kernels' int by set_args; one that does not fit is refused by name.
+TEST(Errors, ArgumentsTooLargeForAnIntAreRefused) {
+  Queue& queue = test_queue();
+  Kernel& fill = queue.kernel("elementwise", "fill");
+  Tensor t = Tensor::empty(test_device(), {8});
+  fill.set_args(t, std::size_t{8}, 1.0f);
+  queue.launch(fill, 8);
+  EXPECT_EQ(t.to_host(queue), std::vector<float>(8, 1.0f));
+  testing::expect_invalid_input([&] { fill.set_args(t, std::size_t{1} << 31, 1.0f); },
+                                "kernel elementwise/fill: argument 2 = 2147483648 does not fit");
+  testing::expect_invalid_input([&] { fill.set_args(t, -(std::int64_t{1} << 40), 1.0f); }, "elementwise/fill");
 }
 
 TEST(Errors, UnknownKernelNamesAreReported) {

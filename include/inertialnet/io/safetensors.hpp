@@ -1,4 +1,5 @@
-// safetensors weight files: a memory-mapped, fully validated reader and an atomic float32 writer.
+// safetensors weight files: the format's element types and a memory-mapped, fully validated
+// reader (the writer is safetensors_writer.hpp, the model-fit check weight_fit.hpp).
 //
 // Format (https://github.com/huggingface/safetensors): 8-byte little-endian header length N, N
 // bytes of UTF-8 JSON {name: {"dtype", "shape", "data_offsets": [begin, end]}, "__metadata__":
@@ -9,11 +10,12 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <functional>
 #include <map>
 #include <memory>
 #include <string>
 #include <vector>
+
+#include "inertialnet/core/tensor_spec.hpp"
 
 namespace inertialnet {
 
@@ -24,19 +26,15 @@ enum class DType { BOOL, U8, I8, F8_E5M2, F8_E4M3, I16, U16, F16, BF16, I32, U32
 // "F32", "F16", … exactly as spelled in the file.
 const char* dtype_name(DType dtype);
 std::size_t dtype_size(DType dtype);  // bytes per element
+// True for the dtypes SafetensorsFile::to_float32 reads: F32 and F16.
+bool reads_as_float32(DType dtype);
 
 // One tensor's header entry, validated: data_end - data_begin == numel * dtype_size.
-struct TensorInfo {
-  std::string name;
+struct TensorInfo : TensorSpec {
   DType dtype = DType::F32;
-  std::vector<int64_t> shape;
   uint64_t data_begin = 0;  // relative to the start of the data section
   uint64_t data_end = 0;
-  int64_t numel() const;
 };
-
-// "[64,6,7,7]" — the form used in every shape message of the library's weight handling.
-std::string shape_to_string(const std::vector<int64_t>& shape);
 
 // A safetensors file, memory-mapped read-only for the lifetime of the object. Move-only.
 class SafetensorsFile {
@@ -77,48 +75,5 @@ class SafetensorsFile {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
-
-// What the writer needs of one tensor. The data is produced on demand, one tensor at a time, so
-// that a full-size FlowNet2 (≈650 MB) never needs to sit in memory twice.
-struct TensorDeclaration {
-  std::string name;
-  std::vector<int64_t> shape;
-};
-
-// Fills `out` (numel floats) with the data of tensor `index` of the declaration list.
-using TensorProducer = std::function<void(std::size_t index, float* out)>;
-
-// Writes F32 tensors, in the given order, with `metadata` as "__metadata__" (omitted when empty).
-// The header is padded with spaces to a multiple of 8 bytes, as the reference implementation
-// does, so every tensor starts 8-byte aligned. The file is written to a temporary beside `path`
-// and renamed into place, so a crash never leaves a half-written weight file under the final
-// name. Throws invalid_input for bad declarations (empty or duplicate names, negative
-// dimensions, the reserved name "__metadata__") and runtime_error for I/O failures.
-void write_safetensors(const std::string& path, const std::vector<TensorDeclaration>& tensors,
-                       const TensorProducer& produce,
-                       const std::map<std::string, std::string>& metadata = {});
-
-// Convenience: tensors already in memory.
-struct HostTensor {
-  std::string name;
-  std::vector<int64_t> shape;
-  std::vector<float> data;
-};
-void write_safetensors(const std::string& path, const std::vector<HostTensor>& tensors,
-                       const std::map<std::string, std::string>& metadata = {});
-
-// What a model expects of a weight file: tensor names with their shapes.
-struct ExpectedTensor {
-  std::string name;
-  std::vector<int64_t> shape;
-};
-
-// Checks that `file` holds exactly the tensors in `expected`, with those shapes and a dtype that
-// to_float32() reads. Throws ONE invalid_input listing every missing, unexpected, mis-shaped and
-// unreadable tensor, e.g. "weights.safetensors does not fit FlowNet2: missing 3 tensors (…),
-// 2 unexpected (…), 1 with wrong shape (x: file [64,6,7,7], model [64,12,7,7])".
-// `model_name` is what the message calls the model.
-void check_tensors_fit(const SafetensorsFile& file, const std::vector<ExpectedTensor>& expected,
-                       const std::string& model_name);
 
 }  // namespace inertialnet

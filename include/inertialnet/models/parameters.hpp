@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "inertialnet/core/tensor_spec.hpp"
+
 namespace inertialnet {
 
 enum class LayerKind { Conv2d, ConvTranspose2d, Linear };
@@ -14,15 +16,14 @@ enum class LayerKind { Conv2d, ConvTranspose2d, Linear };
 // "Conv2d", "ConvTranspose2d", "Linear".
 const char* to_string(LayerKind kind);
 
-struct ParameterSpec {
-  std::string name;             // e.g. "flownetc.conv1.0.weight"
-  std::vector<int64_t> shape;   // Conv2d/Linear [co, ci, k, k] / [out, in]; ConvTranspose2d [ci, co, 4, 4]
+// One tensor of a network: its name (e.g. "flownetc.conv1.0.weight") and shape (Conv2d/Linear
+// [co, ci, k, k] / [out, in]; ConvTranspose2d [ci, co, 4, 4]; biases [co]), and what the
+// synthetic weights need to know of the layer it belongs to.
+struct ParameterSpec : TensorSpec {
   LayerKind kind = LayerKind::Conv2d;
   bool is_bias = false;
   int64_t fan_in = 0;           // of the layer the tensor belongs to (also given for its bias)
   double gain = 1.0;            // of the layer the tensor belongs to (also given for its bias)
-
-  int64_t numel() const;
 };
 
 // What a weight file holds; its string form is stored as metadata "inertialnet.model".

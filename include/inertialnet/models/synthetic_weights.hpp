@@ -12,7 +12,7 @@
 
 #include "inertialnet/core/random.hpp"
 #include "inertialnet/models/parameters.hpp"
-#include "inertialnet/io/safetensors.hpp"
+#include "inertialnet/io/safetensors_writer.hpp"
 
 namespace inertialnet {
 

@@ -5,7 +5,7 @@
 // so each variant is compiled once and the branch disappears from the inner loop.
 #pragma once
 
-#include <string>
+#include "inertialnet/runtime/kernel_defines.hpp"
 
 namespace inertialnet {
 
@@ -22,6 +22,6 @@ struct ActivationSpec {
 
 // "-DACTIVATION=2 -DNEGATIVE_SLOPE=0x1.99999ap-4f": the slope is written as a hex float so the
 // kernel multiplies by exactly the float the host holds.
-std::string activation_defines(const ActivationSpec& activation);
+KernelDefines activation_defines(const ActivationSpec& activation);
 
 }  // namespace inertialnet

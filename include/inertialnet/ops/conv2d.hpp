@@ -43,10 +43,4 @@ void conv2d(Queue& queue, const Tensor& input, const Tensor& weight, const Tenso
 Tensor conv2d(Queue& queue, const Tensor& input, const Tensor& weight, const Tensor& bias,
               const Conv2dOptions& options);
 
-// The epilogue of the GEMM-based ops, in place: x[n, c, …] = activation(x[n, c, …] + bias[c])
-// for every channel c of dimension 1 (for a rank-2 tensor [N, F] the features are the
-// channels). `bias` may be undefined (activation only); with neither, nothing is enqueued.
-// `x` may be a channel slice.
-void add_bias_activation(Queue& queue, const Tensor& x, const Tensor& bias, const ActivationSpec& activation);
-
 }  // namespace inertialnet

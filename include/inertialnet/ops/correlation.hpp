@@ -19,7 +19,7 @@
 
 namespace inertialnet {
 
-struct CorrelationParams {
+struct CorrelationOptions {
   int pad = 20;
   int kernel_size = 1;  // odd
   int max_displacement = 20;
@@ -33,7 +33,7 @@ struct CorrelationParams {
   int vector_width = 0;
 
   // FlowNetC's layer.
-  static CorrelationParams flownetc() { return {}; }
+  static CorrelationOptions flownetc() { return {}; }
 
   int kernel_radius() const { return (kernel_size - 1) / 2; }
   int displacement_radius() const { return max_displacement / stride2; }
@@ -44,14 +44,14 @@ struct CorrelationParams {
 // The output shape for inputs of shape `input` (both inputs share it). Throws invalid_input for
 // impossible settings: an even or non-positive kernel, non-positive strides, a negative pad or
 // displacement, a max displacement exceeding the pad, or an input too small for any output.
-Shape correlation_output_shape(const Shape& input, const CorrelationParams& params = {});
+Shape correlation_output_shape(const Shape& input, const CorrelationOptions& options = {});
 
 // Writes the correlation of `input1` and `input2` into `output` (preallocated, shape
 // correlation_output_shape; it and the inputs may be channel slices of larger tensors). Each
 // input is first copied into a zero-padded temporary from the queue's pool (for FlowNetC at
 // 512×384: 3.1 MB for f1, 5.1 MB for f2), so the kernel's inner loop needs no bounds checks.
 void correlation(Queue& queue, const Tensor& input1, const Tensor& input2, const Tensor& output,
-                 const CorrelationParams& params = {});
-Tensor correlation(Queue& queue, const Tensor& input1, const Tensor& input2, const CorrelationParams& params = {});
+                 const CorrelationOptions& options = {});
+Tensor correlation(Queue& queue, const Tensor& input1, const Tensor& input2, const CorrelationOptions& options = {});
 
 }  // namespace inertialnet

@@ -17,17 +17,17 @@
 
 namespace inertialnet {
 
-struct DropoutSpec {
+struct DropoutOptions {
   float p = 0.3f;            // drop probability, in [0, 1]
   bool training = false;     // false: identity
   std::uint64_t seed = 0;
 };
 
 // Inference returns `input` itself; training returns a new tensor.
-Tensor dropout(Queue& queue, const Tensor& input, const DropoutSpec& spec);
+Tensor dropout(Queue& queue, const Tensor& input, const DropoutOptions& options);
 
 // Into a preallocated output of the same shape (in place allowed). At inference this is a copy,
 // or nothing when output is input.
-void dropout(Queue& queue, const Tensor& input, const Tensor& output, const DropoutSpec& spec);
+void dropout(Queue& queue, const Tensor& input, const Tensor& output, const DropoutOptions& options);
 
 }  // namespace inertialnet

@@ -23,10 +23,10 @@ void sub(Queue& queue, const Tensor& a, const Tensor& b, const Tensor& out);
 Tensor sub(Queue& queue, const Tensor& a, const Tensor& b);
 
 // out = alpha·a + beta·b
-void axpby(Queue& queue, float alpha, const Tensor& a, float beta, const Tensor& b, const Tensor& out);
+void axpby(Queue& queue, const Tensor& a, const Tensor& b, const Tensor& out, float alpha, float beta);
 
 // out = s·a; out may be a itself (FlowNet2's ·20 and /20 on flows).
-void scale(Queue& queue, const Tensor& a, float s, const Tensor& out);
+void scale(Queue& queue, const Tensor& a, const Tensor& out, float s);
 
 // Every element of out set to `value`.
 void fill(Queue& queue, const Tensor& out, float value);

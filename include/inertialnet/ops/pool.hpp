@@ -9,15 +9,15 @@
 
 namespace inertialnet {
 
-struct PoolSpec {
+struct MaxPool2dOptions {
   int kernel = 2;  // square window
   int stride = 2;
 };
 
 // [N, C, floor((H − k)/s) + 1, floor((W − k)/s) + 1]; invalid_input if the window does not fit.
-Shape max_pool_output_shape(const Shape& input, const PoolSpec& spec = {});
+Shape max_pool_output_shape(const Shape& input, const MaxPool2dOptions& options = {});
 
-void max_pool2d(Queue& queue, const Tensor& input, const Tensor& output, const PoolSpec& spec = {});
-Tensor max_pool2d(Queue& queue, const Tensor& input, const PoolSpec& spec = {});
+void max_pool2d(Queue& queue, const Tensor& input, const Tensor& output, const MaxPool2dOptions& options = {});
+Tensor max_pool2d(Queue& queue, const Tensor& input, const MaxPool2dOptions& options = {});
 
 }  // namespace inertialnet

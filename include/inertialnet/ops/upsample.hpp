@@ -20,17 +20,22 @@ namespace inertialnet {
 
 enum class Interpolation { Bilinear, Nearest };
 
+struct ResizeOptions {
+  Interpolation mode = Interpolation::Bilinear;
+  float scale = 1.0f;  // multiplies every output value
+};
+
 // [N, C, H·factor, W·factor]; invalid_input unless the input is a non-empty NCHW shape and
 // factor ≥ 1.
 Shape upsample_output_shape(const Shape& input, int factor);
 
 // Resamples `input` to `output`'s spatial size (any size, up or down; N and C must match);
 // out = scale · interpolated value. Input and output may be channel slices.
-void resize(Queue& queue, const Tensor& input, const Tensor& output, Interpolation mode, float scale = 1.0f);
-Tensor resize(Queue& queue, const Tensor& input, std::int64_t height, std::int64_t width, Interpolation mode,
-              float scale = 1.0f);
+void resize(Queue& queue, const Tensor& input, const Tensor& output, const ResizeOptions& options = {});
+Tensor resize(Queue& queue, const Tensor& input, std::int64_t height, std::int64_t width,
+              const ResizeOptions& options = {});
 // Integer-factor upsampling, the FlowNet2 steps (bilinear ×4 · 20, nearest ×4 · 20, …).
-Tensor upsample(Queue& queue, const Tensor& input, int factor, Interpolation mode, float scale = 1.0f);
+Tensor upsample(Queue& queue, const Tensor& input, int factor, const ResizeOptions& options = {});
 
 // Resizes a flow field [N, 2, H, W] (u then v, in pixels) bilinearly to `output`'s [N, 2, H', W']
 // and rescales the vectors to the new pixel grid: u · (W'/W) · scale, v · (H'/H) · scale.

@@ -1,4 +1,4 @@
-// The --device grammar (DESIGN.md §5):
+// The --device grammar (docs/architecture.md, "Devices and the program cache"):
 //   N            global device index                 --device 1
 //   P:D          platform index : device index       --device 0:1
 //   cpu|gpu|accelerator  the first device of that type

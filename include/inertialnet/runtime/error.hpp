@@ -55,3 +55,17 @@ void check_cl(cl_int status, const char* call, const ClSite& site = {});
 void check_clblast(int status, const char* routine, const ClSite& site = {});
 
 }  // namespace inertialnet
+
+// The name of an OpenCL function as the compiler spells it: INERTIALNET_CL_NAME(clFinish) is
+// "clFinish", and a misspelt name does not compile. For calls whose status is inspected before
+// it is checked: check_cl(status, INERTIALNET_CL_NAME(clCreateKernel), site).
+#define INERTIALNET_CL_NAME(function) (static_cast<void>(&function), #function)
+
+// Calls `function(arguments…)`, which returns its cl_int status, and checks it; an error names
+// the function. `site` is an lvalue or a parenthesised expression (a brace initialiser's comma
+// would split the macro's arguments).
+#define INERTIALNET_CHECK_CL(site, function, ...) ::inertialnet::check_cl(function(__VA_ARGS__), #function, site)
+
+namespace inertialnet {
+
+}  // namespace inertialnet

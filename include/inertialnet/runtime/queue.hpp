@@ -19,6 +19,7 @@
 
 #include "inertialnet/runtime/cl_handle.hpp"
 #include "inertialnet/runtime/error.hpp"
+#include "inertialnet/runtime/kernel_defines.hpp"
 #include "inertialnet/runtime/tensor.hpp"
 
 namespace inertialnet {
@@ -59,13 +60,22 @@ class Kernel {
   const std::string& label() const noexcept { return label_; }  // "family/kernel"
   const ClSite& site() const noexcept { return site_; }
 
-  // Sets all arguments in order; a Tensor expands to (buffer, int offset).
+  // Sets all arguments in order; a Tensor expands to (buffer, int offset). Kernels index with
+  // `int`, so 64-bit integers (sizes, element counts, tensor dimensions) are narrowed to int
+  // here, and one that does not fit throws invalid_input naming the kernel and the argument; a
+  // kernel argument that really is 64-bit (`ulong`) is passed as ULongArg. Other values
+  // (float, int, cl_uint, …) are passed as they are.
   template <class... Args>
   Kernel& set_args(const Args&... args) {
     cl_uint index = 0;
     (set(index, args), ...);
     return *this;
   }
+
+  // A kernel argument declared `ulong`: set_args passes it as 64 bits instead of narrowing it.
+  struct ULongArg {
+    cl_ulong value;
+  };
 
  private:
   template <class T>
@@ -75,11 +85,19 @@ class Kernel {
       set_raw(index++, sizeof(cl_mem), &buffer);
       const cl_int offset = value.offset_int();
       set_raw(index++, sizeof(cl_int), &offset);
+    } else if constexpr (std::is_same_v<T, ULongArg>) {
+      set_raw(index++, sizeof(cl_ulong), &value.value);
+    } else if constexpr (std::is_integral_v<T> && sizeof(T) > sizeof(cl_int)) {
+      const cl_int narrowed = narrow(index, std::is_signed_v<T>, static_cast<long long>(value),
+                                     static_cast<unsigned long long>(value));
+      set_raw(index++, sizeof(cl_int), &narrowed);
     } else {
       static_assert(std::is_trivially_copyable_v<T>, "kernel arguments are plain values");
       set_raw(index++, sizeof(T), &value);
     }
   }
+  // `value` as an int, or invalid_input naming this kernel and argument `index`.
+  cl_int narrow(cl_uint index, bool is_signed, long long value, unsigned long long unsigned_value) const;
   void set_raw(cl_uint index, std::size_t size, const void* value);
 
   KernelHandle handle_;
@@ -102,7 +120,8 @@ class Queue {
 
   // The kernel `name` of the embedded family `family` built with `defines`; created once per
   // queue and reused.
-  Kernel& kernel(const std::string& family, const std::string& name, const std::string& defines = {});
+  Kernel& kernel(const std::string& family, const std::string& name, const KernelDefines& defines = {});
+  Kernel& kernel(const std::string& family, const std::string& name, const std::string& defines);
 
   // Enqueues `kernel` over `global` work-items. With `local` given, global is rounded up to a
   // multiple of it (kernels guard their index against the true size). Returns the event when

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "inertialnet/core/tensor_spec.hpp"
 #include "inertialnet/runtime/buffer_pool.hpp"
 
 namespace inertialnet {
@@ -19,8 +20,6 @@ namespace inertialnet {
 class Device;
 class Queue;
 
-using Shape = std::vector<std::int64_t>;
-std::string to_string(const Shape& shape);  // "[1, 3, 96, 128]"
 std::int64_t element_count(const Shape& shape);
 
 class Tensor {

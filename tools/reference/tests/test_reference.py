@@ -55,13 +55,13 @@ def test_weight_and_bias_formulas():
     seed = 7
     w = sy.synthetic_tensor("x.predict_flow3.weight", (2, 5, 3, 3), "conv", seed)
     u = sy.uniform("x.predict_flow3.weight", 90, seed)
-    assert np.array_equal(w.reshape(-1), ((u * math.sqrt(6.0 / 45)) * 0.1).astype(np.float32))
+    assert np.array_equal(w.reshape(-1), ((u * math.sqrt(6.0 / 45)) * 0.7).astype(np.float32))
     b = sy.synthetic_tensor("x.conv1.0.bias", (64,), "conv", seed)
     assert np.array_equal(b, (0.01 * sy.uniform("x.conv1.0.bias", 64, seed)).astype(np.float32))
     d = sy.synthetic_tensor("deconv5.0.weight", (8, 3, 4, 4), "deconv", seed)
     ud = sy.uniform("deconv5.0.weight", d.size, seed)
     assert np.array_equal(d.reshape(-1), (ud * math.sqrt(6.0 / 32)).astype(np.float32))
-    assert sy.gain_for("flownetc.upsampled_flow6_to_5.weight") == 0.1
+    assert sy.gain_for("flownetc.upsampled_flow6_to_5.weight") == 0.7
     assert sy.gain_for("flownetc.conv1.0.weight") == 1.0
     assert sy.fan_in_for("linear", (128, 384)) == 384
     u_all = sy.uniform("range", 200000, 3)

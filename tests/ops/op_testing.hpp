@@ -1,8 +1,9 @@
-// Helpers for the suites of the memory-bound ops: views that are channel slices of a larger,
-// randomly filled tensor (to check that ops read and write only their view), exact comparison
-// and invalid-input expectations.
+// Helpers for the op suites: the one slice harness (views that are channel slices of a larger,
+// randomly filled tensor, to check that ops read and write only their view, and the host side of
+// such slices) and exact comparison.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -11,6 +12,21 @@
 #include "support/testing.hpp"
 
 namespace inertialnet::testing {
+
+// Channels [first, first + count) of each sample of a contiguous host tensor of `shape` (any
+// rank ≥ 2), in order.
+inline std::vector<float> slice_channels(const std::vector<float>& data, const Shape& shape, std::int64_t first,
+                                         std::int64_t count) {
+  const std::int64_t channels = shape[1];
+  const std::int64_t inner = element_count(shape) / (shape[0] * channels);
+  std::vector<float> out;
+  out.reserve(static_cast<std::size_t>(shape[0] * count * inner));
+  for (std::int64_t n = 0; n < shape[0]; ++n) {
+    const auto begin = data.begin() + static_cast<std::ptrdiff_t>((n * channels + first) * inner);
+    out.insert(out.end(), begin, begin + static_cast<std::ptrdiff_t>(count * inner));
+  }
+  return out;
+}
 
 // `view` is channels [first, first + shape[1]) of `whole` = [N, shape[1] + extra, …], which is
 // filled with random values recorded in `original`.
@@ -31,6 +47,31 @@ inline Sliced make_sliced(Queue& queue, Shape shape, std::int64_t first, std::in
   s.view = s.whole.channels(first, shape[1]);
   s.first = first;
   return s;
+}
+
+// Given view values (a contiguous host tensor of `shape`) at channels [first, first + shape[1])
+// of a wider tensor whose other channels are random from `seed`.
+inline Sliced embed_sliced(Queue& queue, const std::vector<float>& values, Shape shape, std::int64_t first,
+                           std::int64_t extra, std::uint32_t seed) {
+  Sliced s;
+  Shape whole_shape = shape;
+  whole_shape[1] += extra;
+  s.original = random_vector(static_cast<std::size_t>(element_count(whole_shape)), seed);
+  const std::int64_t sample = element_count(shape) / shape[0];
+  const std::int64_t inner = sample / shape[1];
+  for (std::int64_t n = 0; n < shape[0]; ++n) {
+    std::copy_n(values.begin() + static_cast<std::ptrdiff_t>(n * sample), sample,
+                s.original.begin() + static_cast<std::ptrdiff_t>((n * whole_shape[1] + first) * inner));
+  }
+  s.whole = Tensor::from_host(queue, whole_shape, s.original);
+  s.view = s.whole.channels(first, shape[1]);
+  s.first = first;
+  return s;
+}
+
+// The view's current values, as a contiguous host tensor.
+inline std::vector<float> view_values(Queue& queue, const Sliced& s) {
+  return slice_channels(s.whole.to_host(queue), s.whole.shape(), s.first, s.view.dim(1));
 }
 
 // A contiguous tensor, or a channel slice (2 channels before, 3 after) of a larger one.

@@ -1,0 +1,82 @@
+#include "runtime/atomic_file.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cstring>
+#include <utility>
+
+#include "inertialnet/runtime/error.hpp"
+
+namespace inertialnet {
+
+namespace {
+
+[[noreturn]] void throw_io(const std::string& what, const std::filesystem::path& path, int err) {
+  const std::string message = "cannot " + what + " " + path.string() + ": " + std::strerror(err);
+  // Problems the user can fix by choosing another path are bad input, the rest are the machine's.
+  if (err == ENOENT || err == ENOTDIR || err == EACCES || err == EPERM || err == EROFS || err == EISDIR) {
+    throw invalid_input(message);
+  }
+  throw runtime_error(message);
+}
+
+// Makes the rename durable. Best effort: some file systems cannot sync a folder (EINVAL), and by
+// now the file's content is on the disk under one name or the other.
+void sync_folder(const std::filesystem::path& file) {
+  std::filesystem::path folder = file.parent_path();
+  if (folder.empty()) folder = ".";
+  const int fd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return;
+  ::fsync(fd);
+  ::close(fd);
+}
+
+}  // namespace
+
+AtomicFile::AtomicFile(std::filesystem::path path) : path_(std::move(path)) {
+  // Unique per process and per call, so that threads writing the same name never share a temporary.
+  static std::atomic<unsigned> counter{0};
+  temporary_ = path_;
+  temporary_ += ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++);
+  fd_ = ::open(temporary_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd_ < 0) throw_io("create", temporary_, errno);
+}
+
+AtomicFile::~AtomicFile() {
+  if (fd_ >= 0) ::close(fd_);
+  if (!committed_) ::unlink(temporary_.c_str());
+}
+
+void AtomicFile::write(const void* data, std::size_t size) {
+  const char* p = static_cast<const char*>(data);
+  while (size > 0) {
+    const ssize_t n = ::write(fd_, p, size);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      throw_io("write", temporary_, errno);
+    }
+    p += n;
+    size -= static_cast<std::size_t>(n);
+  }
+}
+
+void AtomicFile::commit() {
+  if (::fsync(fd_) != 0) throw_io("flush", temporary_, errno);
+  const int fd = std::exchange(fd_, -1);
+  if (::close(fd) != 0) throw_io("close", temporary_, errno);
+  if (::rename(temporary_.c_str(), path_.c_str()) != 0) throw_io("rename the temporary file to", path_, errno);
+  committed_ = true;
+  sync_folder(path_);
+}
+
+void write_file_atomically(const std::filesystem::path& path, const void* data, std::size_t size) {
+  AtomicFile file(path);
+  file.write(data, size);
+  file.commit();
+}
+
+}  // namespace inertialnet
