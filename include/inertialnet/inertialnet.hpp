@@ -2,6 +2,8 @@
 #pragma once
 
 // core
+#include "inertialnet/core/constants.hpp"
+#include "inertialnet/core/random.hpp"
 #include "inertialnet/core/tensor_spec.hpp"
 #include "inertialnet/core/vec3.hpp"
 
@@ -31,6 +33,7 @@
 #include "inertialnet/ops/elementwise.hpp"
 #include "inertialnet/ops/gemm.hpp"
 #include "inertialnet/ops/linear.hpp"
+#include "inertialnet/ops/motion_field.hpp"
 #include "inertialnet/ops/normalize.hpp"
 #include "inertialnet/ops/pool.hpp"
 #include "inertialnet/ops/upsample.hpp"
@@ -40,12 +43,12 @@
 #include "inertialnet/models/flownet.hpp"
 #include "inertialnet/models/geometric_head.hpp"
 #include "inertialnet/models/inertialnet_head.hpp"
-#include "inertialnet/models/opengv_head.hpp"
 #include "inertialnet/models/parameters.hpp"
 #include "inertialnet/models/synthetic_weights.hpp"
 #include "inertialnet/models/weights.hpp"
 
 // io
+#include "inertialnet/io/camera.hpp"
 #include "inertialnet/io/euroc.hpp"
 #include "inertialnet/io/flow_io.hpp"
 #include "inertialnet/io/frame_source.hpp"

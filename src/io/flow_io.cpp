@@ -11,6 +11,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "inertialnet/core/constants.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "io/input_file.hpp"
 #include "runtime/atomic_file.hpp"
@@ -195,11 +196,10 @@ struct ColorWheel {
 
 // (fx, fy) is the flow divided by the normalising radius.
 void encode_vector(const ColorWheel& wheel, float fx, float fy, std::uint8_t* out) {
-  constexpr float kPi = 3.14159265358979323846f;
   const float radius = std::sqrt(fx * fx + fy * fy);
   // The angle of the reversed vector in [-1, 1] (units of π): -1 (just below) for +u, so that
   // motion to the right lands at the wheel's red start.
-  const float angle = std::atan2(-fy, -fx) / kPi;
+  const float angle = std::atan2(-fy, -fx) / static_cast<float>(kPi);
   const float position = (angle + 1.0f) / 2.0f * static_cast<float>(ColorWheel::kSize - 1);
   const int k0 = std::min(static_cast<int>(position), ColorWheel::kSize - 1);
   const int k1 = (k0 + 1) % ColorWheel::kSize;

@@ -1,4 +1,4 @@
-// The geometric head's OpenGV solver (include/inertialnet/models/opengv_head.hpp).
+// The geometric head's OpenGV solver (src/models/opengv_head.hpp).
 //
 // OpenGV is a compiled library whose headers are Eigen templates: objects cross the boundary
 // by reference (rotation_t, the 3×4 transformation_t, aligned std::vectors of bearing vectors),
@@ -6,7 +6,7 @@
 // builds for baseline x86-64 (SSE2, 16-byte alignment; its libopengv.so has no AVX code), hence
 // the check below: a -march flag that enables AVX would make Eigen assume 32-byte alignment
 // for objects the library allocates with 16, and crash or corrupt at run time.
-#include "inertialnet/models/opengv_head.hpp"
+#include "models/opengv_head.hpp"
 
 #include <Eigen/Dense>
 #include <opengv/relative_pose/CentralRelativeAdapter.hpp>
@@ -20,13 +20,15 @@
 #include <cstdlib>
 #include <memory>
 
+#include "core/eigen_conversions.hpp"
+#include "core/so3.hpp"
 #include "inertialnet/runtime/error.hpp"
 
 #if defined(__x86_64__) && EIGEN_MAX_STATIC_ALIGN_BYTES != 16
 #error "Debian's libopengv is built for 16-byte Eigen alignment; build opengv_head.cpp without -mavx/-march=native"
 #endif
 
-namespace inertialnet {
+namespace inertialnet::detail {
 namespace {
 
 using opengv::bearingVectors_t;
@@ -37,12 +39,6 @@ namespace sacp = opengv::sac_problems::relative_pose;
 // OpenGV's RANSAC scores correspondences by 1 − cos(angle); for the problems that triangulate
 // (eigensolver, five-point) the score is the sum over both views.
 double angular_threshold(double pixels, double focal_px) { return 1.0 - std::cos(std::atan(pixels / focal_px)); }
-
-Vec3 log_rotation(const rotation_t& r) {
-  const Eigen::AngleAxisd aa(r);
-  const Eigen::Vector3d v = aa.angle() * aa.axis();
-  return {v(0), v(1), v(2)};
-}
 
 // RMS over `inliers` of the angle between f1 and the epipolar plane of f2 under (R, t) — or,
 // for t = 0, the angle between f1 and R·f2 — in pixels.
@@ -136,12 +132,8 @@ RotationEstimate solve_opengv(const std::vector<NormalizedCorrespondence>& corre
     iterations = ransac.iterations_;
   }
 
-  const Vec3 angle_axis = log_rotation(rotation);
-  est.omega = {angle_axis[0] / dt, angle_axis[1] / dt, angle_axis[2] / dt};
-  if (translation.norm() > 1e-12) {
-    const Eigen::Vector3d t = translation.normalized();
-    est.translation_direction = {t(0), t(1), t(2)};
-  }
+  est.omega = to_vec3(so3_log(rotation) / dt);
+  if (translation.norm() > 1e-12) est.translation_direction = to_vec3(translation.normalized());
   est.inlier_fraction = static_cast<double>(inliers.size()) / static_cast<double>(f1.size());
   est.residual_px = residual_px(f1, f2, inliers, rotation, translation, focal_px);
   est.iterations = iterations;
@@ -149,4 +141,4 @@ RotationEstimate solve_opengv(const std::vector<NormalizedCorrespondence>& corre
   return est;
 }
 
-}  // namespace inertialnet
+}  // namespace inertialnet::detail

@@ -8,19 +8,11 @@
 namespace inertialnet {
 namespace {
 
-constexpr uint64_t kGoldenGamma = 0x9E3779B97F4A7C15ull;
 constexpr double kBiasScale = 0.01;
 
 }  // namespace
 
 uint64_t fnv1a64(std::string_view text) { return detail::fnv1a64(text); }
-
-uint64_t splitmix64(uint64_t x) {
-  uint64_t z = x + kGoldenGamma;
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  return z ^ (z >> 31);
-}
 
 uint64_t synthetic_key(std::string_view name, uint64_t seed) { return fnv1a64(name) ^ (seed * kGoldenGamma); }
 

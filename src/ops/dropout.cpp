@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "inertialnet/core/random.hpp"
 #include "inertialnet/runtime/device.hpp"
 #include "inertialnet/ops/elementwise.hpp"
 #include "ops/op_support.hpp"
@@ -10,13 +11,6 @@ namespace inertialnet {
 namespace {
 
 const std::string kOp = "dropout";
-
-std::uint64_t splitmix64(std::uint64_t z) {
-  z += 0x9E3779B97F4A7C15ULL;
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
-  return z ^ (z >> 31);
-}
 
 void check_options(const DropoutOptions& options) {
   if (!(options.p >= 0.0f && options.p <= 1.0f)) {

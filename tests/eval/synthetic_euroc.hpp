@@ -17,6 +17,7 @@
 
 #include <unistd.h>
 
+#include "inertialnet/core/constants.hpp"
 #include "inertialnet/core/vec3.hpp"
 
 namespace inertialnet::testing_euroc {
@@ -44,7 +45,6 @@ class TempDir {
 };
 
 constexpr std::int64_t kStartNs = 1403715273262142976;  // EuRoC V1_01's first camera timestamp
-constexpr double kPi = 3.14159265358979323846;
 
 // The default body-frame rate (rad/s): three sines of different frequency and phase.
 struct SineRate {

@@ -5,14 +5,13 @@
 #include <functional>
 #include <string>
 
+#include "inertialnet/core/constants.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/eval/spline.hpp"
 
 using namespace inertialnet;
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 CubicSpline sample(double a, double b, std::size_t n, double (*f)(double)) {
   std::vector<double> x(n), y(n);

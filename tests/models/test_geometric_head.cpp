@@ -1,7 +1,7 @@
-// The geometric head: the normalised-coordinate map against a forward lens model, the OpenCL
-// reductions against tests/reference/motion_field, and ω recovered from exact flow fields of
-// known motions (a room of planes at 1.5–6 m, EuRoC's cam0 at a quarter of its size with its
-// lens distortion, 15 % random outlier vectors, Gaussian flow noise).
+// The geometric head: the normalised-coordinate map against a forward lens model, and ω
+// recovered from exact flow fields of known motions (tests/support/motion_fields.hpp: a room of
+// planes at 1.5–6 m, EuRoC's cam0 at a quarter of its size with its lens distortion, 15 % random
+// outlier vectors, Gaussian flow noise). The reductions themselves: tests/ops/test_motion_field.
 //
 // The recovery tests use rates whose axes all differ in size by ≥ 5 deg/s and are ≥ 10 deg/s,
 // and bounds of ≤ 1.5 deg/s: a sign flip (≥ 20 deg/s error), swapped axes (≥ 5 deg/s) or
@@ -11,120 +11,19 @@
 #include <random>
 #include <sstream>
 
+#include "inertialnet/core/constants.hpp"
+#include "inertialnet/io/camera.hpp"
 #include "inertialnet/models/geometric_head.hpp"
-#include "inertialnet/models/opengv_head.hpp"
+#include "models/motion_field_solver.hpp"
+#include "models/opengv_head.hpp"
 #include "reference/motion_field.hpp"
+#include "support/motion_fields.hpp"
 #include "support/testing.hpp"
 
 namespace inertialnet {
 namespace {
 
-constexpr double kDeg = 3.14159265358979323846 / 180;
-
-// --- analytic flow fields ------------------------------------------------------------------
-
-// EuRoC cam0 scaled to 188×120 (pixel centres at integer coordinates), with its distortion.
-CameraIntrinsics quarter_euroc(bool distorted = true) {
-  CameraIntrinsics k;
-  k.width = 188;
-  k.height = 120;
-  k.fx = 458.654 / 4;
-  k.fy = 457.296 / 4;
-  k.cx = (367.215 + 0.5) / 4 - 0.5;
-  k.cy = (248.375 + 0.5) / 4 - 0.5;
-  if (distorted) {
-    k.distortion = LensDistortion::RadialTangential;
-    k.coefficients = {-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05};
-  }
-  return k;
-}
-
-// The forward lens models, written out here (the head inverts them with OpenCV).
-std::array<double, 2> project(const CameraIntrinsics& k, double x, double y) {
-  double xd = x, yd = y;
-  if (k.distortion == LensDistortion::RadialTangential) {
-    const double k1 = k.coefficients[0], k2 = k.coefficients[1], p1 = k.coefficients[2], p2 = k.coefficients[3];
-    const double r2 = x * x + y * y, radial = 1 + k1 * r2 + k2 * r2 * r2;
-    xd = x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x);
-    yd = y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y;
-  } else if (k.distortion == LensDistortion::Equidistant) {
-    const double r = std::hypot(x, y), th = std::atan(r), t2 = th * th;
-    const double thd = th * (1 + t2 * (k.coefficients[0] + t2 * (k.coefficients[1] + t2 * (k.coefficients[2] + t2 * k.coefficients[3]))));
-    const double s = r > 1e-12 ? thd / r : 1.0;
-    xd = x * s;
-    yd = y * s;
-  }
-  return {k.fx * xd + k.cx, k.fy * yd + k.cy};
-}
-
-using Mat = std::array<double, 9>;
-
-Mat exp_so3(const Vec3& v) {  // Rodrigues
-  const double th = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-  if (th < 1e-15) return {1, 0, 0, 0, 1, 0, 0, 0, 1};
-  const double x = v[0] / th, y = v[1] / th, z = v[2] / th, c = std::cos(th), s = std::sin(th), C = 1 - c;
-  return {c + x * x * C, x * y * C - z * s, x * z * C + y * s,
-          y * x * C + z * s, c + y * y * C, y * z * C - x * s,
-          z * x * C - y * s, z * y * C + x * s, c + z * z * C};
-}
-
-// Depth along the ray (x, y, 1): the nearest of a room's planes (floor, ceiling, side walls,
-// back wall at 6 m, a box at 1.6 m, a cupboard at 3 m), clamped to [1.5, 6] m.
-double depth(double x, double y) {
-  double z = 6.0;
-  if (y > 1e-9) z = std::min(z, 1.1 / y);
-  if (y < -1e-9) z = std::min(z, -1.6 / y);
-  if (x < -1e-9) z = std::min(z, -1.8 / x);
-  if (x > 1e-9) z = std::min(z, 2.6 / x);
-  if (x > -0.35 && x < 0.05 && y > -0.25 && y < 0.15) z = std::min(z, 1.6);
-  if (x > 0.2 && x < 0.45 && y > -0.4 && y < 0.0) z = std::min(z, 3.0);
-  return std::max(1.5, z);
-}
-
-struct Motion {
-  Vec3 omega{};     // rad/s, camera frame
-  Vec3 velocity{};  // m/s, camera frame
-  double dt = 0.05;
-  double outliers = 0.15;  // fraction of vectors replaced by uniform ones in [−15, 15]² px
-  double noise_px = 0.075; // 0.3 px at full size
-  unsigned seed = 1;
-};
-
-// Exact flow of the static room: with R = exp([ω·dt]×) the camera's rotation over the frame
-// interval and c its displacement, a point P seen at t−1 is at Rᵀ(P − c) at t, i.e.
-// Ṗ = −ω × P − v: the convention of docs/data_conventions.md's motion-field equations.
-FlowField render(const CameraIntrinsics& k, const std::vector<float>& map, const Motion& m) {
-  FlowField f(k.width, k.height);
-  const Mat r = exp_so3({m.omega[0] * m.dt, m.omega[1] * m.dt, m.omega[2] * m.dt});
-  const Mat half = exp_so3({m.omega[0] * m.dt / 2, m.omega[1] * m.dt / 2, m.omega[2] * m.dt / 2});
-  const Vec3 c = mul(half, {m.velocity[0] * m.dt, m.velocity[1] * m.dt, m.velocity[2] * m.dt});
-  std::mt19937 rng(m.seed);
-  std::uniform_real_distribution<double> uniform(0, 1);
-  std::normal_distribution<double> gauss(0, 1);
-  const std::size_t plane = f.pixel_count();
-  for (int v = 0; v < k.height; ++v) {
-    for (int u = 0; u < k.width; ++u) {
-      const std::size_t i = f.index(u, v);
-      const double x = map[i], y = map[plane + i], z = depth(x, y);
-      const Vec3 p = mul_transposed(r, {x * z - c[0], y * z - c[1], z - c[2]});
-      const auto q = project(k, p[0] / p[2], p[1] / p[2]);
-      double du = q[0] - u + m.noise_px * gauss(rng), dv = q[1] - v + m.noise_px * gauss(rng);
-      if (uniform(rng) < m.outliers) {
-        du = -15 + 30 * uniform(rng);
-        dv = -15 + 30 * uniform(rng);
-      }
-      f.u[i] = static_cast<float>(du);
-      f.v[i] = static_cast<float>(dv);
-    }
-  }
-  return f;
-}
-
-Tensor upload(Queue& queue, const FlowField& f) {
-  std::vector<float> planes(f.u);
-  planes.insert(planes.end(), f.v.begin(), f.v.end());
-  return Tensor::from_host(queue, {1, 2, f.height, f.width}, planes);
-}
+using namespace testing;  // the motion fields of tests/support/motion_fields.hpp
 
 // Options for 188×120 flow: a quarter of the full-size scales (the same angles).
 GeometricHeadOptions quarter_options() {
@@ -150,20 +49,6 @@ GeometricHeadOptions quarter_options() {
                                        << ": worst axis error " << worst << " > " << bound_deg_s << " deg/s";
 }
 
-
-// Rates with distinct magnitudes ≥ 10 deg/s on every axis, up to 60 deg/s.
-const std::vector<Vec3> kRates = {
-    {-22 * kDeg, 38 * kDeg, 13 * kDeg},
-    {45 * kDeg, -12 * kDeg, -30 * kDeg},
-    {-17 * kDeg, -52 * kDeg, 35 * kDeg},
-};
-// Forward, lateral, oblique backward and vertical translation, 0.35–0.9 m/s.
-const std::vector<Vec3> kVelocities = {
-    {0.1, -0.05, 0.8},
-    {0.7, 0.1, 0.2},
-    {-0.4, 0.3, -0.6},
-    {0.1, 0.5, 0.3},
-};
 
 // --- the camera ------------------------------------------------------------------------------
 
@@ -241,105 +126,6 @@ TEST(CameraIntrinsics, FromEurocCalibration) {
   c.intrinsics[0] = 458;
   c.camera_model = "omni";
   testing::expect_invalid_input([&] { CameraIntrinsics::from_calibration(c); }, "camera model 'omni' is not supported");
-}
-
-// --- the reductions against the reference ----------------------------------------------------
-
-// A flow with every kind of sample: a general motion with outliers, unknown vectors (NaN and
-// Middlebury's 1e10) and vectors that leave the image.
-FlowField awkward_flow(const CameraIntrinsics& k, const std::vector<float>& map) {
-  Motion m;
-  m.omega = kRates[0];
-  m.velocity = kVelocities[0];
-  FlowField f = render(k, map, m);
-  for (std::size_t i = 0; i < f.pixel_count(); i += 97) f.u[i] = std::nanf("");
-  for (std::size_t i = 13; i < f.pixel_count(); i += 89) f.v[i] = kUnknownFlowValue;
-  for (int v = 0; v < k.height; v += 7) f.u_at(k.width - 2, v) = 5.0f;  // ends outside
-  for (int u = 0; u < k.width; u += 5) f.v_at(u, 1) = -3.0f;
-  return f;
-}
-
-// Relative difference against a scale: |a − b| / (|b| + floor).
-double rel(double a, double b, double floor) { return std::fabs(a - b) / (std::fabs(b) + floor); }
-
-TEST(MotionFieldMoments, MatchTheReferenceInEveryModeAndLoss) {
-  Queue& queue = testing::test_queue();
-  const CameraIntrinsics k = quarter_euroc();
-  GeometricHead head(testing::test_device(), k);
-  const std::vector<float> map = normalized_coordinate_map(k);
-  const FlowField flow = awkward_flow(k, map);
-  // The flow as channels 1–2 of a 4-channel tensor, so the kernel must honour the offset.
-  std::vector<float> wide(4 * flow.pixel_count(), 7.0f);
-  std::copy(flow.u.begin(), flow.u.end(), wide.begin() + static_cast<std::ptrdiff_t>(flow.pixel_count()));
-  std::copy(flow.v.begin(), flow.v.end(), wide.begin() + 2 * static_cast<std::ptrdiff_t>(flow.pixel_count()));
-  const Tensor all = Tensor::from_host(queue, {1, 4, k.height, k.width}, wide);
-  const Tensor slice = all.channels(1, 2);
-
-  for (MotionFieldMode mode : {MotionFieldMode::Rotation, MotionFieldMode::General}) {
-    for (RobustLoss loss : {RobustLoss::LeastSquares, RobustLoss::Huber, RobustLoss::Cauchy, RobustLoss::Tukey}) {
-      for (int stride : {1, 3}) {
-        for (bool with_t : {false, true}) {
-          if (with_t && mode == MotionFieldMode::Rotation) continue;
-          SCOPED_TRACE("mode " + std::to_string(static_cast<int>(mode)) + ", loss " + to_string(loss) + ", stride " +
-                       std::to_string(stride) + (with_t ? ", T given" : ", T = 0"));
-          MotionFieldParams p;
-          p.mode = mode;
-          p.loss = loss;
-          p.omega = {-0.3, 0.5, 0.2};
-          p.translation = with_t ? Vec3{0.2, -0.1, 0.9} : Vec3{0, 0, 0};
-          p.dt = 0.05;
-          p.scale = 0.08;            // ≈0.5 px in normalised image velocity
-          p.inlier_threshold = 0.3;  // ≈2 px
-          p.stride = stride;
-          const MotionFieldMoments got = head.moments(queue, slice, p);
-          const MotionFieldMoments want = reference::motion_field_moments(flow, map, p);
-          // Counts are exact; the sample set must be the same one.
-          EXPECT_EQ(got.usable, want.usable);
-          EXPECT_GT(want.usable, 0.9 * SampleGrid::of(k.width, k.height, stride).count());
-          EXPECT_LT(want.usable, SampleGrid::of(k.width, k.height, stride).count());
-          // Float sums of ≈20k terms against double: ≈1e-5 relative; the inlier count may differ
-          // by the few samples within float rounding of the threshold.
-          EXPECT_NEAR(got.inliers, want.inliers, 2 + 1e-4 * want.inliers);
-          const double scale = want.weight_sum;  // the size of a typical sum
-          EXPECT_LT(rel(got.weight_sum, want.weight_sum, 1), 1e-4);
-          EXPECT_LT(rel(got.weighted_sq_residual, want.weighted_sq_residual, 1e-3 * scale), 1e-4);
-          EXPECT_LT(rel(got.loss_sum, want.loss_sum, 1e-3 * scale), 1e-4);
-          if (mode == MotionFieldMode::Rotation) {
-            for (int i = 0; i < 6; ++i) EXPECT_LT(rel(got.normal[i], want.normal[i], 1e-3 * scale), 1e-4) << i;
-            for (int i = 0; i < 3; ++i) EXPECT_LT(rel(got.rhs[i], want.rhs[i], 1e-3 * scale), 1e-4) << i;
-          } else {
-            // The Gram matrix holds products of velocities weighted by up to 1/0.01: compared
-            // against its largest entry (cancellation in float across ≈20k terms).
-            double largest = 0;
-            for (double g : want.gram) largest = std::max(largest, std::fabs(g));
-            for (int i = 0; i < 78; ++i) EXPECT_LT(std::fabs(got.gram[i] - want.gram[i]) / largest, 2e-5) << i;
-            for (int i = 0; i < 6; ++i) EXPECT_LT(rel(got.metric[i], want.metric[i], 1e-3 * scale), 1e-4) << i;
-            if (with_t) {
-              EXPECT_LT(rel(got.parallel_sq, want.parallel_sq, 1e-3 * scale), 1e-3);
-              EXPECT_NEAR(got.parallel_sum, want.parallel_sum, 1e-3 * std::sqrt(want.parallel_sq * want.inliers) + 1e-6);
-            }
-          }
-        }
-      }
-    }
-  }
-}
-
-TEST(MotionFieldMoments, CorrespondencesMatchTheReference) {
-  Queue& queue = testing::test_queue();
-  const CameraIntrinsics k = quarter_euroc();
-  GeometricHead head(testing::test_device(), k);
-  const std::vector<float> map = normalized_coordinate_map(k);
-  const FlowField flow = awkward_flow(k, map);
-  const auto got = head.correspondences(queue, upload(queue, flow), 2);
-  const auto want = reference::motion_field_correspondences(flow, map, 2);
-  ASSERT_EQ(got.size(), want.size());
-  double worst = 0;
-  for (std::size_t i = 0; i < got.size(); ++i) {
-    const float diffs[4] = {got[i].x1 - want[i].x1, got[i].y1 - want[i].y1, got[i].x2 - want[i].x2, got[i].y2 - want[i].y2};
-    for (float d : diffs) worst = std::max(worst, static_cast<double>(std::fabs(d)));
-  }
-  EXPECT_LT(worst, 1e-6);  // float bilinear interpolation of values ≤ 1
 }
 
 // --- ω from exact flow ---------------------------------------------------------------------------
@@ -469,7 +255,7 @@ TEST(GeometricHead, KernelAndReferenceDriveTheSolverAlike) {
   m.velocity = kVelocities[2];
   const FlowField flow = render(k, map, m);
   const RotationEstimate device = head.estimate(queue, upload(queue, flow), m.dt);
-  const RotationEstimate host = solve_motion_field(
+  const RotationEstimate host = detail::solve_motion_field(
       [&](const MotionFieldParams& p) { return reference::motion_field_moments(flow, map, p); }, m.dt,
       0.5 * (k.fx + k.fy), o);
   EXPECT_TRUE(near_rates(host.omega, m.omega, 1.5));
@@ -540,7 +326,7 @@ TEST(GeometricHead, BadInputIsInvalidInput) {
   o.solver = GeometricSolver::OpenGV;
   head.set_options(o);
   testing::expect_invalid_input([&] { head.estimate(queue, outside, 0.05); }, "at least 10 are needed");
-  testing::expect_invalid_input([&] { solve_opengv({}, 0.05, 100, o); }, "at least 10 are needed");
+  testing::expect_invalid_input([&] { detail::solve_opengv({}, 0.05, 100, o); }, "at least 10 are needed");
 }
 
 }  // namespace

@@ -94,6 +94,17 @@ void add_general(MotionFieldMoments& m, double x, double y, const double ax[3], 
   for (int i = 0; i < 6; ++i) m.metric[i] += w * mtm[i];
 }
 
+// The sums of every usable sample: weight, weighted squared residual, loss, and the inliers.
+void add_diagnostics(MotionFieldMoments& m, const MotionFieldParams& p, double psi, double e) {
+  m.weight_sum += psi;
+  m.weighted_sq_residual += psi * e * e;
+  m.loss_sum += loss(p.loss, e, p.scale);
+  if (e < p.inlier_threshold) {
+    m.inliers += 1;
+    m.inlier_sq_residual += e * e;
+  }
+}
+
 }  // namespace
 
 MotionFieldMoments motion_field_moments(const FlowField& flow, const std::vector<float>& map,
@@ -124,12 +135,8 @@ MotionFieldMoments motion_field_moments(const FlowField& flow, const std::vector
         const double e = std::fabs(nh[0] * r[0] + nh[1] * r[1]);
         const double psi = weight(p.loss, e, p.scale);
         add_general(m, x, y, ax, ay, r, psi / std::max(n2, 1e-2));
-        m.weight_sum += psi;
-        m.weighted_sq_residual += psi * e * e;
-        m.loss_sum += loss(p.loss, e, p.scale);
+        add_diagnostics(m, p, psi, e);
         if (e < p.inlier_threshold) {
-          m.inliers += 1;
-          m.inlier_sq_residual += e * e;
           const double d[2] = {nh[1], -nh[0]};  // the translational flow's direction
           const double par = d[0] * r[0] + d[1] * r[1];
           m.parallel_sum += par;
@@ -145,13 +152,7 @@ MotionFieldMoments motion_field_moments(const FlowField& flow, const std::vector
         add_row(m, ax, b[0], psi);
         add_row(m, ay, b[1], psi);
       }
-      m.weight_sum += psi;
-      m.weighted_sq_residual += psi * e * e;
-      m.loss_sum += loss(p.loss, e, p.scale);
-      if (e < p.inlier_threshold) {
-        m.inliers += 1;
-        m.inlier_sq_residual += e * e;
-      }
+      add_diagnostics(m, p, psi, e);
     }
   }
   return m;

@@ -15,6 +15,7 @@
 #include <opencv2/video/tracking.hpp>
 
 #include "eval/synthetic_euroc.hpp"
+#include "inertialnet/core/constants.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/io/euroc.hpp"
 #include "inertialnet/synth/synthetic_sequence.hpp"
@@ -25,7 +26,6 @@ using inertialnet::testing_euroc::TempDir;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kEurocT_BS[16] = {0.0148655429818,  -0.999880929698,  0.00414029679422, -0.0216401454975,
                                    0.999557249008,   0.0149672133247,  0.025715529948,   -0.064676986768,
                                    -0.0257744366974, 0.00375618835797, 0.999660727178,   0.00981073058949,

@@ -10,6 +10,7 @@
 #include <string_view>
 #include <vector>
 
+#include "inertialnet/core/random.hpp"
 #include "inertialnet/models/parameters.hpp"
 #include "inertialnet/io/safetensors_writer.hpp"
 
@@ -18,8 +19,7 @@ namespace inertialnet {
 // FNV-1a, 64-bit, over the bytes of `text`.
 uint64_t fnv1a64(std::string_view text);
 
-// The standard splitmix64 output for state `x` (adds the golden gamma, then the finaliser).
-uint64_t splitmix64(uint64_t x);
+// The counter-based generator is splitmix64 (inertialnet/core/random.hpp).
 
 // The generator's per-tensor key: fnv1a64(name) XOR (seed · 0x9E3779B97F4A7C15 mod 2^64).
 uint64_t synthetic_key(std::string_view name, uint64_t seed);

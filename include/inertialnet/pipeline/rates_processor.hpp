@@ -9,6 +9,7 @@
 #include <map>
 #include <optional>
 
+#include "inertialnet/io/camera.hpp"
 #include "inertialnet/models/geometric_head.hpp"
 #include "inertialnet/models/parameters.hpp"
 #include "inertialnet/models/weights.hpp"

@@ -2,27 +2,10 @@
 // truth, so that the reader, IMU synchronisation, the pipeline and the metrics can be checked
 // end to end against rates that are known exactly.
 //
-// The camera is an ideal pinhole with EuRoC cam0's intrinsics scaled to the chosen size and no
-// lens distortion; it is mounted on the body with EuRoC cam0's T_BS, so the body-to-camera
-// rotation of a real sequence is exercised. The IMU frame is the body frame (imu0 T_BS = I).
-//
-// Motion. The camera orientation is R_WC(t) = Exp(θ(t)) in closed form, with θ(t) a sum of three
-// sinusoids per axis (random frequencies, phases and amplitudes from the seed); the angular rate
-// in the camera frame is then exactly ω_C(t) = J_r(θ) θ̇ (J_r: the right Jacobian of SO(3)),
-// so images and gyro agree to rounding whatever the frame rate. A closed form keeps the
-// orientation bounded (|θ_k| ≤ 0.35 rad) on sequences of any length, which integrating a sum of
-// sinusoidal rates would not (coning drift). Amplitudes are scaled so that every axis of ω_C
-// peaks at or below max_rate_deg_s. In the world frame W of the renderer the reference camera
-// (θ = 0) looks along +z with x right and y down; the ground truth is written in a z-up frame R
+// The options and the camera: synth_options.hpp; the motion: trajectory.hpp. Frames are
+// global-shutter snapshots at the camera timestamps, ray-cast against textured planes
+// (src/synth/scene.hpp, src/synth/renderer.hpp). The ground truth is written in a z-up frame R
 // (R's x = W's z, R's z = −W's y) so that gravity is −z as in EuRoC.
-//
-// Rendering. Frames are global-shutter snapshots at the camera timestamps, ray-cast against
-// textured planes: one wall for `Rotation` (the camera centre stays fixed, so every frame is the
-// homography K·R·K⁻¹ of one wide texture and the true flow is exact), a wall at 6 m and four
-// tilted panels at 1.5–4.5 m for `General` (the camera also translates at ≈0.2–0.5 m/s; the
-// nearest plane wins per ray). Each plane's texture is procedural (multi-scale noise, edges and
-// blobs at every scale from 2 px up) and the wall is made wide enough for the whole motion, so
-// no border ever shows. Each pixel averages 2×2 bilinear samples.
 //
 // The output is bit-identical for the same options, whatever the thread count: the random
 // numbers, the noise upsampling and the rendering are our own code (no SIMD-dispatched OpenCV
@@ -32,63 +15,16 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
-#include <string>
 #include <vector>
 
 #include "inertialnet/core/vec3.hpp"
+#include "inertialnet/synth/synth_options.hpp"
+#include "inertialnet/synth/trajectory.hpp"
 
 namespace inertialnet {
 
 // EuRoC V1_01's first camera timestamp: the synthetic IMU and camera both start here.
 constexpr std::int64_t kSynthStartNs = 1403715273262142976;
-
-struct SynthOptions {
-  enum Motion { Rotation, General };
-
-  int frames = 40;                 // at least 2 (one frame pair)
-  int width = 752, height = 480;   // 16..4096 pixels
-  double camera_rate_hz = 20;
-  double imu_rate_hz = 200;        // an integer multiple of camera_rate_hz
-  Motion motion = Rotation;
-  std::uint64_t seed = 1;
-  double max_rate_deg_s = 60;      // peak |ω| per camera axis; 0 gives a still camera orientation
-  // White gyro/accel noise with EuRoC's noise densities and a constant seeded bias (a few
-  // hundredths of rad/s on the gyro); off: the IMU holds the exact rates and specific force.
-  bool noise = true;
-  // An existing, non-empty output folder is an error unless this is set; then only its mav0/
-  // folder is replaced, whatever else it holds is left alone.
-  bool overwrite = false;
-};
-
-// "rotation" / "general" (case-insensitive); throws invalid_input for anything else.
-SynthOptions::Motion parse_synth_motion(const std::string& name);
-const char* to_string(SynthOptions::Motion motion);
-
-// EuRoC cam0's intrinsics (fu, fv, cu, cv) scaled from 752×480 to width×height (pixel centres at
-// integer coordinates, so c' = (c + 0.5)·scale − 0.5).
-std::array<double, 4> synth_intrinsics(int width, int height);
-
-// The camera motion of a sequence; t is in seconds from the first frame. Throws invalid_input
-// for options write_synthetic_sequence would reject.
-class SynthTrajectory {
- public:
-  explicit SynthTrajectory(const SynthOptions& options);
-
-  // R_WC: camera-frame vectors to the renderer's world frame W (row-major).
-  Mat3 rotation(double t) const;
-  // ω_C: the camera's angular rate in the camera frame (x right, y down, z forward), rad/s.
-  Vec3 camera_rate(double t) const;
-  // Camera centre in W (m) and its velocity (m/s); zero for `Rotation`.
-  Vec3 position(double t) const;
-  Vec3 velocity(double t) const;
-
- private:
-  struct Sine {
-    double amplitude, omega, phase;  // amplitude · sin(omega · t + phase)
-  };
-  std::array<std::vector<Sine>, 3> angle_;     // θ_k(t)
-  std::array<std::vector<Sine>, 3> position_;  // c_k(t)
-};
 
 struct SynthReport {
   std::filesystem::path mav0;              // the folder written

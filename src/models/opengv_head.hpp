@@ -1,13 +1,15 @@
 // The geometric head's OpenGV solver (GeometricSolver::OpenGV): relative rotation between two
 // frames from bearing-vector correspondences sampled from the flow, with OpenGV's RANSAC.
-// No OpenGV or Eigen type appears here: the library links OpenGV privately.
+// Private to the geometric head; no OpenGV or Eigen type appears here, so only
+// src/models/opengv_head.cpp compiles against OpenGV's headers.
 #pragma once
 
 #include <vector>
 
 #include "inertialnet/models/geometric_head.hpp"
+#include "inertialnet/ops/motion_field.hpp"
 
-namespace inertialnet {
+namespace inertialnet::detail {
 
 // ω (camera frame, rad/s) from correspondences in normalised coordinates. The rays are
 // f1 = (x1, y1, 1) at t−1 and f2 = (x2, y2, 1) at t; OpenGV returns R12 with f1 ∝ R12·f2 for a
@@ -19,4 +21,4 @@ namespace inertialnet {
 RotationEstimate solve_opengv(const std::vector<NormalizedCorrespondence>& correspondences, double dt, double focal_px,
                               const GeometricHeadOptions& options);
 
-}  // namespace inertialnet
+}  // namespace inertialnet::detail

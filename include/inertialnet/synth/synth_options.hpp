@@ -1,0 +1,46 @@
+// What a `synth` sequence is made of: its length, frame size, rates, kind of motion, seed and
+// noise (include/inertialnet/synth/synthetic_sequence.hpp writes one).
+//
+// The camera is an ideal pinhole with EuRoC cam0's intrinsics scaled to the chosen size and no
+// lens distortion; it is mounted on the body with EuRoC cam0's T_BS, so the body-to-camera
+// rotation of a real sequence is exercised. The IMU frame is the body frame (imu0 T_BS = I).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+
+namespace inertialnet {
+
+struct SynthOptions {
+  enum Motion { Rotation, General };
+
+  int frames = 40;                 // at least 2 (one frame pair)
+  int width = 752, height = 480;   // 16..4096 pixels
+  double camera_rate_hz = 20;
+  double imu_rate_hz = 200;        // an integer multiple of camera_rate_hz
+  Motion motion = Rotation;
+  std::uint64_t seed = 1;
+  double max_rate_deg_s = 60;      // peak |ω| per camera axis; 0 gives a still camera orientation
+  // White gyro/accel noise with EuRoC's noise densities and a constant seeded bias (a few
+  // hundredths of rad/s on the gyro); off: the IMU holds the exact rates and specific force.
+  bool noise = true;
+  // An existing, non-empty output folder is an error unless this is set; then only its mav0/
+  // folder is replaced, whatever else it holds is left alone.
+  bool overwrite = false;
+
+  // Throws invalid_input, with the accepted range, for anything out of range: the frame count
+  // and size, the rates (the IMU's an integer multiple of the camera's), a maximum rate too fast
+  // for the camera rate, an unknown motion.
+  void validate() const;
+};
+
+// "rotation" / "general" (case-insensitive); throws invalid_input for anything else.
+SynthOptions::Motion parse_synth_motion(const std::string& name);
+const char* to_string(SynthOptions::Motion motion);
+
+// EuRoC cam0's intrinsics (fu, fv, cu, cv) scaled from 752×480 to width×height (pixel centres at
+// integer coordinates, so c' = (c + 0.5)·scale − 0.5).
+std::array<double, 4> synth_intrinsics(int width, int height);
+
+}  // namespace inertialnet

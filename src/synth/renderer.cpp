@@ -1,0 +1,78 @@
+#include "synth/renderer.hpp"
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <string>
+
+#include "inertialnet/runtime/error.hpp"
+
+namespace inertialnet::detail {
+namespace {
+
+constexpr int kSuper = 2;  // sub-samples per pixel and axis
+
+float bilinear(const cv::Mat& t, double p, double q) {
+  const int x = std::min(static_cast<int>(p), t.cols - 2), y = std::min(static_cast<int>(q), t.rows - 2);
+  const float fx = static_cast<float>(p - x), fy = static_cast<float>(q - y);
+  const float* r0 = t.ptr<float>(y);
+  const float* r1 = t.ptr<float>(y + 1);
+  const float top = r0[x] + fx * (r0[x + 1] - r0[x]);
+  const float bottom = r1[x] + fx * (r1[x + 1] - r1[x]);
+  return top + fy * (bottom - top);
+}
+
+}  // namespace
+
+// Every sub-sample takes the nearest plane its ray hits (largest inverse depth h2).
+cv::Mat render(const std::vector<Plane>& planes, const SynthCamera& cam, const Eigen::Matrix3d& R_WC,
+               const Eigen::Vector3d& c, std::int64_t t_ns) {
+  std::vector<std::array<double, 9>> H;
+  for (const auto& p : planes) H.push_back(plane_homography(p, R_WC, c, cam.K_inv));
+  cv::Mat frame(cam.height, cam.width, CV_8U);
+  std::atomic<long> holes{0};
+  cv::parallel_for_(cv::Range(0, cam.height), [&](const cv::Range& range) {
+    long missing = 0;
+    for (int y = range.start; y < range.end; ++y) {
+      auto* out = frame.ptr<std::uint8_t>(y);
+      for (int x = 0; x < cam.width; ++x) {
+        float sum = 0;
+        for (int sy = 0; sy < kSuper; ++sy) {
+          const double v = y + (sy + 0.5) / kSuper - 0.5;
+          for (int sx = 0; sx < kSuper; ++sx) {
+            const double u = x + (sx + 0.5) / kSuper - 0.5;
+            int best = -1;
+            double best_w = 0, best_p = 0, best_q = 0;
+            for (std::size_t i = 0; i < H.size(); ++i) {
+              const double* h = H[i].data();
+              const double w = h[6] * u + h[7] * v + h[8];
+              if (w <= best_w) continue;  // behind the camera, or farther than a plane already hit
+              const double p = (h[0] * u + h[1] * v + h[2]) / w, q = (h[3] * u + h[4] * v + h[5]) / w;
+              const cv::Mat& t = planes[i].texture;
+              if (!(p >= 0 && q >= 0 && p <= t.cols - 1 && q <= t.rows - 1)) continue;
+              best = static_cast<int>(i);
+              best_w = w;
+              best_p = p;
+              best_q = q;
+            }
+            if (best < 0) {
+              ++missing;
+              continue;
+            }
+            sum += bilinear(planes[best].texture, best_p, best_q);
+          }
+        }
+        out[x] = cv::saturate_cast<std::uint8_t>(std::lround(sum / (kSuper * kSuper)));
+      }
+    }
+    holes += missing;
+  });
+  if (holes > 0) {
+    throw runtime_error("synth: the frame at " + std::to_string(t_ns) + " ns left " +
+                        std::to_string(holes.load()) + " samples outside the textured scene.");
+  }
+  return frame;
+}
+
+}  // namespace inertialnet::detail
