@@ -5,26 +5,14 @@
 #include <mutex>
 
 #include "inertialnet/runtime/device.hpp"
+#include "ops/gemm_support.hpp"
 
 namespace inertialnet {
 
-namespace {
+namespace detail {
 
-// CLBlast keeps process-wide caches of compiled programs and tuning data, and calling it from
-// several threads at once (the pipeline's lanes) crashed intermittently here, as reported
-// upstream for multi-threaded use (CLBlast issue 486). Calls only enqueue work — the GEMM runs
-// after the lock is released — so serialising them costs the lanes no overlap.
-std::mutex& clblast_mutex() {
-  static std::mutex mutex;
-  return mutex;
-}
-
-clblast::Transpose to_clblast(Transpose t) { return t == Transpose::Yes ? clblast::Transpose::kYes : clblast::Transpose::kNo; }
-
-// Checks that a row-major `rows`×`cols` matrix stored with `view.leading_dimension`, repeated
-// `batch` times `stride` apart, lies inside its buffer.
-void check_operand(const char* name, const MatrixView& view, std::size_t rows, std::size_t cols, std::size_t stride,
-                   std::size_t batch) {
+void check_gemm_operand(const char* name, const MatrixView& view, std::size_t rows, std::size_t cols,
+                        std::size_t stride, std::size_t batch) {
   if (!view.buffer) throw invalid_input(std::string("GEMM operand ") + name + " has no buffer");
   if (view.leading_dimension < cols) {
     throw invalid_input(std::string("GEMM operand ") + name + ": leading dimension " +
@@ -41,6 +29,21 @@ void check_operand(const char* name, const MatrixView& view, std::size_t rows, s
   }
 }
 
+}  // namespace detail
+
+namespace {
+
+// CLBlast keeps process-wide caches of compiled programs and tuning data, and calling it from
+// several threads at once (the pipeline's lanes) crashed intermittently here, as reported
+// upstream for multi-threaded use (CLBlast issue 486). Calls only enqueue work — the GEMM runs
+// after the lock is released — so serialising them costs the lanes no overlap.
+std::mutex& clblast_mutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+
+clblast::Transpose to_clblast(Transpose t) { return t == Transpose::Yes ? clblast::Transpose::kYes : clblast::Transpose::kNo; }
+
 void check_problem(Transpose ta, Transpose tb, std::size_t m, std::size_t n, std::size_t k, const MatrixView& a,
                    std::size_t sa, const MatrixView& b, std::size_t sb, const MatrixView& c, std::size_t sc,
                    std::size_t batch) {
@@ -49,9 +52,9 @@ void check_problem(Transpose ta, Transpose tb, std::size_t m, std::size_t n, std
                         " k=" + std::to_string(k) + " batch=" + std::to_string(batch));
   }
   // As stored (row-major): A is m×k, or k×m when transposed; likewise B.
-  check_operand("A", a, ta == Transpose::No ? m : k, ta == Transpose::No ? k : m, sa, batch);
-  check_operand("B", b, tb == Transpose::No ? k : n, tb == Transpose::No ? n : k, sb, batch);
-  check_operand("C", c, m, n, sc, batch);
+  detail::check_gemm_operand("A", a, ta == Transpose::No ? m : k, ta == Transpose::No ? k : m, sa, batch);
+  detail::check_gemm_operand("B", b, tb == Transpose::No ? k : n, tb == Transpose::No ? n : k, sb, batch);
+  detail::check_gemm_operand("C", c, m, n, sc, batch);
 }
 
 }  // namespace
