@@ -29,6 +29,8 @@
 #include "inertialnet/ops/dropout.hpp"
 #include "inertialnet/ops/elementwise.hpp"
 #include "inertialnet/ops/gemm.hpp"
+#include "inertialnet/ops/gemm_backend.hpp"
+#include "inertialnet/ops/gemm_packed.hpp"
 #include "inertialnet/ops/linear.hpp"
 #include "inertialnet/ops/normalize.hpp"
 #include "inertialnet/ops/pool.hpp"

@@ -4,6 +4,7 @@
 
 #include <mutex>
 
+#include "inertialnet/ops/gemm_packed.hpp"
 #include "inertialnet/runtime/device.hpp"
 #include "ops/gemm_support.hpp"
 
@@ -65,7 +66,19 @@ MatrixView MatrixView::of(const Tensor& tensor, std::size_t leading_dimension, s
 
 void gemm(Queue& queue, Transpose transpose_a, Transpose transpose_b, std::size_t m, std::size_t n, std::size_t k,
           float alpha, const MatrixView& a, const MatrixView& b, float beta, const MatrixView& c) {
+  gemm(queue, gemm_backend(queue.device().info()), transpose_a, transpose_b, m, n, k, alpha, a, b, beta, c);
+}
+
+void gemm(Queue& queue, GemmBackend backend, Transpose transpose_a, Transpose transpose_b, std::size_t m,
+          std::size_t n, std::size_t k, float alpha, const MatrixView& a, const MatrixView& b, float beta,
+          const MatrixView& c) {
   check_problem(transpose_a, transpose_b, m, n, k, a, 0, b, 0, c, 0, 1);
+  if (backend == GemmBackend::Packed) {
+    const PackedPanels packed_a = pack_a(queue, transpose_a, m, k, a);
+    const PackedPanels packed_b = pack_b(queue, transpose_b, k, n, b);
+    gemm_packed(queue, packed_a, packed_b, c, GemmEpilogue{alpha, beta, Tensor(), ActivationSpec::none()});
+    return;
+  }
   cl_command_queue handle = queue.handle();
   std::lock_guard<std::mutex> lock(clblast_mutex());
   const auto status = clblast::Gemm<float>(clblast::Layout::kRowMajor, to_clblast(transpose_a), to_clblast(transpose_b),
@@ -80,8 +93,17 @@ void gemm_strided_batched(Queue& queue, Transpose transpose_a, Transpose transpo
                           std::size_t stride_b, float beta, const MatrixView& c, std::size_t stride_c,
                           std::size_t batch) {
   check_problem(transpose_a, transpose_b, m, n, k, a, stride_a, b, stride_b, c, stride_c, batch);
-  if (batch == 1) {
-    gemm(queue, transpose_a, transpose_b, m, n, k, alpha, a, b, beta, c);
+  const GemmBackend backend = gemm_backend(queue.device().info());
+  if (batch == 1 || backend == GemmBackend::Packed) {
+    // The packed kernels have no batched form: one product per batch entry.
+    for (std::size_t i = 0; i < batch; ++i) {
+      auto at = [i](MatrixView view, std::size_t stride) {
+        view.offset += i * stride;
+        return view;
+      };
+      gemm(queue, backend, transpose_a, transpose_b, m, n, k, alpha, at(a, stride_a), at(b, stride_b), beta,
+           at(c, stride_c));
+    }
     return;
   }
   cl_command_queue handle = queue.handle();
