@@ -31,6 +31,7 @@
 #include "inertialnet/ops/gemm.hpp"
 #include "inertialnet/ops/gemm_backend.hpp"
 #include "inertialnet/ops/gemm_packed.hpp"
+#include "inertialnet/ops/gemm_plan.hpp"
 #include "inertialnet/ops/linear.hpp"
 #include "inertialnet/ops/normalize.hpp"
 #include "inertialnet/ops/pool.hpp"

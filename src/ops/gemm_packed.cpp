@@ -88,6 +88,18 @@ std::size_t PackedPanels::floats(std::size_t lines, std::size_t depth, int width
   return (lines + w - 1) / w * w * depth;
 }
 
+PackedPanels PackedPanels::rows(std::size_t first, std::size_t count) const {
+  const auto w = static_cast<std::size_t>(width);
+  if (first % w != 0 || first + count > lines || count == 0) {
+    throw invalid_input("packed panels: lines [" + std::to_string(first) + ", " + std::to_string(first + count) +
+                        ") are not whole panels of " + std::to_string(lines) + " lines of width " + std::to_string(w));
+  }
+  PackedPanels part = *this;
+  part.lines = count;
+  part.data = data.region(first * depth, {static_cast<std::int64_t>(floats(count, depth, width))});
+  return part;
+}
+
 PackedPanels pack_a(Queue& queue, Transpose transpose, std::size_t m, std::size_t k, const MatrixView& a,
                     int tile_rows, Device* long_lived) {
   if (m == 0 || k == 0) throw invalid_input("packed GEMM: A is empty (" + std::to_string(m) + "×" + std::to_string(k) + ")");

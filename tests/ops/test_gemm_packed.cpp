@@ -195,5 +195,17 @@ TEST(PackedGemm, MismatchesAreInvalidInput) {
       [&] { gemm_packed(queue, a, b, MatrixView::of(big, 10), GemmEpilogue{1.0f, 0.0f, small, {}}); }, "bias");
 }
 
+TEST(GemmBackend, DeterministicChoiceByDeviceTypeAndPlan) {
+  DeviceInfo cpu, gpu;
+  cpu.type = DeviceType::CPU;
+  gpu.type = DeviceType::GPU;
+  EXPECT_EQ(gemm_backend(cpu, ""), GemmBackend::Packed);
+  EXPECT_EQ(gemm_backend(gpu, ""), GemmBackend::CLBlast);
+  EXPECT_EQ(gemm_backend(cpu, "clblast"), GemmBackend::CLBlast);
+  EXPECT_EQ(gemm_backend(gpu, "packed"), GemmBackend::Packed);
+  EXPECT_STREQ(to_string(GemmBackend::Packed), "packed");
+  testing::expect_invalid_input([&] { gemm_backend(cpu, "fastest"); }, "INERTIALNET_PLAN='fastest'");
+}
+
 }  // namespace
 }  // namespace inertialnet

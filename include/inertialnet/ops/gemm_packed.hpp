@@ -47,6 +47,8 @@ struct PackedPanels {
   int width = 0;          // MR for A, 32 for B
 
   std::size_t panels() const { return (lines + static_cast<std::size_t>(width) - 1) / static_cast<std::size_t>(width); }
+  // Lines [first, first + count) as packed panels of their own; `first` must start a panel.
+  PackedPanels rows(std::size_t first, std::size_t count) const;
   // Floats the packed form takes: whole panels.
   static std::size_t floats(std::size_t lines, std::size_t depth, int width);
 };
