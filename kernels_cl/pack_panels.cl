@@ -6,36 +6,47 @@
 
 // Element (line i, depth q) of the source is src[src_offset + i·line_stride + q·depth_stride]:
 // A stored row-major is (lda, 1), A stored transposed (1, lda); B stored row-major is (1, ldb).
-// One work-item per (line slot, depth); consecutive work-items write consecutive addresses.
+// One work-item per line slot and block of DEPTH_BLOCK depth steps (few, large work-groups:
+// PoCL's cost per work-group dominated one work-item per element); consecutive work-items
+// write consecutive addresses.
+#define DEPTH_BLOCK 64
 __kernel void pack_panels(__global const float* restrict src, const int src_offset,
                           __global float* restrict dst, const int dst_offset,
                           const int lines, const int depth, const int line_stride, const int depth_stride) {
   const int i = get_global_id(0);  // line slot, up to the padded line count
-  const int q = get_global_id(1);
+  const int q0 = get_global_id(1) * DEPTH_BLOCK;
   const int padded = (lines + WIDTH - 1) / WIDTH * WIDTH;
-  if (i >= padded || q >= depth) return;
-  const float v = i < lines ? src[src_offset + i * line_stride + q * depth_stride] : 0.0f;
-  dst[dst_offset + (i / WIDTH) * depth * WIDTH + q * WIDTH + i % WIDTH] = v;
+  if (i >= padded || q0 >= depth) return;
+  const int q1 = min(depth, q0 + DEPTH_BLOCK);
+  __global float* out = dst + dst_offset + (i / WIDTH) * depth * WIDTH + i % WIDTH;
+  if (i >= lines) {
+    for (int q = q0; q < q1; ++q) out[q * WIDTH] = 0.0f;
+    return;
+  }
+  const __global float* line = src + src_offset + i * line_stride;
+  for (int q = q0; q < q1; ++q) out[q * WIDTH] = line[q * depth_stride];
 }
 
 #ifdef KH
 // im2col straight into B panels (WIDTH = 32): the column of output pixel first_pixel + j is
 // line j; its depth index is (channel·KH + ky)·KW + kx, as the weight matrix [co, ci·KH·KW]
-// orders it. One work-item per (line slot, input channel) writes the KH·KW entries of its
-// channel; slots past pixel_count are zero.
+// orders it. One work-item per (line slot, block of CHANNEL_BLOCK input channels) writes the
+// KH·KW entries of its channels; slots past pixel_count are zero.
+#define CHANNEL_BLOCK 16
 __kernel void im2col_panels(__global const float* restrict in, const int in_offset,
                             __global float* restrict dst, const int dst_offset,
                             const int channels, const int height, const int width,
                             const int out_height, const int out_width,
                             const int first_pixel, const int pixel_count) {
   const int j = get_global_id(0);
-  const int c = get_global_id(1);
+  const int c0 = get_global_id(1) * CHANNEL_BLOCK;
   const int padded = (pixel_count + WIDTH - 1) / WIDTH * WIDTH;
-  if (j >= padded || c >= channels) return;
+  if (j >= padded || c0 >= channels) return;
+  const int c1 = min(channels, c0 + CHANNEL_BLOCK);
   const int depth = channels * KH * KW;
-  __global float* out = dst + dst_offset + (j / WIDTH) * depth * WIDTH + c * (KH * KW) * WIDTH + j % WIDTH;
+  __global float* out = dst + dst_offset + (j / WIDTH) * depth * WIDTH + c0 * (KH * KW) * WIDTH + j % WIDTH;
   if (j >= pixel_count) {
-    for (int t = 0; t < KH * KW; ++t) out[t * WIDTH] = 0.0f;
+    for (int t = 0; t < (c1 - c0) * KH * KW; ++t) out[t * WIDTH] = 0.0f;
     return;
   }
   const int p = first_pixel + j;
@@ -43,14 +54,17 @@ __kernel void im2col_panels(__global const float* restrict in, const int in_offs
   const int ox = p - oy * out_width;
   const int y0 = oy * STRIDE - PAD;
   const int x0 = ox * STRIDE - PAD;
-  const __global float* plane = in + in_offset + c * height * width;
-  for (int ky = 0; ky < KH; ++ky) {
-    const int y = y0 + ky;
-    const bool row_inside = y >= 0 && y < height;
-    for (int kx = 0; kx < KW; ++kx) {
-      const int x = x0 + kx;
-      out[(ky * KW + kx) * WIDTH] = (row_inside && x >= 0 && x < width) ? plane[y * width + x] : 0.0f;
+  for (int c = c0; c < c1; ++c) {
+    const __global float* plane = in + in_offset + c * height * width;
+    for (int ky = 0; ky < KH; ++ky) {
+      const int y = y0 + ky;
+      const bool row_inside = y >= 0 && y < height;
+      for (int kx = 0; kx < KW; ++kx) {
+        const int x = x0 + kx;
+        out[(ky * KW + kx) * WIDTH] = (row_inside && x >= 0 && x < width) ? plane[y * width + x] : 0.0f;
+      }
     }
+    out += KH * KW * WIDTH;
   }
 }
 #endif

@@ -13,6 +13,9 @@ namespace inertialnet {
 namespace {
 
 constexpr int kColumns = static_cast<int>(kPackedColumns);
+// Work per work-item of the packing kernels: DEPTH_BLOCK and CHANNEL_BLOCK of pack_panels.cl.
+constexpr std::size_t kPackDepthBlock = 64;
+constexpr std::size_t kIm2colChannelBlock = 16;
 
 int to_int(std::size_t value, const char* what) {
   if (value > static_cast<std::size_t>(std::numeric_limits<int>::max())) {
@@ -54,7 +57,8 @@ PackedPanels pack(Queue& queue, std::size_t lines, std::size_t depth, int width,
   kernel.set_args(source.buffer, to_int(source.offset, "offset"), packed.data, to_int(lines, "lines"),
                   to_int(depth, "depth"), to_int(line_stride, "stride"), to_int(depth_stride, "stride"));
   const std::size_t padded = packed.panels() * static_cast<std::size_t>(width);
-  queue.launch(kernel, Range(padded, depth), Range(std::min<std::size_t>(padded, kColumns), 1));
+  queue.launch(kernel, Range(padded, (depth + kPackDepthBlock - 1) / kPackDepthBlock),
+               Range(std::min<std::size_t>(padded, kColumns), 1));
   return packed;
 }
 
@@ -145,7 +149,8 @@ PackedPanels im2col_panels(Queue& queue, const Tensor& sample, const Im2colGeome
   kernel.set_args(sample, into, static_cast<int>(channels), static_cast<int>(sample.h()), static_cast<int>(sample.w()),
                   g.out_h, g.out_w, to_int(first_pixel, "first pixel"), to_int(count, "pixel count"));
   const std::size_t padded = packed.panels() * kPackedColumns;
-  queue.launch(kernel, Range(padded, channels), Range(kPackedColumns, 1));
+  queue.launch(kernel, Range(padded, (channels + kIm2colChannelBlock - 1) / kIm2colChannelBlock),
+               Range(kPackedColumns, 1));
   return packed;
 }
 
