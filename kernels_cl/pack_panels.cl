@@ -30,41 +30,65 @@ __kernel void pack_panels(__global const float* restrict src, const int src_offs
 #ifdef KH
 // im2col straight into B panels (WIDTH = 32): the column of output pixel first_pixel + j is
 // line j; its depth index is (channel·KH + ky)·KW + kx, as the weight matrix [co, ci·KH·KW]
-// orders it. One work-item per (line slot, block of CHANNEL_BLOCK input channels) writes the
-// KH·KW entries of its channels; slots past pixel_count are zero.
+// orders it, so each (channel, ky, kx) of a panel is 32 consecutive floats.
+// One work-item per (panel, block of CHANNEL_BLOCK input channels), launched in work-groups of
+// one: PoCL does not vectorise across work-items through the kernel's own loops, so the 32
+// lanes are written explicitly — two float16 copies where a stride-1 panel lies inside one
+// output row and inside the input row (FlowNet's widths are multiples of 32), a plain loop
+// elsewhere (borders, strides, panels across rows, the partial last panel).
 #define CHANNEL_BLOCK 16
 __kernel void im2col_panels(__global const float* restrict in, const int in_offset,
                             __global float* restrict dst, const int dst_offset,
                             const int channels, const int height, const int width,
                             const int out_height, const int out_width,
                             const int first_pixel, const int pixel_count) {
-  const int j = get_global_id(0);
+  const int panel = get_global_id(0);
   const int c0 = get_global_id(1) * CHANNEL_BLOCK;
-  const int padded = (pixel_count + WIDTH - 1) / WIDTH * WIDTH;
-  if (j >= padded || c0 >= channels) return;
+  const int j0 = panel * WIDTH;
+  if (j0 >= pixel_count || c0 >= channels) return;
   const int c1 = min(channels, c0 + CHANNEL_BLOCK);
   const int depth = channels * KH * KW;
-  __global float* out = dst + dst_offset + (j / WIDTH) * depth * WIDTH + c0 * (KH * KW) * WIDTH + j % WIDTH;
-  if (j >= pixel_count) {
-    for (int t = 0; t < (c1 - c0) * KH * KW; ++t) out[t * WIDTH] = 0.0f;
-    return;
-  }
-  const int p = first_pixel + j;
-  const int oy = p / out_width;
-  const int ox = p - oy * out_width;
-  const int y0 = oy * STRIDE - PAD;
-  const int x0 = ox * STRIDE - PAD;
+  const int lanes = min(WIDTH, pixel_count - j0);
+  const int p0 = first_pixel + j0;
+  const int oy0 = p0 / out_width;
+  const int ox0 = p0 - oy0 * out_width;
+  const bool one_row = STRIDE == 1 && lanes == WIDTH && ox0 + WIDTH <= out_width;
+  __global float* out = dst + dst_offset + panel * depth * WIDTH + c0 * (KH * KW) * WIDTH;
   for (int c = c0; c < c1; ++c) {
     const __global float* plane = in + in_offset + c * height * width;
     for (int ky = 0; ky < KH; ++ky) {
-      const int y = y0 + ky;
-      const bool row_inside = y >= 0 && y < height;
-      for (int kx = 0; kx < KW; ++kx) {
-        const int x = x0 + kx;
-        out[(ky * KW + kx) * WIDTH] = (row_inside && x >= 0 && x < width) ? plane[y * width + x] : 0.0f;
+      for (int kx = 0; kx < KW; ++kx, out += WIDTH) {
+        if (one_row) {
+          const int y = oy0 - PAD + ky, x = ox0 - PAD + kx;
+          if (y < 0 || y >= height) {
+            vstore16((float16)(0.0f), 0, out);
+            vstore16((float16)(0.0f), 1, out);
+            continue;
+          }
+          const __global float* src = plane + y * width + x;
+          if (x >= 0 && x + WIDTH <= width) {
+            vstore16(vload16(0, src), 0, out);
+            vstore16(vload16(1, src), 1, out);
+            continue;
+          }
+          for (int q = 0; q < WIDTH; ++q) out[q] = (x + q >= 0 && x + q < width) ? src[q] : 0.0f;
+          continue;
+        }
+        int oy = oy0, ox = ox0;
+        for (int q = 0; q < WIDTH; ++q) {
+          float v = 0.0f;
+          if (q < lanes) {
+            const int y = oy * STRIDE - PAD + ky, x = ox * STRIDE - PAD + kx;
+            if (y >= 0 && y < height && x >= 0 && x < width) v = plane[y * width + x];
+            if (++ox == out_width) {
+              ox = 0;
+              ++oy;
+            }
+          }
+          out[q] = v;
+        }
       }
     }
-    out += KH * KW * WIDTH;
   }
 }
 #endif

@@ -148,9 +148,7 @@ PackedPanels im2col_panels(Queue& queue, const Tensor& sample, const Im2colGeome
                                     .add("PAD", g.padding));
   kernel.set_args(sample, into, static_cast<int>(channels), static_cast<int>(sample.h()), static_cast<int>(sample.w()),
                   g.out_h, g.out_w, to_int(first_pixel, "first pixel"), to_int(count, "pixel count"));
-  const std::size_t padded = packed.panels() * kPackedColumns;
-  queue.launch(kernel, Range(padded, (channels + kIm2colChannelBlock - 1) / kIm2colChannelBlock),
-               Range(kPackedColumns, 1));
+  queue.launch(kernel, Range(packed.panels(), (channels + kIm2colChannelBlock - 1) / kIm2colChannelBlock), Range(1, 1));
   return packed;
 }
 
