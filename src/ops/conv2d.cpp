@@ -44,8 +44,8 @@ void conv2d_packed(Queue& queue, const Tensor& input, const Tensor& weight, cons
   }
 }
 
-// Few output channels: one work-item per output pixel computes all of them from the input
-// window, with bias and activation; no column matrix.
+// Few output channels: each work-item computes 16 output pixels of a row for all of them from
+// the input window, with bias and activation; no column matrix.
 void conv2d_direct(Queue& queue, const Tensor& input, const Tensor& weight, const Tensor& bias, const Tensor& output,
                    const Conv2dOptions& options) {
   const bool has_bias = bias.defined();
@@ -59,12 +59,12 @@ void conv2d_direct(Queue& queue, const Tensor& input, const Tensor& weight, cons
                                     .add("HAS_BIAS", has_bias)
                                     .add(activation_defines(options.activation)));
   const auto out_h = static_cast<std::size_t>(output.h()), out_w = static_cast<std::size_t>(output.w());
-  const Range local(detail::work_group_size(queue.device(), 64), 1);
+  constexpr std::size_t kLanes = 16;  // output pixels per work-item: LANES of conv2d_direct.cl
   for (std::int64_t n = 0; n < input.n(); ++n) {
     // Without a bias the kernel never reads its bias argument; any valid buffer will do.
     kernel.set_args(input.sample(n), weight, has_bias ? bias : weight, output.sample(n), input.c(), input.h(),
                     input.w(), out_h, out_w);
-    queue.launch(kernel, Range(out_w, out_h), local);
+    queue.launch(kernel, Range((out_w + kLanes - 1) / kLanes, out_h), Range(1, 1));
   }
 }
 
