@@ -33,9 +33,9 @@ __kernel void pack_panels(__global const float* restrict src, const int src_offs
 // orders it, so each (channel, ky, kx) of a panel is 32 consecutive floats.
 // One work-item per (panel, block of CHANNEL_BLOCK input channels), launched in work-groups of
 // one: PoCL does not vectorise across work-items through the kernel's own loops, so the 32
-// lanes are written explicitly — two float16 copies where a stride-1 panel lies inside one
-// output row and inside the input row (FlowNet's widths are multiples of 32), a plain loop
-// elsewhere (borders, strides, panels across rows, the partial last panel).
+// lanes are written explicitly — float16 copies where a stride-1 or stride-2 panel lies inside
+// one output row and inside the input row (FlowNet's widths are multiples of 32), a plain loop
+// elsewhere (borders, other strides, panels across rows, the partial last panel).
 #define CHANNEL_BLOCK 16
 __kernel void im2col_panels(__global const float* restrict in, const int in_offset,
                             __global float* restrict dst, const int dst_offset,
@@ -52,26 +52,36 @@ __kernel void im2col_panels(__global const float* restrict in, const int in_offs
   const int p0 = first_pixel + j0;
   const int oy0 = p0 / out_width;
   const int ox0 = p0 - oy0 * out_width;
-  const bool one_row = STRIDE == 1 && lanes == WIDTH && ox0 + WIDTH <= out_width;
+  const bool one_row = (STRIDE == 1 || STRIDE == 2) && lanes == WIDTH && ox0 + WIDTH <= out_width;
   __global float* out = dst + dst_offset + panel * depth * WIDTH + c0 * (KH * KW) * WIDTH;
   for (int c = c0; c < c1; ++c) {
     const __global float* plane = in + in_offset + c * height * width;
     for (int ky = 0; ky < KH; ++ky) {
       for (int kx = 0; kx < KW; ++kx, out += WIDTH) {
         if (one_row) {
-          const int y = oy0 - PAD + ky, x = ox0 - PAD + kx;
+          const int y = oy0 * STRIDE - PAD + ky, x = ox0 * STRIDE - PAD + kx;
           if (y < 0 || y >= height) {
             vstore16((float16)(0.0f), 0, out);
             vstore16((float16)(0.0f), 1, out);
             continue;
           }
           const __global float* src = plane + y * width + x;
-          if (x >= 0 && x + WIDTH <= width) {
+          if (x >= 0 && x + WIDTH * STRIDE <= width) {
+#if STRIDE == 1
             vstore16(vload16(0, src), 0, out);
             vstore16(vload16(1, src), 1, out);
+#else
+            // Every other input pixel: the even lanes of 64 consecutive floats.
+            const float16 a0 = vload16(0, src), a1 = vload16(1, src), a2 = vload16(2, src), a3 = vload16(3, src);
+            vstore16((float16)(a0.even, a1.even), 0, out);
+            vstore16((float16)(a2.even, a3.even), 1, out);
+#endif
             continue;
           }
-          for (int q = 0; q < WIDTH; ++q) out[q] = (x + q >= 0 && x + q < width) ? src[q] : 0.0f;
+          for (int q = 0; q < WIDTH; ++q) {
+            const int xi = x + q * STRIDE;
+            out[q] = (xi >= 0 && xi < width) ? src[q * STRIDE] : 0.0f;
+          }
           continue;
         }
         int oy = oy0, ox = ox0;
