@@ -6,13 +6,7 @@
 // activation are fused. Launch with work-groups of one.
 // Build options: -DCOUT, -DKH, -DKW, -DSTRIDE, -DPAD, -DHAS_BIAS, -DACTIVATION, -DNEGATIVE_SLOPE.
 
-#if ACTIVATION == 1
-#define ACTIVATE(v) fmax((v), 0.0f)
-#elif ACTIVATION == 2
-#define ACTIVATE(v) select((v), (v) * NEGATIVE_SLOPE, (v) < 0.0f)
-#else
-#define ACTIVATE(v) (v)
-#endif
+#include "common.cl"
 
 #define LANES 16
 

@@ -11,13 +11,7 @@
 // Build options: -DMR (rows per tile: 1..14), -DPANELS_FIRST (1: global dimension 0 enumerates
 // A panels, 0: B panels), -DHAS_BIAS, -DHAS_BETA, -DACTIVATION, -DNEGATIVE_SLOPE.
 
-#if ACTIVATION == 1
-#define ACTIVATE(v) fmax((v), 0.0f)
-#elif ACTIVATION == 2
-#define ACTIVATE(v) select((v), (v) * NEGATIVE_SLOPE, (v) < 0.0f)
-#else
-#define ACTIVATE(v) (v)
-#endif
+#include "common.cl"
 
 #if MR == 1
 #define EACH_ROW(X) X(0)

@@ -4,13 +4,7 @@
 // is bound by memory bandwidth, not by arithmetic.
 // Build options: -DHAS_BIAS, -DACTIVATION, -DNEGATIVE_SLOPE.
 
-#if ACTIVATION == 1
-#define ACTIVATE(v) fmax((v), 0.0f)
-#elif ACTIVATION == 2
-#define ACTIVATE(v) ((v) < 0.0f ? (v) * NEGATIVE_SLOPE : (v))
-#else
-#define ACTIVATE(v) (v)
-#endif
+#include "common.cl"
 
 // One work-item per output row; W row-major with leading dimension ldw.
 __kernel void gemv(__global const float* restrict w, const int w_offset, const int ldw,
