@@ -1,17 +1,17 @@
 #!/usr/bin/env bash
 # Installs the Debian packages that building, testing and running InertialNet-CL need
 # (OpenCL headers and ICD loader, PoCL for the CPU, CLBlast, OpenCV, Eigen, GoogleTest,
-# Google Benchmark, OpenBLAS (the benchmarks' CPU reference), CLI11, nlohmann-json, CMake and a
-# C++17 compiler).
+# Google Benchmark, CLI11, nlohmann-json, CMake and a C++17 compiler; OpenBLAS only as the
+# benchmarks' reference, never linked into the library).
 # Does nothing when everything is present. Works as root (no sudo needed) or through sudo.
 set -euo pipefail
 
 packages=(
   build-essential cmake pkg-config
   opencl-headers ocl-icd-opencl-dev pocl-opencl-icd clinfo
-  libclblast-dev
+  libclblast-dev libopenblas-dev
   libopencv-dev libeigen3-dev libopengv-dev
-  libgtest-dev libgmock-dev libbenchmark-dev libopenblas-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev
 )
 

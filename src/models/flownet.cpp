@@ -52,7 +52,7 @@ Tensor FlowNet::compute(Queue& queue, const Tensor& frame1, const Tensor& frame2
                         " and " + to_string(frame2.shape()));
   }
   prepare(frame1.n(), frame1.h(), frame1.w());
-  plan_->executor->run(queue, {{"frame1", frame1}, {"frame2", frame2}}, weights_.tensors(), stop);
+  plan_->executor->run(queue, {{"frame1", frame1}, {"frame2", frame2}}, weights_.tensors(), stop, &weights_.prepared());
   return plan_->executor->output("output");
 }
 

@@ -266,7 +266,7 @@ Tensor Executor::output(const std::string& name) const {
 }
 
 void Executor::run(Queue& queue, const std::map<std::string, Tensor>& inputs, const ParameterTensors& parameters,
-                   const std::atomic<bool>* stop) {
+                   const std::atomic<bool>* stop, PreparedWeights* prepared) {
   // Bind inputs (and slices of inputs).
   for (std::size_t id = 0; id < bound_.size(); ++id) {
     const Value& v = graph_.values()[id];
@@ -291,20 +291,40 @@ void Executor::run(Queue& queue, const std::map<std::string, Tensor>& inputs, co
     return found->second;
   };
 
+  // The plan of the GEMM layers, once: their backend and their weights as it reads them.
+  if (prepared && gemm_weights_.empty()) {
+    const auto& nodes = graph_.nodes();
+    gemm_weights_.assign(nodes.size(), nullptr);
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+      const Node& node = nodes[i];
+      if (node.kind == OpKind::Conv2d) gemm_weights_[i] = &prepared->conv2d(queue, node.weight, param(node.weight));
+      if (node.kind == OpKind::ConvTranspose2d) {
+        gemm_weights_[i] = &prepared->conv_transpose2d(queue, node.weight, param(node.weight));
+      }
+    }
+  }
+
   LayerProfiler* const profiler = queue.profiler();
-  for (const Node& node : graph_.nodes()) {
+  for (std::size_t index = 0; index < graph_.nodes().size(); ++index) {
+    const Node& node = graph_.nodes()[index];
+    const GemmWeights* gemm_weights = gemm_weights_.empty() ? nullptr : gemm_weights_[index];
     if (profiler) profiler->begin(queue, describe_layer(graph_, node));
     std::vector<Tensor> in;
     for (const ValueId id : node.inputs) in.push_back(resolve(id));
     const Tensor out = resolve(node.output);
     switch (node.kind) {
-      case OpKind::Conv2d:
-        conv2d(queue, in[0], param(node.weight), param(node.bias), out, node.options_as<Conv2dOptions>());
+      case OpKind::Conv2d: {
+        Conv2dOptions options = node.options_as<Conv2dOptions>();
+        options.prepared = gemm_weights;
+        conv2d(queue, in[0], param(node.weight), param(node.bias), out, options);
         break;
-      case OpKind::ConvTranspose2d:
-        conv_transpose2d(queue, in[0], param(node.weight), param(node.bias), out,
-                         node.options_as<ConvTranspose2dOptions>());
+      }
+      case OpKind::ConvTranspose2d: {
+        ConvTranspose2dOptions options = node.options_as<ConvTranspose2dOptions>();
+        options.prepared = gemm_weights;
+        conv_transpose2d(queue, in[0], param(node.weight), param(node.bias), out, options);
         break;
+      }
       case OpKind::Linear:
         linear(queue, in[0], param(node.weight), param(node.bias), out, node.options_as<ActivationSpec>());
         break;

@@ -21,6 +21,7 @@
 #include "inertialnet/ops/conv2d.hpp"
 #include "inertialnet/ops/conv_transpose2d.hpp"
 #include "inertialnet/ops/correlation.hpp"
+#include "inertialnet/ops/gemm_plan.hpp"
 #include "inertialnet/ops/pool.hpp"
 #include "inertialnet/ops/upsample.hpp"
 #include "inertialnet/runtime/queue.hpp"
@@ -163,8 +164,11 @@ class Executor {
   // Binds the graph's inputs by name and runs every node on `queue` (no wait at the end).
   // With `stop` given, the queue is drained after every node and a set flag ends the run by
   // throwing, so a cancelled run stops within one layer instead of one network.
+  // With `prepared`, the GEMM layers take their weights prepared for their backend from it (made
+  // on the first run, shared with every executor using the same cache); without, each call
+  // prepares its own.
   void run(Queue& queue, const std::map<std::string, Tensor>& inputs, const ParameterTensors& parameters,
-           const std::atomic<bool>* stop = nullptr);
+           const std::atomic<bool>* stop = nullptr, PreparedWeights* prepared = nullptr);
 
   // The tensor of a marked output (valid after run(), until the next run()).
   Tensor output(const std::string& name) const;
@@ -179,6 +183,7 @@ class Executor {
   MemoryPlan plan_;
   Tensor arena_;
   std::vector<Tensor> bound_;  // per value: its tensor for the current run
+  std::vector<const GemmWeights*> gemm_weights_;  // per node: its prepared weights (GEMM layers)
 };
 
 }  // namespace inertialnet::graph

@@ -71,7 +71,7 @@ Tensor InertialNetHead::compute(Queue& queue, const Tensor& flow, const std::ato
     plan->executor = std::make_unique<graph::Executor>(device_, std::move(g));
     plan_ = std::move(plan);
   }
-  plan_->executor->run(queue, {{"flow", flow}}, weights_.tensors(), stop);
+  plan_->executor->run(queue, {{"flow", flow}}, weights_.tensors(), stop, &weights_.prepared());
   return plan_->executor->output("omega");
 }
 

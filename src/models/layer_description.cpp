@@ -4,10 +4,6 @@ namespace inertialnet::graph {
 
 namespace {
 
-// The GEMM backend the GEMM-based ops use unless the op reports another one while it runs
-// (LayerProfiler::set_backend).
-constexpr const char* kDefaultGemmBackend = "clblast";
-
 std::string kernel_label(const char* op, const Shape& weight, std::int64_t stride) {
   return std::string(op) + " " + std::to_string(weight[2]) + "\u00d7" + std::to_string(weight[3]) + " s" +
          std::to_string(stride);
@@ -29,7 +25,6 @@ LayerInfo describe_layer(const Graph& graph, const Node& node) {
       // out [N, co, Ho, Wo], weight [co, ci, kh, kw]
       info.flops = 2.0 * static_cast<double>(element_count(out)) * (weight ? (*weight)[1] * (*weight)[2] * (*weight)[3] : 0);
       info.kind = out[1] == 2 ? "predict_flow" : kernel_label("conv", *weight, node.options_as<Conv2dOptions>().stride);
-      info.backend = kDefaultGemmBackend;
       break;
     }
     case OpKind::ConvTranspose2d: {
@@ -38,13 +33,11 @@ LayerInfo describe_layer(const Graph& graph, const Node& node) {
       info.flops = 2.0 * static_cast<double>(element_count(in)) * (weight ? (*weight)[1] * (*weight)[2] * (*weight)[3] : 0);
       info.kind = in[1] == 2 && out[1] == 2 ? "upsampled_flow"
                                             : kernel_label("deconv", *weight, node.options_as<ConvTranspose2dOptions>().stride);
-      info.backend = kDefaultGemmBackend;
       break;
     }
     case OpKind::Linear:
       info.flops = 2.0 * static_cast<double>(element_count(out)) * (weight ? (*weight)[1] : 0);
       info.kind = "linear";
-      info.backend = kDefaultGemmBackend;
       break;
     case OpKind::Correlation: {
       const Shape& in = graph.shape(node.inputs.at(0));

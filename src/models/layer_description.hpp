@@ -1,4 +1,5 @@
-// What a graph node is, for the per-layer profile: its kind label, FLOPs and GEMM backend.
+// What a graph node is, for the per-layer profile: its kind label and FLOPs (the op running it
+// reports its GEMM backend to the profiler itself).
 #pragma once
 
 #include "inertialnet/runtime/layer_profiler.hpp"

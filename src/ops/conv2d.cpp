@@ -15,6 +15,59 @@ namespace {
 
 const std::string kOp = "conv2d";
 
+// The packed backend: weights in MR-row panels (prepared once, or packed now), im2col writing
+// the B panels of a range of output pixels, and a GEMM whose store adds the bias, applies the
+// activation and writes the range's pixels of every output channel into the output view.
+void conv2d_packed(Queue& queue, const Tensor& input, const Tensor& weight, const Tensor& bias, const Tensor& output,
+                   const Conv2dOptions& options) {
+  const bool prepared = options.prepared && options.prepared->packed.data.defined();
+  const PackedPanels weights = prepared ? options.prepared->packed
+                                        : prepare_conv2d_weights(queue, weight, GemmBackend::Packed).packed;
+  const std::size_t reduction = weights.depth;
+  const auto out_h = static_cast<int>(output.h()), out_w = static_cast<int>(output.w());
+  const std::size_t pixels = static_cast<std::size_t>(out_h) * static_cast<std::size_t>(out_w);
+  // Whole panels per range, so only the last range of a sample has a partial panel.
+  std::size_t chunk = std::clamp<std::size_t>(detail::column_budget(queue.device(), options.max_column_floats) / reduction, 1, pixels);
+  if (chunk >= kPackedColumns && chunk < pixels) chunk -= chunk % kPackedColumns;
+  const Tensor columns = Tensor::empty(queue, {static_cast<std::int64_t>(PackedPanels::floats(chunk, reduction, static_cast<int>(kPackedColumns)))});
+  const Im2colGeometry geometry{static_cast<int>(weight.dim(2)), static_cast<int>(weight.dim(3)), options.stride,
+                                options.padding, out_h, out_w};
+  const GemmEpilogue epilogue{1.0f, 0.0f, bias, options.activation};
+  for (std::int64_t n = 0; n < input.n(); ++n) {
+    const Tensor in_n = input.sample(n);
+    const Tensor out_n = output.sample(n);
+    for (std::size_t first = 0; first < pixels; first += chunk) {
+      const std::size_t count = std::min(chunk, pixels - first);
+      const PackedPanels panels = im2col_panels(queue, in_n, geometry, first, count, columns);
+      gemm_packed(queue, weights, panels, MatrixView::of(out_n, pixels, first), epilogue);
+    }
+  }
+}
+
+// Few output channels: each work-item computes 16 output pixels of a row for all of them from
+// the input window, with bias and activation; no column matrix.
+void conv2d_direct(Queue& queue, const Tensor& input, const Tensor& weight, const Tensor& bias, const Tensor& output,
+                   const Conv2dOptions& options) {
+  const bool has_bias = bias.defined();
+  Kernel& kernel = queue.kernel("conv2d_direct", "conv2d_direct",
+                                KernelDefines()
+                                    .add("COUT", weight.dim(0))
+                                    .add("KH", weight.dim(2))
+                                    .add("KW", weight.dim(3))
+                                    .add("STRIDE", options.stride)
+                                    .add("PAD", options.padding)
+                                    .add("HAS_BIAS", has_bias)
+                                    .add(activation_defines(options.activation)));
+  const auto out_h = static_cast<std::size_t>(output.h()), out_w = static_cast<std::size_t>(output.w());
+  constexpr std::size_t kLanes = 16;  // output pixels per work-item: LANES of conv2d_direct.cl
+  for (std::int64_t n = 0; n < input.n(); ++n) {
+    // Without a bias the kernel never reads its bias argument; any valid buffer will do.
+    kernel.set_args(input.sample(n), weight, has_bias ? bias : weight, output.sample(n), input.c(), input.h(),
+                    input.w(), out_h, out_w);
+    queue.launch(kernel, Range((out_w + kLanes - 1) / kLanes, out_h), Range(1, 1));
+  }
+}
+
 }  // namespace
 
 Shape conv2d_output_shape(const Shape& input, const Shape& weight, int stride, int padding) {
@@ -54,6 +107,18 @@ void conv2d(Queue& queue, const Tensor& input, const Tensor& weight, const Tenso
   }
 
   Device& device = queue.device();
+  const GemmBackend backend = options.prepared ? options.prepared->backend : gemm_backend(device.info());
+  if (backend == GemmBackend::Packed) {
+    if (weight.dim(0) <= kDirectConvMaxChannels) {
+      detail::report_backend(queue, "direct");
+      conv2d_direct(queue, input, weight, bias, output, options);
+    } else {
+      detail::report_backend(queue, to_string(backend));
+      conv2d_packed(queue, input, weight, bias, output, options);
+    }
+    return;
+  }
+  detail::report_backend(queue, to_string(backend));
   const auto batch = input.n();
   const auto channels = static_cast<std::size_t>(input.c());
   const auto kh = static_cast<std::size_t>(weight.dim(2)), kw = static_cast<std::size_t>(weight.dim(3));
@@ -67,7 +132,7 @@ void conv2d(Queue& queue, const Tensor& input, const Tensor& weight, const Tenso
   if (direct) {
     // The input sample is already the [ci, H·W] column matrix.
     for (std::int64_t n = 0; n < batch; ++n) {
-      gemm(queue, Transpose::No, Transpose::No, out_channels, pixels, reduction, 1.0f, weights,
+      gemm(queue, backend, Transpose::No, Transpose::No, out_channels, pixels, reduction, 1.0f, weights,
            MatrixView::of(input.sample(n), pixels), 0.0f, MatrixView::of(output.sample(n), pixels));
     }
   } else {
@@ -85,7 +150,7 @@ void conv2d(Queue& queue, const Tensor& input, const Tensor& weight, const Tenso
         unfold.set_args(in_n, columns, channels, input.h(), input.w(), out_h, out_w, first, count);
         queue.launch(unfold, Range(count, channels), local);
         // Output pixels [first, first + count) of every output channel: rows `pixels` apart.
-        gemm(queue, Transpose::No, Transpose::No, out_channels, count, reduction, 1.0f, weights,
+        gemm(queue, backend, Transpose::No, Transpose::No, out_channels, count, reduction, 1.0f, weights,
              MatrixView::of(columns, count), 0.0f, MatrixView::of(out_n, pixels, first));
       }
     }

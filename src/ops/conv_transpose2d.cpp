@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <numeric>
 #include <string>
 
 #include "inertialnet/runtime/device.hpp"
@@ -64,8 +65,22 @@ void conv_transpose2d(Queue& queue, const Tensor& input, const Tensor& weight, c
   const std::size_t in_pixels = static_cast<std::size_t>(input.h() * input.w());
   const std::size_t out_pixels = static_cast<std::size_t>(expected[2] * expected[3]);
 
-  const std::size_t block =
+  std::size_t block =
       std::clamp<std::size_t>(detail::column_budget(device, options.max_column_floats) / (taps * in_pixels), 1, out_channels);
+  const GemmBackend backend = options.prepared ? options.prepared->backend : gemm_backend(device.info());
+  detail::report_backend(queue, to_string(backend));
+  // The packed backend multiplies Wᵀ packed once per layer (or now) by the input packed per
+  // sample; a block of channels is then a range of whole A panels.
+  PackedPanels packed_weight, packed_input;
+  if (backend == GemmBackend::Packed) {
+    const bool prepared = options.prepared && options.prepared->packed.data.defined();
+    packed_weight = prepared ? options.prepared->packed
+                             : prepare_conv_transpose2d_weights(queue, weight, GemmBackend::Packed).packed;
+    const auto width = static_cast<std::size_t>(packed_weight.width);
+    const std::size_t step = width / std::gcd(taps, width);
+    // Rounding up to whole panels can exceed the column budget by less than one panel's rows.
+    if (block < out_channels) block = std::min(out_channels, std::max(step, block / step * step));
+  }
   const Tensor columns =
       Tensor::empty(queue, {static_cast<std::int64_t>(block * taps), static_cast<std::int64_t>(in_pixels)});
   const bool has_bias = bias.defined();
@@ -84,13 +99,22 @@ void conv_transpose2d(Queue& queue, const Tensor& input, const Tensor& weight, c
   for (std::int64_t n = 0; n < input.n(); ++n) {
     const Tensor in_n = input.sample(n);
     const Tensor out_n = output.sample(n);
+    if (backend == GemmBackend::Packed) {
+      packed_input = pack_b(queue, Transpose::No, in_channels, in_pixels, MatrixView::of(in_n, in_pixels),
+                            packed_input.data);
+    }
     for (std::size_t first = 0; first < out_channels; first += block) {
       const std::size_t count = std::min(block, out_channels - first);
       // columns[count·taps, H·W] = Wᵀ · X: W is stored [ci, co·taps], so the block's rows of Wᵀ
       // are columns [first·taps, (first + count)·taps) of W.
-      gemm(queue, Transpose::Yes, Transpose::No, count * taps, in_pixels, in_channels, 1.0f,
-           MatrixView::of(weight, out_channels * taps, first * taps), MatrixView::of(in_n, in_pixels), 0.0f,
-           MatrixView::of(columns, in_pixels));
+      if (backend == GemmBackend::Packed) {
+        gemm_packed(queue, packed_weight.rows(first * taps, count * taps), packed_input,
+                    MatrixView::of(columns, in_pixels));
+      } else {
+        gemm(queue, backend, Transpose::Yes, Transpose::No, count * taps, in_pixels, in_channels, 1.0f,
+             MatrixView::of(weight, out_channels * taps, first * taps), MatrixView::of(in_n, in_pixels), 0.0f,
+             MatrixView::of(columns, in_pixels));
+      }
       const auto first_channel = static_cast<std::int64_t>(first);
       const auto channel_count = static_cast<std::int64_t>(count);
       const Tensor out_block = out_n.channels(first_channel, channel_count);

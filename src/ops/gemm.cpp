@@ -4,27 +4,16 @@
 
 #include <mutex>
 
+#include "inertialnet/ops/gemm_packed.hpp"
 #include "inertialnet/runtime/device.hpp"
+#include "ops/gemm_support.hpp"
 
 namespace inertialnet {
 
-namespace {
+namespace detail {
 
-// CLBlast keeps process-wide caches of compiled programs and tuning data, and calling it from
-// several threads at once (the pipeline's lanes) crashed intermittently here, as reported
-// upstream for multi-threaded use (CLBlast issue 486). Calls only enqueue work — the GEMM runs
-// after the lock is released — so serialising them costs the lanes no overlap.
-std::mutex& clblast_mutex() {
-  static std::mutex mutex;
-  return mutex;
-}
-
-clblast::Transpose to_clblast(Transpose t) { return t == Transpose::Yes ? clblast::Transpose::kYes : clblast::Transpose::kNo; }
-
-// Checks that a row-major `rows`×`cols` matrix stored with `view.leading_dimension`, repeated
-// `batch` times `stride` apart, lies inside its buffer.
-void check_operand(const char* name, const MatrixView& view, std::size_t rows, std::size_t cols, std::size_t stride,
-                   std::size_t batch) {
+void check_gemm_operand(const char* name, const MatrixView& view, std::size_t rows, std::size_t cols,
+                        std::size_t stride, std::size_t batch) {
   if (!view.buffer) throw invalid_input(std::string("GEMM operand ") + name + " has no buffer");
   if (view.leading_dimension < cols) {
     throw invalid_input(std::string("GEMM operand ") + name + ": leading dimension " +
@@ -41,6 +30,21 @@ void check_operand(const char* name, const MatrixView& view, std::size_t rows, s
   }
 }
 
+}  // namespace detail
+
+namespace {
+
+// CLBlast keeps process-wide caches of compiled programs and tuning data, and calling it from
+// several threads at once (the pipeline's lanes) crashed intermittently here, as reported
+// upstream for multi-threaded use (CLBlast issue 486). Calls only enqueue work — the GEMM runs
+// after the lock is released — so serialising them costs the lanes no overlap.
+std::mutex& clblast_mutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+
+clblast::Transpose to_clblast(Transpose t) { return t == Transpose::Yes ? clblast::Transpose::kYes : clblast::Transpose::kNo; }
+
 void check_problem(Transpose ta, Transpose tb, std::size_t m, std::size_t n, std::size_t k, const MatrixView& a,
                    std::size_t sa, const MatrixView& b, std::size_t sb, const MatrixView& c, std::size_t sc,
                    std::size_t batch) {
@@ -49,9 +53,9 @@ void check_problem(Transpose ta, Transpose tb, std::size_t m, std::size_t n, std
                         " k=" + std::to_string(k) + " batch=" + std::to_string(batch));
   }
   // As stored (row-major): A is m×k, or k×m when transposed; likewise B.
-  check_operand("A", a, ta == Transpose::No ? m : k, ta == Transpose::No ? k : m, sa, batch);
-  check_operand("B", b, tb == Transpose::No ? k : n, tb == Transpose::No ? n : k, sb, batch);
-  check_operand("C", c, m, n, sc, batch);
+  detail::check_gemm_operand("A", a, ta == Transpose::No ? m : k, ta == Transpose::No ? k : m, sa, batch);
+  detail::check_gemm_operand("B", b, tb == Transpose::No ? k : n, tb == Transpose::No ? n : k, sb, batch);
+  detail::check_gemm_operand("C", c, m, n, sc, batch);
 }
 
 }  // namespace
@@ -62,7 +66,19 @@ MatrixView MatrixView::of(const Tensor& tensor, std::size_t leading_dimension, s
 
 void gemm(Queue& queue, Transpose transpose_a, Transpose transpose_b, std::size_t m, std::size_t n, std::size_t k,
           float alpha, const MatrixView& a, const MatrixView& b, float beta, const MatrixView& c) {
+  gemm(queue, gemm_backend(queue.device().info()), transpose_a, transpose_b, m, n, k, alpha, a, b, beta, c);
+}
+
+void gemm(Queue& queue, GemmBackend backend, Transpose transpose_a, Transpose transpose_b, std::size_t m,
+          std::size_t n, std::size_t k, float alpha, const MatrixView& a, const MatrixView& b, float beta,
+          const MatrixView& c) {
   check_problem(transpose_a, transpose_b, m, n, k, a, 0, b, 0, c, 0, 1);
+  if (backend == GemmBackend::Packed) {
+    const PackedPanels packed_a = pack_a(queue, transpose_a, m, k, a);
+    const PackedPanels packed_b = pack_b(queue, transpose_b, k, n, b);
+    gemm_packed(queue, packed_a, packed_b, c, GemmEpilogue{alpha, beta, Tensor(), ActivationSpec::none()});
+    return;
+  }
   cl_command_queue handle = queue.handle();
   std::lock_guard<std::mutex> lock(clblast_mutex());
   const auto status = clblast::Gemm<float>(clblast::Layout::kRowMajor, to_clblast(transpose_a), to_clblast(transpose_b),
@@ -77,8 +93,17 @@ void gemm_strided_batched(Queue& queue, Transpose transpose_a, Transpose transpo
                           std::size_t stride_b, float beta, const MatrixView& c, std::size_t stride_c,
                           std::size_t batch) {
   check_problem(transpose_a, transpose_b, m, n, k, a, stride_a, b, stride_b, c, stride_c, batch);
-  if (batch == 1) {
-    gemm(queue, transpose_a, transpose_b, m, n, k, alpha, a, b, beta, c);
+  const GemmBackend backend = gemm_backend(queue.device().info());
+  if (batch == 1 || backend == GemmBackend::Packed) {
+    // The packed kernels have no batched form: one product per batch entry.
+    for (std::size_t i = 0; i < batch; ++i) {
+      auto at = [i](MatrixView view, std::size_t stride) {
+        view.offset += i * stride;
+        return view;
+      };
+      gemm(queue, backend, transpose_a, transpose_b, m, n, k, alpha, at(a, stride_a), at(b, stride_b), beta,
+           at(c, stride_c));
+    }
     return;
   }
   cl_command_queue handle = queue.handle();

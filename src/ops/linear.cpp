@@ -6,6 +6,7 @@
 #include "inertialnet/runtime/device.hpp"
 #include "inertialnet/ops/bias_activation.hpp"
 #include "inertialnet/ops/gemm.hpp"
+#include "inertialnet/ops/gemm_packed.hpp"
 #include "ops/op_support.hpp"
 
 namespace inertialnet {
@@ -13,6 +14,10 @@ namespace inertialnet {
 namespace {
 
 const std::string kOp = "linear";
+
+// Up to this many samples the packed backend runs one GEMV per sample (reading W once per
+// sample); more go through the packed GEMM.
+constexpr std::size_t kGemvMaxBatch = 4;
 
 }  // namespace
 
@@ -47,9 +52,21 @@ void linear(Queue& queue, const Tensor& input, const Tensor& weight, const Tenso
   const auto batch = static_cast<std::size_t>(expected[0]);
   const auto out_features = static_cast<std::size_t>(expected[1]);
   const auto in_features = static_cast<std::size_t>(weight.dim(1));
+  const GemmBackend backend = gemm_backend(queue.device().info());
+  if (backend == GemmBackend::Packed && batch <= kGemvMaxBatch) {
+    // A few samples: one pass over W per sample, W read in place, bias and activation fused.
+    detail::report_backend(queue, "gemv");
+    for (std::size_t n = 0; n < batch; ++n) {
+      const auto i = static_cast<std::int64_t>(n);
+      gemv(queue, out_features, in_features, MatrixView::of(weight, in_features), input.sample(i),
+           output.sample(i), bias, activation);
+    }
+    return;
+  }
+  detail::report_backend(queue, to_string(backend));
   // Row i of A is sample i (contiguous within the sample, batch_stride apart), row i of C the
   // output sample (possibly a slice of wider rows); B = Wᵀ with W stored [out, in].
-  gemm(queue, Transpose::No, Transpose::Yes, batch, out_features, in_features, 1.0f,
+  gemm(queue, backend, Transpose::No, Transpose::Yes, batch, out_features, in_features, 1.0f,
        MatrixView::of(input, input.batch_stride()), MatrixView::of(weight, in_features), 0.0f,
        MatrixView::of(output, output.batch_stride()));
   add_bias_activation(queue, output, bias, activation);

@@ -11,6 +11,7 @@
 
 #include "inertialnet/runtime/device.hpp"
 #include "inertialnet/runtime/error.hpp"
+#include "inertialnet/runtime/layer_profiler.hpp"
 #include "inertialnet/runtime/queue.hpp"
 #include "inertialnet/runtime/tensor.hpp"
 
@@ -117,6 +118,12 @@ inline RowLayout row_layout(std::initializer_list<const Tensor*> tensors) {
   }
   for (const Tensor* t : tensors) t->offset_int();  // every view must fit 32-bit indexing
   return layout;
+}
+
+// Tells a profiling queue which implementation ran the current layer ("clblast", "packed",
+// "direct", "gemv"), so per-layer profiles show the plan as it ran, not as it was assumed.
+inline void report_backend(const Queue& queue, const char* backend) {
+  if (LayerProfiler* profiler = queue.profiler()) profiler->set_backend(queue, backend);
 }
 
 }  // namespace inertialnet::detail

@@ -8,11 +8,13 @@
 
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "inertialnet/runtime/device.hpp"
 #include "inertialnet/models/parameters.hpp"
+#include "inertialnet/ops/gemm_plan.hpp"
 #include "inertialnet/runtime/tensor.hpp"
 
 namespace inertialnet {
@@ -49,6 +51,11 @@ class WeightSet {
   std::string sources() const;  // file names, or "synthetic …", for messages
   std::size_t bytes() const;
 
+  // The layers' weights prepared for their GEMM backend (packed panels on CPU devices), made
+  // when a network first runs and shared by every network and lane using this set, so pipeline
+  // lanes do not each hold a copy. Copies of the set share it.
+  PreparedWeights& prepared() const { return *prepared_; }
+
  private:
   void add(Device& device, const std::string& name, const Shape& shape, const std::vector<float>& data,
            const std::string& source);
@@ -61,6 +68,7 @@ class WeightSet {
   std::vector<ModelKind> models_;
   bool has_head_config_ = false;
   HeadConfig head_config_;
+  std::shared_ptr<PreparedWeights> prepared_ = std::make_shared<PreparedWeights>();
 };
 
 }  // namespace inertialnet

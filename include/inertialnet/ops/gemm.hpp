@@ -1,13 +1,15 @@
-// Single-precision GEMM through CLBlast, row-major: C = alpha·op(A)·op(B) + beta·C with op(A)
-// m×k, op(B) k×n and C m×n. Convolutions and fully connected layers end here.
+// Single-precision GEMM, row-major: C = alpha·op(A)·op(B) + beta·C with op(A) m×k, op(B) k×n
+// and C m×n, through CLBlast or the packed-panel kernels (ops/gemm_backend.hpp says which).
+// Convolutions and fully connected layers end here.
 //
 // Matrices are views into device buffers (buffer, element offset, leading dimension); every
-// shape, leading dimension and extent is checked against the buffer before CLBlast sees it, so
-// a wrong shape is an invalid_input naming the operand, not a driver error.
+// shape, leading dimension and extent is checked against the buffer before a backend sees it,
+// so a wrong shape is an invalid_input naming the operand, not a driver error.
 #pragma once
 
 #include <cstddef>
 
+#include "inertialnet/ops/gemm_backend.hpp"
 #include "inertialnet/runtime/queue.hpp"
 #include "inertialnet/runtime/tensor.hpp"
 
@@ -25,8 +27,15 @@ struct MatrixView {
   static MatrixView of(const Tensor& tensor, std::size_t leading_dimension, std::size_t extra_offset = 0);
 };
 
+// On the device's backend (gemm_backend()). The packed backend packs both operands on every
+// call; layers that multiply by the same weights every time pack them once (ops/gemm_plan.hpp).
 void gemm(Queue& queue, Transpose transpose_a, Transpose transpose_b, std::size_t m, std::size_t n,
           std::size_t k, float alpha, const MatrixView& a, const MatrixView& b, float beta,
+          const MatrixView& c);
+
+// On the given backend.
+void gemm(Queue& queue, GemmBackend backend, Transpose transpose_a, Transpose transpose_b, std::size_t m,
+          std::size_t n, std::size_t k, float alpha, const MatrixView& a, const MatrixView& b, float beta,
           const MatrixView& c);
 
 // `batch` independent GEMMs; operand i starts `stride_*` elements after operand i−1.

@@ -25,7 +25,7 @@ struct LayerInfo {
   std::string name;
   std::string kind;
   double flops = 0;
-  std::string backend;  // "clblast", … for GEMM-based layers; "" for the others
+  std::string backend;  // "clblast", "packed", "direct", "gemv" for GEMM-based layers; "" for the others
 };
 
 struct LayerTime {

@@ -1,0 +1,94 @@
+// The project's own SGEMM for CPU devices (kernels_cl/gemm_packed.cl): both operands are
+// rearranged into panels that one work-item streams through in order, one MR×32 tile of C per
+// work-item held in registers, bias and activation applied as the tile is stored.
+//
+// A (m×k, the weights of a layer) is packed once, into panels of MR rows stored k-major;
+// B (k×n, the im2col columns or an input) into panels of 32 columns, written directly by
+// im2col_panels() for convolutions. Both are zero-padded to whole panels, so the inner loop has
+// no edge case; the store is guarded and writes only the m×n view of C (leading dimension
+// and element offset: a channel slice of a concatenation is written in place).
+//
+// Kernel parameters are build options listed in packed_gemm_parameters(), the one place a
+// parameter search (`tune`) looks for what it may vary.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "inertialnet/ops/activation.hpp"
+#include "inertialnet/ops/gemm.hpp"
+#include "inertialnet/runtime/queue.hpp"
+#include "inertialnet/runtime/tensor.hpp"
+
+namespace inertialnet {
+
+// Columns per B panel and per tile: two float16 registers.
+inline constexpr std::size_t kPackedColumns = 32;
+
+// A build option of the packed GEMM: its name, the default, and the values the kernel accepts.
+struct PackedGemmParameter {
+  const char* name;
+  int default_value;
+  std::vector<int> candidates;
+  const char* meaning;
+};
+const std::vector<PackedGemmParameter>& packed_gemm_parameters();
+
+// The tile rows for an m-row product: the default MR, or a smaller one that wastes fewer padded
+// rows when m is small (m = 2 → 2, m = 4 → 4); `requested` > 0 forces a candidate.
+int packed_gemm_tile_rows(std::size_t m, int requested = 0);
+
+// A matrix packed into panels of `width` lines (rows of A, or columns of B), depth-major.
+struct PackedPanels {
+  Tensor data;
+  std::size_t lines = 0;  // m for A, n for B (before padding)
+  std::size_t depth = 0;  // k
+  int width = 0;          // MR for A, 32 for B
+
+  std::size_t panels() const { return (lines + static_cast<std::size_t>(width) - 1) / static_cast<std::size_t>(width); }
+  // Lines [first, first + count) as packed panels of their own; `first` must start a panel.
+  PackedPanels rows(std::size_t first, std::size_t count) const;
+  // Floats the packed form takes: whole panels.
+  static std::size_t floats(std::size_t lines, std::size_t depth, int width);
+};
+
+// Packs op(A) (m×k; A stored m×k, or k×m when transposed) into panels of `tile_rows`. With a
+// Device target the panels are long-lived (a layer's weights, packed once); the work runs on
+// `queue`, and the caller finishes the queue before another queue reads them.
+PackedPanels pack_a(Queue& queue, Transpose transpose, std::size_t m, std::size_t k, const MatrixView& a,
+                    int tile_rows = 0, Device* long_lived = nullptr);
+// Packs op(B) (k×n; B stored k×n, or n×k when transposed) into panels of 32 columns, into
+// `into` when it is defined and large enough (a reusable temporary), else a new tensor.
+PackedPanels pack_b(Queue& queue, Transpose transpose, std::size_t k, std::size_t n, const MatrixView& b,
+                    const Tensor& into = {});
+
+// The B panels of a convolution's columns for output pixels [first_pixel, first_pixel + count)
+// of one NCHW sample, written straight from the input: im2col without the column matrix.
+// `into` must hold PackedPanels::floats(count, channels·kh·kw, 32) floats.
+struct Im2colGeometry {
+  int kernel_h = 1, kernel_w = 1, stride = 1, padding = 0;
+  int out_h = 0, out_w = 0;
+};
+PackedPanels im2col_panels(Queue& queue, const Tensor& sample, const Im2colGeometry& geometry,
+                           std::size_t first_pixel, std::size_t count, const Tensor& into);
+
+// How the product is stored: C = activation(alpha·A·B + beta·C + bias[row]). `bias` holds one
+// value per row of C (a layer's output channels) or is undefined.
+struct GemmEpilogue {
+  float alpha = 1.0f;
+  float beta = 0.0f;
+  Tensor bias;
+  ActivationSpec activation{};
+};
+
+// C (m×n view, m = a.lines, n = b.lines) from packed operands of equal depth.
+void gemm_packed(Queue& queue, const PackedPanels& a, const PackedPanels& b, const MatrixView& c,
+                 const GemmEpilogue& epilogue = {});
+
+// y[row] = activation(Σ W[row][q]·x[q] + bias[row]) for `rows` rows of a row-major W: one
+// matrix-vector product, reading W in place (a fully connected layer on one sample).
+void gemv(Queue& queue, std::size_t rows, std::size_t depth, const MatrixView& w, const Tensor& x, const Tensor& y,
+          const Tensor& bias, const ActivationSpec& activation);
+
+}  // namespace inertialnet

@@ -1,0 +1,103 @@
+// Packed-panel SGEMM for CPU devices: C = alpha·A·B (+ beta·C), then + bias[row] and the
+// activation, stored into a strided view of C.
+//
+// A (m×k) arrives packed in panels of MR rows, k-major: panel p holds A[p·MR + r][q] at
+// p·k·MR + q·MR + r, rows past m zero. B (k×n) arrives packed in panels of 32 columns: panel j
+// holds B[q][j·32 + c] at j·k·32 + q·32 + c, columns past n zero. One work-item computes one
+// MR×32 tile of C over the whole of k in 2·MR float16 accumulators: per k it loads two float16
+// of B, broadcasts MR floats of A and does 2·MR fma, which PoCL compiles to a register-blocked
+// AVX-512 loop (a BLIS-style micro-kernel). Launch with work-groups of one work-item.
+//
+// Build options: -DMR (rows per tile: 1..14), -DPANELS_FIRST (1: global dimension 0 enumerates
+// A panels, 0: B panels), -DHAS_BIAS, -DHAS_BETA, -DACTIVATION, -DNEGATIVE_SLOPE.
+
+#include "common.cl"
+
+#if MR == 1
+#define EACH_ROW(X) X(0)
+#elif MR == 2
+#define EACH_ROW(X) X(0) X(1)
+#elif MR == 4
+#define EACH_ROW(X) X(0) X(1) X(2) X(3)
+#elif MR == 6
+#define EACH_ROW(X) X(0) X(1) X(2) X(3) X(4) X(5)
+#elif MR == 8
+#define EACH_ROW(X) X(0) X(1) X(2) X(3) X(4) X(5) X(6) X(7)
+#elif MR == 12
+#define EACH_ROW(X) X(0) X(1) X(2) X(3) X(4) X(5) X(6) X(7) X(8) X(9) X(10) X(11)
+#elif MR == 14
+#define EACH_ROW(X) X(0) X(1) X(2) X(3) X(4) X(5) X(6) X(7) X(8) X(9) X(10) X(11) X(12) X(13)
+#else
+#error "MR must be 1, 2, 4, 6, 8, 12 or 14"
+#endif
+
+#define DECLARE(r) float16 lo##r = (float16)(0.0f), hi##r = (float16)(0.0f);
+#define ACCUMULATE(r)                      \
+  {                                        \
+    const float16 a = (float16)(ap[r]);    \
+    lo##r = fma(a, b_lo, lo##r);           \
+    hi##r = fma(a, b_hi, hi##r);           \
+  }
+#define STORE(r) store_row(c, c_offset + (row0 + r) * ldc + col0, lo##r, hi##r, row0 + r < m, cols, alpha, beta, bias, bias_offset + row0 + r);
+
+// One row of a tile: `cols` (1..32) valid columns starting at c[index].
+inline void store_row(__global float* c, const int index, float16 lo, float16 hi, const bool valid_row,
+                      const int cols, const float alpha, const float beta, __global const float* bias,
+                      const int bias_index) {
+  if (!valid_row) return;
+  lo *= alpha;
+  hi *= alpha;
+#if HAS_BETA
+  if (cols == 32) {
+    lo += beta * vload16(0, c + index);
+    hi += beta * vload16(0, c + index + 16);
+  } else {
+    float t[32];
+    for (int q = 0; q < cols; ++q) t[q] = beta * c[index + q];
+    for (int q = cols; q < 32; ++q) t[q] = 0.0f;
+    lo += vload16(0, t);
+    hi += vload16(0, t + 16);
+  }
+#endif
+#if HAS_BIAS
+  const float b = bias[bias_index];
+  lo += b;
+  hi += b;
+#endif
+  lo = ACTIVATE(lo);
+  hi = ACTIVATE(hi);
+  if (cols == 32) {
+    vstore16(lo, 0, c + index);
+    vstore16(hi, 0, c + index + 16);
+  } else {
+    float t[32];
+    vstore16(lo, 0, t);
+    vstore16(hi, 0, t + 16);
+    for (int q = 0; q < cols; ++q) c[index + q] = t[q];
+  }
+}
+
+__kernel void gemm_packed(__global const float* restrict a_packed, const int a_offset,
+                          __global const float* restrict b_packed, const int b_offset,
+                          __global float* restrict c, const int c_offset, const int ldc,
+                          __global const float* restrict bias, const int bias_offset,
+                          const int m, const int n, const int k, const float alpha, const float beta) {
+#if PANELS_FIRST
+  const int panel = get_global_id(0), column_panel = get_global_id(1);
+#else
+  const int panel = get_global_id(1), column_panel = get_global_id(0);
+#endif
+  const int row0 = panel * MR, col0 = column_panel * 32;
+  if (row0 >= m || col0 >= n) return;
+  __global const float* ap = a_packed + a_offset + (size_t)panel * k * MR;
+  __global const float* bp = b_packed + b_offset + (size_t)column_panel * k * 32;
+  EACH_ROW(DECLARE)
+  for (int q = 0; q < k; ++q) {
+    const float16 b_lo = vload16(0, bp), b_hi = vload16(1, bp);
+    EACH_ROW(ACCUMULATE)
+    ap += MR;
+    bp += 32;
+  }
+  const int cols = min(32, n - col0);
+  EACH_ROW(STORE)
+}

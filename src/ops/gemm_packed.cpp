@@ -1,0 +1,210 @@
+#include "inertialnet/ops/gemm_packed.hpp"
+
+#include <algorithm>
+#include <cstdint>
+#include <limits>
+#include <string>
+
+#include "inertialnet/runtime/device.hpp"
+#include "ops/gemm_support.hpp"
+
+namespace inertialnet {
+
+namespace {
+
+constexpr int kColumns = static_cast<int>(kPackedColumns);
+// Work per work-item of the packing kernels: DEPTH_BLOCK and CHANNEL_BLOCK of pack_panels.cl.
+constexpr std::size_t kPackDepthBlock = 64;
+constexpr std::size_t kIm2colChannelBlock = 16;
+
+int to_int(std::size_t value, const char* what) {
+  if (value > static_cast<std::size_t>(std::numeric_limits<int>::max())) {
+    throw invalid_input(std::string("packed GEMM: ") + what + " (" + std::to_string(value) +
+                        ") exceeds 32-bit kernel indexing");
+  }
+  return static_cast<int>(value);
+}
+
+int parameter_default(const char* name) {
+  for (const auto& p : packed_gemm_parameters()) {
+    if (std::string(p.name) == name) return p.default_value;
+  }
+  throw runtime_error(std::string("packed GEMM: no parameter ") + name);
+}
+
+bool is_candidate(const char* name, int value) {
+  for (const auto& p : packed_gemm_parameters()) {
+    if (std::string(p.name) == name) return std::find(p.candidates.begin(), p.candidates.end(), value) != p.candidates.end();
+  }
+  return false;
+}
+
+// The destination of a packing: `into` when it is large enough, else a new tensor.
+Tensor panel_storage(Queue& queue, Device* long_lived, std::size_t floats, const Tensor& into) {
+  if (into.defined() && into.buffer_floats() >= into.offset() + floats) return into;
+  const Shape shape{static_cast<std::int64_t>(floats)};
+  return long_lived ? Tensor::empty(*long_lived, shape) : Tensor::empty(queue, shape);
+}
+
+PackedPanels pack(Queue& queue, std::size_t lines, std::size_t depth, int width, const MatrixView& source,
+                  std::size_t line_stride, std::size_t depth_stride, Device* long_lived, const Tensor& into) {
+  PackedPanels packed;
+  packed.lines = lines;
+  packed.depth = depth;
+  packed.width = width;
+  packed.data = panel_storage(queue, long_lived, PackedPanels::floats(lines, depth, width), into);
+  Kernel& kernel = queue.kernel("pack_panels", "pack_panels", KernelDefines().add("WIDTH", width));
+  kernel.set_args(source.buffer, to_int(source.offset, "offset"), packed.data, to_int(lines, "lines"),
+                  to_int(depth, "depth"), to_int(line_stride, "stride"), to_int(depth_stride, "stride"));
+  const std::size_t padded = packed.panels() * static_cast<std::size_t>(width);
+  queue.launch(kernel, Range(padded, (depth + kPackDepthBlock - 1) / kPackDepthBlock),
+               Range(std::min<std::size_t>(padded, kColumns), 1));
+  return packed;
+}
+
+}  // namespace
+
+const std::vector<PackedGemmParameter>& packed_gemm_parameters() {
+  static const std::vector<PackedGemmParameter> parameters{
+      {"MR", 8, {1, 2, 4, 6, 8, 12, 14},
+       "rows of A per tile: 2·MR float16 accumulators must stay in the 32 vector registers"},
+      {"PANELS_FIRST", 1, {0, 1},
+       "1: consecutive work-groups walk A panels against one B panel (B stays in cache), 0: the reverse"},
+  };
+  return parameters;
+}
+
+int packed_gemm_tile_rows(std::size_t m, int requested) {
+  if (requested > 0) {
+    if (!is_candidate("MR", requested)) throw invalid_input("packed GEMM: MR=" + std::to_string(requested) + " is not supported");
+    return requested;
+  }
+  const int standard = parameter_default("MR");
+  // A small m fills one short tile instead of padding to the standard one.
+  for (const int mr : {1, 2, 4}) {
+    if (m <= static_cast<std::size_t>(mr) && mr < standard) return mr;
+  }
+  return standard;
+}
+
+std::size_t PackedPanels::floats(std::size_t lines, std::size_t depth, int width) {
+  const auto w = static_cast<std::size_t>(width);
+  return (lines + w - 1) / w * w * depth;
+}
+
+PackedPanels PackedPanels::rows(std::size_t first, std::size_t count) const {
+  const auto w = static_cast<std::size_t>(width);
+  if (first % w != 0 || first + count > lines || count == 0) {
+    throw invalid_input("packed panels: lines [" + std::to_string(first) + ", " + std::to_string(first + count) +
+                        ") are not whole panels of " + std::to_string(lines) + " lines of width " + std::to_string(w));
+  }
+  PackedPanels part = *this;
+  part.lines = count;
+  part.data = data.region(first * depth, {static_cast<std::int64_t>(floats(count, depth, width))});
+  return part;
+}
+
+PackedPanels pack_a(Queue& queue, Transpose transpose, std::size_t m, std::size_t k, const MatrixView& a,
+                    int tile_rows, Device* long_lived) {
+  if (m == 0 || k == 0) throw invalid_input("packed GEMM: A is empty (" + std::to_string(m) + "×" + std::to_string(k) + ")");
+  const bool t = transpose == Transpose::Yes;
+  detail::check_gemm_operand("A", a, t ? k : m, t ? m : k);
+  const int width = packed_gemm_tile_rows(m, tile_rows);
+  // Row i of op(A), element q: A[i][q] = (lda, 1); stored transposed, A[q][i] = (1, lda).
+  return pack(queue, m, k, width, a, t ? 1 : a.leading_dimension, t ? a.leading_dimension : 1, long_lived, Tensor());
+}
+
+PackedPanels pack_b(Queue& queue, Transpose transpose, std::size_t k, std::size_t n, const MatrixView& b,
+                    const Tensor& into) {
+  if (n == 0 || k == 0) throw invalid_input("packed GEMM: B is empty (" + std::to_string(k) + "×" + std::to_string(n) + ")");
+  const bool t = transpose == Transpose::Yes;
+  detail::check_gemm_operand("B", b, t ? n : k, t ? k : n);
+  // Column j of op(B), element q: B[q][j] = (1, ldb); stored transposed, B[j][q] = (ldb, 1).
+  return pack(queue, n, k, kColumns, b, t ? b.leading_dimension : 1, t ? 1 : b.leading_dimension, nullptr, into);
+}
+
+PackedPanels im2col_panels(Queue& queue, const Tensor& sample, const Im2colGeometry& g, std::size_t first_pixel,
+                           std::size_t count, const Tensor& into) {
+  if (sample.rank() != 4 || sample.n() != 1) {
+    throw invalid_input("im2col_panels: expected one NCHW sample, got shape " + to_string(sample.shape()));
+  }
+  const auto channels = static_cast<std::size_t>(sample.c());
+  PackedPanels packed;
+  packed.lines = count;
+  packed.depth = channels * static_cast<std::size_t>(g.kernel_h * g.kernel_w);
+  packed.width = kColumns;
+  const std::size_t floats = PackedPanels::floats(count, packed.depth, kColumns);
+  if (!into.defined() || into.buffer_floats() < into.offset() + floats) {
+    throw invalid_input("im2col_panels: the destination holds " + std::to_string(into.buffer_floats()) +
+                        " floats, the panels need " + std::to_string(floats));
+  }
+  packed.data = into;
+  Kernel& kernel = queue.kernel("pack_panels", "im2col_panels",
+                                KernelDefines()
+                                    .add("WIDTH", kColumns)
+                                    .add("KH", g.kernel_h)
+                                    .add("KW", g.kernel_w)
+                                    .add("STRIDE", g.stride)
+                                    .add("PAD", g.padding));
+  kernel.set_args(sample, into, static_cast<int>(channels), static_cast<int>(sample.h()), static_cast<int>(sample.w()),
+                  g.out_h, g.out_w, to_int(first_pixel, "first pixel"), to_int(count, "pixel count"));
+  queue.launch(kernel, Range(packed.panels(), (channels + kIm2colChannelBlock - 1) / kIm2colChannelBlock), Range(1, 1));
+  return packed;
+}
+
+void gemm_packed(Queue& queue, const PackedPanels& a, const PackedPanels& b, const MatrixView& c,
+                 const GemmEpilogue& epilogue) {
+  if (a.depth != b.depth) {
+    throw invalid_input("packed GEMM: A has depth " + std::to_string(a.depth) + ", B " + std::to_string(b.depth));
+  }
+  if (b.width != kColumns) throw invalid_input("packed GEMM: B must be packed in panels of 32 columns");
+  const std::size_t m = a.lines, n = b.lines, k = a.depth;
+  detail::check_gemm_operand("C", c, m, n);
+  const bool has_bias = epilogue.bias.defined();
+  if (has_bias && static_cast<std::size_t>(epilogue.bias.numel()) != m) {
+    throw invalid_input("packed GEMM: the bias has " + std::to_string(epilogue.bias.numel()) + " values for " +
+                        std::to_string(m) + " rows");
+  }
+  const bool has_beta = epilogue.beta != 0.0f;
+  const int panels_first = parameter_default("PANELS_FIRST");
+  Kernel& kernel = queue.kernel("gemm_packed", "gemm_packed",
+                                KernelDefines()
+                                    .add("MR", a.width)
+                                    .add("PANELS_FIRST", panels_first)
+                                    .add("HAS_BIAS", has_bias)
+                                    .add("HAS_BETA", has_beta)
+                                    .add(activation_defines(epilogue.activation)));
+  // Without a bias the kernel never reads its bias argument; any valid buffer will do.
+  const cl_mem bias_buffer = has_bias ? epilogue.bias.buffer() : c.buffer;
+  const int bias_offset = has_bias ? epilogue.bias.offset_int() : 0;
+  kernel.set_args(a.data, b.data, c.buffer, to_int(c.offset, "offset of C"), to_int(c.leading_dimension, "ldc"),
+                  bias_buffer, bias_offset, to_int(m, "m"), to_int(n, "n"), to_int(k, "k"), epilogue.alpha,
+                  epilogue.beta);
+  const std::size_t row_panels = a.panels(), column_panels = b.panels();
+  const Range global = panels_first ? Range(row_panels, column_panels) : Range(column_panels, row_panels);
+  queue.launch(kernel, global, Range(1, 1));
+}
+
+void gemv(Queue& queue, std::size_t rows, std::size_t depth, const MatrixView& w, const Tensor& x, const Tensor& y,
+          const Tensor& bias, const ActivationSpec& activation) {
+  if (rows == 0 || depth == 0) throw invalid_input("GEMV with an empty dimension");
+  detail::check_gemm_operand("W", w, rows, depth);
+  if (static_cast<std::size_t>(x.numel()) != depth || !x.contiguous()) {
+    throw invalid_input("GEMV: x must be " + std::to_string(depth) + " contiguous floats, got " + to_string(x.shape()));
+  }
+  if (static_cast<std::size_t>(y.numel()) != rows || !y.contiguous()) {
+    throw invalid_input("GEMV: y must be " + std::to_string(rows) + " contiguous floats, got " + to_string(y.shape()));
+  }
+  const bool has_bias = bias.defined();
+  if (has_bias && static_cast<std::size_t>(bias.numel()) != rows) {
+    throw invalid_input("GEMV: the bias has " + std::to_string(bias.numel()) + " values for " + std::to_string(rows) +
+                        " rows");
+  }
+  Kernel& kernel =
+      queue.kernel("gemv", "gemv", KernelDefines().add("HAS_BIAS", has_bias).add(activation_defines(activation)));
+  kernel.set_args(w.buffer, to_int(w.offset, "offset of W"), to_int(w.leading_dimension, "ldw"), x, y,
+                  has_bias ? bias : y, to_int(rows, "rows"), to_int(depth, "depth"));
+  queue.launch(kernel, Range(rows), Range(1));
+}
+
+}  // namespace inertialnet
