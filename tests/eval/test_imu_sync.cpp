@@ -7,6 +7,7 @@
 #include "eval/synthetic_euroc.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/eval/imu_sync.hpp"
+#include "support/testing.hpp"
 
 namespace fs = std::filesystem;
 using namespace inertialnet;
@@ -14,18 +15,8 @@ namespace te = inertialnet::testing_euroc;
 
 namespace {
 
-std::string invalid_input_message(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    EXPECT_EQ(e.kind(), ErrorKind::InvalidInput) << e.what();
-    return e.what();
-  }
-  ADD_FAILURE() << "expected an invalid_input error, nothing was thrown";
-  return {};
-}
-
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+using inertialnet::testing::contains;
+using inertialnet::testing::invalid_input_message;
 
 bool any_contains(const std::vector<std::string>& v, const std::string& part) {
   for (const auto& s : v) {

@@ -6,6 +6,7 @@
 #include "eval/synthetic_euroc.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/io/euroc.hpp"
+#include "support/testing.hpp"
 
 namespace fs = std::filesystem;
 using namespace inertialnet;
@@ -13,23 +14,8 @@ namespace te = inertialnet::testing_euroc;
 
 namespace {
 
-// Runs f, expects an invalid_input Error and returns its message.
-template <class F>
-std::string invalid_input_message(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    EXPECT_EQ(e.kind(), ErrorKind::InvalidInput) << e.what();
-    return e.what();
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "expected inertialnet::Error, got: " << e.what();
-    return {};
-  }
-  ADD_FAILURE() << "expected an invalid_input error, nothing was thrown";
-  return {};
-}
-
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+using inertialnet::testing::contains;
+using inertialnet::testing::invalid_input_message;
 
 }  // namespace
 

@@ -22,9 +22,8 @@ namespace it = inertialnet::testing;
 
 namespace {
 
+using it::contains;
 using it::invalid_input_message;
-
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
 void append_le32(std::vector<unsigned char>& out, std::uint32_t value) {
   for (int i = 0; i < 4; ++i) out.push_back(static_cast<unsigned char>(value >> (8 * i)));

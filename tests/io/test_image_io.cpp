@@ -21,9 +21,8 @@ namespace it = inertialnet::testing;
 
 namespace {
 
+using it::contains;
 using it::invalid_input_message;
-
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
 std::vector<char> read_bytes(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);

@@ -7,24 +7,15 @@
 #include "eval/synthetic_euroc.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/io/rates_csv.hpp"
+#include "support/testing.hpp"
 
 using namespace inertialnet;
 namespace te = inertialnet::testing_euroc;
 
 namespace {
 
-std::string invalid_input_message(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    EXPECT_EQ(e.kind(), ErrorKind::InvalidInput) << e.what();
-    return e.what();
-  }
-  ADD_FAILURE() << "expected an invalid_input error, nothing was thrown";
-  return {};
-}
-
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+using inertialnet::testing::contains;
+using inertialnet::testing::invalid_input_message;
 
 std::filesystem::path write_text(const te::TempDir& dir, const std::string& text) {
   const auto p = dir.path() / "rates.csv";

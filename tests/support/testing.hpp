@@ -36,6 +36,9 @@ Difference compare(const std::vector<float>& actual, const std::vector<float>& e
 // Runs `call`, expects an Error of kind InvalidInput and returns its message ("" and a test
 // failure when nothing or something else is thrown).
 std::string invalid_input_message(const std::function<void()>& call);
+// True when `part` occurs in `text` (for checking messages).
+inline bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
 // Runs `call` and expects an Error of kind InvalidInput whose message contains `needle`.
 void expect_invalid_input(const std::function<void()>& call, const std::string& needle);
 

@@ -21,34 +21,25 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "inertialnet 0.1.0");
   app.footer("Exit codes: 0 ok, 1 runtime failure, 2 bad usage or bad input.");
 
+  // The subcommands, in the order --help lists them.
+  struct Subcommand {
+    const char* name;
+    const char* description;
+    cli::Command (*register_options)(CLI::App&, const cli::GlobalOptions&);
+  };
+  static constexpr Subcommand kSubcommands[] = {
+      {"devices", "list the OpenCL platforms and devices", cli::register_devices},
+      {"flow", "optical flow between two images (FlowNet2 family)", cli::register_flow},
+      {"predict", "angular rates for every frame pair of a sequence", cli::register_predict},
+      {"eval", "the paper's metrics for a rates CSV against a EuRoC sequence", cli::register_eval},
+      {"synth", "render a EuRoC-layout sequence from a known camera motion", cli::register_synth},
+      {"bench", "pairs per second, stage split and per-layer profile (synthetic weights)", cli::register_bench},
+      {"weights", "write synthetic weights, or describe a weight file", cli::register_weights},
+  };
   std::map<CLI::App*, cli::Command> commands;
-  {
-    CLI::App* sub = app.add_subcommand("devices", "list the OpenCL platforms and devices");
-    commands[sub] = cli::register_devices(*sub, global);
-  }
-  {
-    CLI::App* sub = app.add_subcommand("flow", "optical flow between two images (FlowNet2 family)");
-    commands[sub] = cli::register_flow(*sub, global);
-  }
-  {
-    CLI::App* sub = app.add_subcommand("predict", "angular rates for every frame pair of a sequence");
-    commands[sub] = cli::register_predict(*sub, global);
-  }
-  {
-    CLI::App* sub = app.add_subcommand("eval", "the paper's metrics for a rates CSV against a EuRoC sequence");
-    commands[sub] = cli::register_eval(*sub, global);
-  }
-  {
-    CLI::App* sub = app.add_subcommand("synth", "render a EuRoC-layout sequence from a known camera motion");
-    commands[sub] = cli::register_synth(*sub, global);
-  }
-  {
-    CLI::App* sub = app.add_subcommand("bench", "pairs per second, stage split and per-layer profile (synthetic weights)");
-    commands[sub] = cli::register_bench(*sub, global);
-  }
-  {
-    CLI::App* sub = app.add_subcommand("weights", "write synthetic weights, or describe a weight file");
-    commands[sub] = cli::register_weights(*sub, global);
+  for (const Subcommand& s : kSubcommands) {
+    CLI::App* sub = app.add_subcommand(s.name, s.description);
+    commands[sub] = s.register_options(*sub, global);
   }
 
   try {
