@@ -266,6 +266,20 @@ Tensor Executor::output(const std::string& name) const {
   return resolve(found->second);
 }
 
+namespace {
+
+// A timed plan's run of one GEMM layer: `op` with the layer's options and the weights under test.
+template <class Options, class Op>
+PlannedLayer planned_layer(std::string key, const Options& base, Op op) {
+  return {std::move(key), [base, op](const GemmWeights& weights) {
+            Options options = base;
+            options.prepared = &weights;
+            op(options);
+          }};
+}
+
+}  // namespace
+
 void Executor::run(Queue& queue, const std::map<std::string, Tensor>& inputs, const ParameterTensors& parameters,
                    const std::atomic<bool>* stop, PreparedWeights* prepared) {
   // Bind inputs (and slices of inputs).
@@ -312,25 +326,18 @@ void Executor::run(Queue& queue, const std::map<std::string, Tensor>& inputs, co
         scratch_out = Tensor::empty(queue, out_shape);
       }
       if (node.kind == OpKind::Conv2d) {
+        const auto base = node.options_as<Conv2dOptions>();
         if (timed) {
-          const Conv2dOptions base = node.options_as<Conv2dOptions>();
-          layer.key = conv2d_plan_key(scratch_in.shape(), weight.shape(), base.stride, base.padding);
-          layer.run = [&, base](const GemmWeights& w) {
-            Conv2dOptions options = base;
-            options.prepared = &w;
-            conv2d(queue, scratch_in, weight, bias, scratch_out, options);
-          };
+          layer = planned_layer(conv2d_plan_key(scratch_in.shape(), weight.shape(), base.stride, base.padding), base,
+                                [&](const Conv2dOptions& o) { conv2d(queue, scratch_in, weight, bias, scratch_out, o); });
         }
         gemm_weights_[i] = &prepared->conv2d(queue, node.weight, weight, timed ? &layer : nullptr);
       } else {
+        const auto base = node.options_as<ConvTranspose2dOptions>();
         if (timed) {
-          const ConvTranspose2dOptions base = node.options_as<ConvTranspose2dOptions>();
-          layer.key = conv_transpose2d_plan_key(scratch_in.shape(), weight.shape(), base.stride, base.padding);
-          layer.run = [&, base](const GemmWeights& w) {
-            ConvTranspose2dOptions options = base;
-            options.prepared = &w;
-            conv_transpose2d(queue, scratch_in, weight, bias, scratch_out, options);
-          };
+          layer = planned_layer(
+              conv_transpose2d_plan_key(scratch_in.shape(), weight.shape(), base.stride, base.padding), base,
+              [&](const ConvTranspose2dOptions& o) { conv_transpose2d(queue, scratch_in, weight, bias, scratch_out, o); });
         }
         gemm_weights_[i] = &prepared->conv_transpose2d(queue, node.weight, weight, timed ? &layer : nullptr);
       }
