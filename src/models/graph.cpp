@@ -8,6 +8,7 @@
 #include "inertialnet/ops/conv2d.hpp"
 #include "inertialnet/ops/conv_transpose2d.hpp"
 #include "inertialnet/ops/elementwise.hpp"
+#include "inertialnet/ops/gemm_plan_cache.hpp"
 #include "inertialnet/ops/linear.hpp"
 #include "inertialnet/ops/normalize.hpp"
 #include "inertialnet/ops/warp.hpp"
@@ -265,6 +266,20 @@ Tensor Executor::output(const std::string& name) const {
   return resolve(found->second);
 }
 
+namespace {
+
+// A timed plan's run of one GEMM layer: `op` with the layer's options and the weights under test.
+template <class Options, class Op>
+PlannedLayer planned_layer(std::string key, const Options& base, Op op) {
+  return {std::move(key), [base, op](const GemmWeights& weights) {
+            Options options = base;
+            options.prepared = &weights;
+            op(options);
+          }};
+}
+
+}  // namespace
+
 void Executor::run(Queue& queue, const std::map<std::string, Tensor>& inputs, const ParameterTensors& parameters,
                    const std::atomic<bool>* stop, PreparedWeights* prepared) {
   // Bind inputs (and slices of inputs).
@@ -295,11 +310,36 @@ void Executor::run(Queue& queue, const std::map<std::string, Tensor>& inputs, co
   if (prepared && gemm_weights_.empty()) {
     const auto& nodes = graph_.nodes();
     gemm_weights_.assign(nodes.size(), nullptr);
+    const bool timed = gemm_plan_timed();
     for (std::size_t i = 0; i < nodes.size(); ++i) {
       const Node& node = nodes[i];
-      if (node.kind == OpKind::Conv2d) gemm_weights_[i] = &prepared->conv2d(queue, node.weight, param(node.weight));
-      if (node.kind == OpKind::ConvTranspose2d) {
-        gemm_weights_[i] = &prepared->conv_transpose2d(queue, node.weight, param(node.weight));
+      if (node.kind != OpKind::Conv2d && node.kind != OpKind::ConvTranspose2d) continue;
+      const Tensor weight = param(node.weight), bias = param(node.bias);
+      // A timed plan runs the layer on its real shape, on scratch tensors: the values of the
+      // graph are not computed yet, and the network inputs must stay as given.
+      PlannedLayer layer;
+      Tensor scratch_in, scratch_out;
+      if (timed) {
+        const Shape& in_shape = graph_.value(node.inputs[0]).shape;
+        const Shape& out_shape = graph_.value(node.output).shape;
+        scratch_in = Tensor::from_host(queue, in_shape, std::vector<float>(static_cast<std::size_t>(checked_numel(in_shape).value_or(0)), 0.5f));
+        scratch_out = Tensor::empty(queue, out_shape);
+      }
+      if (node.kind == OpKind::Conv2d) {
+        const auto base = node.options_as<Conv2dOptions>();
+        if (timed) {
+          layer = planned_layer(conv2d_plan_key(scratch_in.shape(), weight.shape(), base.stride, base.padding), base,
+                                [&](const Conv2dOptions& o) { conv2d(queue, scratch_in, weight, bias, scratch_out, o); });
+        }
+        gemm_weights_[i] = &prepared->conv2d(queue, node.weight, weight, timed ? &layer : nullptr);
+      } else {
+        const auto base = node.options_as<ConvTranspose2dOptions>();
+        if (timed) {
+          layer = planned_layer(
+              conv_transpose2d_plan_key(scratch_in.shape(), weight.shape(), base.stride, base.padding), base,
+              [&](const ConvTranspose2dOptions& o) { conv_transpose2d(queue, scratch_in, weight, bias, scratch_out, o); });
+        }
+        gemm_weights_[i] = &prepared->conv_transpose2d(queue, node.weight, weight, timed ? &layer : nullptr);
       }
     }
   }

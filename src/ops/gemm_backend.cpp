@@ -6,22 +6,51 @@
 
 namespace inertialnet {
 
+namespace {
+
+std::string plan_from_environment() {
+  const char* plan = std::getenv(kPlanEnvironmentVariable);
+  return plan ? std::string(plan) : std::string();
+}
+
+}  // namespace
+
 const char* to_string(GemmBackend backend) { return backend == GemmBackend::Packed ? "packed" : "clblast"; }
 
+std::optional<GemmBackend> parse_gemm_backend(const std::string& name) {
+  for (const GemmBackend backend : {GemmBackend::CLBlast, GemmBackend::Packed}) {
+    if (name == to_string(backend)) return backend;
+  }
+  return std::nullopt;
+}
+
+std::vector<GemmBackend> gemm_candidates(const DeviceInfo& device) {
+  const GemmBackend first = gemm_backend(device, "");
+  std::vector<GemmBackend> candidates{first};
+  for (const GemmBackend backend : {GemmBackend::CLBlast, GemmBackend::Packed}) {
+    if (backend != first) candidates.push_back(backend);
+  }
+  return candidates;
+}
+
 GemmBackend gemm_backend(const DeviceInfo& device, const std::string& plan) {
-  if (plan == "clblast") return GemmBackend::CLBlast;
-  if (plan == "packed") return GemmBackend::Packed;
-  if (!plan.empty()) {
-    throw invalid_input(std::string(kPlanEnvironmentVariable) + "='" + plan + "' is not a plan: use clblast or packed");
+  if (const auto forced = parse_gemm_backend(plan)) return *forced;
+  if (!plan.empty() && plan != kPlanAuto) {
+    throw invalid_input(std::string(kPlanEnvironmentVariable) + "='" + plan +
+                        "' is not a plan: use clblast, packed or auto");
   }
   // The packed kernels are written for CPUs (one register tile per work-item, work-groups of
   // one); on GPUs CLBlast's tuned kernels are the ones to use.
   return device.type == DeviceType::CPU ? GemmBackend::Packed : GemmBackend::CLBlast;
 }
 
-GemmBackend gemm_backend(const DeviceInfo& device) {
-  const char* plan = std::getenv(kPlanEnvironmentVariable);
-  return gemm_backend(device, plan ? std::string(plan) : std::string());
+GemmBackend gemm_backend(const DeviceInfo& device) { return gemm_backend(device, plan_from_environment()); }
+
+bool gemm_plan_timed() {
+  const std::string plan = plan_from_environment();
+  if (plan == kPlanAuto) return true;
+  if (!plan.empty() && !parse_gemm_backend(plan)) gemm_backend(DeviceInfo{}, plan);  // throws: names the value
+  return false;
 }
 
 }  // namespace inertialnet

@@ -1,8 +1,57 @@
 #include "inertialnet/ops/gemm_plan.hpp"
 
+#include <algorithm>
+#include <chrono>
+#include <vector>
+
+#include "inertialnet/ops/gemm_plan_cache.hpp"
 #include "inertialnet/runtime/device.hpp"
 
 namespace inertialnet {
+
+namespace {
+
+// Seconds of one run of `layer` with `weights`, as the host sees it (the queue drained before
+// and after, so the time is the layer's alone).
+double seconds_of(Queue& queue, const PlannedLayer& layer, const GemmWeights& weights) {
+  queue.finish();
+  const auto start = std::chrono::steady_clock::now();
+  layer.run(weights);
+  queue.finish();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Times every candidate of the device on `layer`, records the choice in `plans`, and returns the
+// fastest candidate's prepared weights. The first candidate is the deterministic choice: a tie
+// keeps it.
+template <class Prepare>
+GemmWeights time_candidates(Queue& queue, const PlannedLayer& layer, Prepare& prepare, GemmPlanCache& plans) {
+  std::map<GemmBackend, double> medians;
+  GemmWeights best;
+  double best_seconds = 0.0;
+  bool have_best = false;
+  for (const GemmBackend candidate : gemm_candidates(queue.device().info())) {
+    GemmWeights weights = prepare(candidate);
+    seconds_of(queue, layer, weights);  // warm-up: builds the kernels, touches the buffers
+    std::vector<double> runs;
+    for (int run = 0; run < kPlanTimedRuns; ++run) runs.push_back(seconds_of(queue, layer, weights));
+    std::nth_element(runs.begin(), runs.begin() + runs.size() / 2, runs.end());
+    const double median = runs[runs.size() / 2];
+    medians[candidate] = median;
+    if (!have_best || median < best_seconds) {
+      best = std::move(weights);
+      best_seconds = median;
+      have_best = true;
+    }
+  }
+  plans.store(layer.key, best.backend, medians);
+  return best;
+}
+
+}  // namespace
+
+PreparedWeights::PreparedWeights(std::filesystem::path plan_directory) : plan_directory_(std::move(plan_directory)) {}
+PreparedWeights::~PreparedWeights() = default;
 
 GemmWeights prepare_conv2d_weights(Queue& queue, const Tensor& weight, GemmBackend backend) {
   if (weight.rank() != 4 || !weight.contiguous()) {
@@ -35,22 +84,39 @@ GemmWeights prepare_conv_transpose2d_weights(Queue& queue, const Tensor& weight,
 }
 
 template <class Prepare>
-const GemmWeights& PreparedWeights::get(Queue& queue, const std::string& name, Prepare&& prepare) {
+const GemmWeights& PreparedWeights::get(Queue& queue, const std::string& name, Prepare&& prepare,
+                                        const PlannedLayer* layer) {
   std::lock_guard<std::mutex> lock(mutex_);
   const auto found = weights_.find(name);
   if (found != weights_.end()) return found->second;
-  GemmWeights prepared = prepare(gemm_backend(queue.device().info()));
+  GemmWeights prepared;
+  if (layer && gemm_plan_timed()) {
+    if (!plans_) {
+      Device& device = queue.device();
+      plans_ = plan_directory_.empty() ? std::make_unique<GemmPlanCache>(device)
+                                       : std::make_unique<GemmPlanCache>(device.info(), plan_directory_);
+    }
+    const auto cached = plans_->find(layer->key);
+    prepared = cached ? prepare(*cached) : time_candidates(queue, *layer, prepare, *plans_);
+  } else {
+    prepared = prepare(gemm_backend(queue.device().info()));
+  }
   // Other lanes read the packed weights from their own queues: they must be complete first.
   queue.finish();
   return weights_.emplace(name, std::move(prepared)).first->second;
 }
 
-const GemmWeights& PreparedWeights::conv2d(Queue& queue, const std::string& name, const Tensor& weight) {
-  return get(queue, name, [&](GemmBackend backend) { return prepare_conv2d_weights(queue, weight, backend); });
+const GemmWeights& PreparedWeights::conv2d(Queue& queue, const std::string& name, const Tensor& weight,
+                                            const PlannedLayer* layer) {
+  return get(
+      queue, name, [&](GemmBackend backend) { return prepare_conv2d_weights(queue, weight, backend); }, layer);
 }
 
-const GemmWeights& PreparedWeights::conv_transpose2d(Queue& queue, const std::string& name, const Tensor& weight) {
-  return get(queue, name, [&](GemmBackend backend) { return prepare_conv_transpose2d_weights(queue, weight, backend); });
+const GemmWeights& PreparedWeights::conv_transpose2d(Queue& queue, const std::string& name, const Tensor& weight,
+                                                      const PlannedLayer* layer) {
+  return get(
+      queue, name, [&](GemmBackend backend) { return prepare_conv_transpose2d_weights(queue, weight, backend); },
+      layer);
 }
 
 std::size_t PreparedWeights::packed_bytes() const {

@@ -6,9 +6,17 @@
 // Without timing the choice is deterministic: $INERTIALNET_PLAN=clblast|packed forces one
 // backend everywhere (tests run every suite under both; `bench` compares them), otherwise CPU
 // devices use the packed kernels and every other device CLBlast.
+//
+// $INERTIALNET_PLAN=auto opts in to timing: each GEMM layer of a model times every candidate of
+// gemm_candidates() on its real shape when the model is prepared and keeps the fastest, cached
+// per device and driver on disk (ops/gemm_plan_cache.hpp). Timing is opt-in so that tests stay
+// deterministic and a first run costs no extra seconds; where a layer is not prepared by a
+// model (a bare op call), "auto" means the deterministic choice.
 #pragma once
 
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "inertialnet/runtime/device_info.hpp"
 
@@ -17,11 +25,22 @@ namespace inertialnet {
 enum class GemmBackend { CLBlast, Packed };
 
 const char* to_string(GemmBackend backend);  // "clblast", "packed"
+// The backend a name denotes; nullopt for anything else.
+std::optional<GemmBackend> parse_gemm_backend(const std::string& name);
+
+// The backends a timed plan may choose from on `device`, the deterministic choice first (so a
+// tie keeps it). A new backend joins the plan by joining this list.
+std::vector<GemmBackend> gemm_candidates(const DeviceInfo& device);
 
 inline constexpr const char* kPlanEnvironmentVariable = "INERTIALNET_PLAN";
 
+inline constexpr const char* kPlanAuto = "auto";
+
 // The backend for layers on `device`; an unknown $INERTIALNET_PLAN is invalid_input.
 GemmBackend gemm_backend(const DeviceInfo& device);
+
+// Whether $INERTIALNET_PLAN asks for timed plans ("auto"); an unknown value is invalid_input.
+bool gemm_plan_timed();
 
 // The same from an explicit plan string ("" = the device's default), for tests.
 GemmBackend gemm_backend(const DeviceInfo& device, const std::string& plan);

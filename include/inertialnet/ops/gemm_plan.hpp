@@ -7,9 +7,18 @@
 // device's weights), not per graph: pipeline lanes do not duplicate them. Layers with very few
 // output channels (predict_flow*) run a direct convolution and need no packing; fully connected
 // layers read their weights in place (GEMV).
+//
+// Under $INERTIALNET_PLAN=auto the backend of a layer comes from timing: the layer runs on its
+// real shape with the weights prepared for each candidate of gemm_candidates() (one warm-up,
+// then the median of kPlanTimedRuns), the fastest is kept with its prepared weights, and the
+// choice is cached on disk per device and driver (ops/gemm_plan_cache.hpp), so a later start
+// only reads it.
 #pragma once
 
+#include <filesystem>
+#include <functional>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <string>
 
@@ -37,20 +46,41 @@ inline constexpr std::int64_t kDirectConvMaxChannels = 4;
 GemmWeights prepare_conv2d_weights(Queue& queue, const Tensor& weight, GemmBackend backend);
 GemmWeights prepare_conv_transpose2d_weights(Queue& queue, const Tensor& weight, GemmBackend backend);
 
+class GemmPlanCache;
+
+// Timed runs per candidate when a plan is timed (after one warm-up run); the median counts.
+inline constexpr int kPlanTimedRuns = 3;
+
+// A layer as a timed plan runs it: its key in the plan cache (conv2d_plan_key() etc.) and one
+// run of the layer on its real shape with the given prepared weights (enqueued on the queue
+// that prepares; the timing waits for it).
+struct PlannedLayer {
+  std::string key;
+  std::function<void(const GemmWeights&)> run;
+};
+
 // The prepared weights of a set of layers on one device, by parameter name, made on first use
-// and then shared by every queue (thread-safe).
+// and then shared by every queue (thread-safe). With a PlannedLayer and $INERTIALNET_PLAN=auto
+// the backend is the timed one; otherwise the deterministic gemm_backend().
 class PreparedWeights {
  public:
-  const GemmWeights& conv2d(Queue& queue, const std::string& name, const Tensor& weight);
-  const GemmWeights& conv_transpose2d(Queue& queue, const std::string& name, const Tensor& weight);
+  // Timed plans are cached in `plan_directory` (empty: the device's program-cache directory).
+  explicit PreparedWeights(std::filesystem::path plan_directory = {});
+  ~PreparedWeights();
+  const GemmWeights& conv2d(Queue& queue, const std::string& name, const Tensor& weight,
+                            const PlannedLayer* layer = nullptr);
+  const GemmWeights& conv_transpose2d(Queue& queue, const std::string& name, const Tensor& weight,
+                                      const PlannedLayer* layer = nullptr);
   std::size_t packed_bytes() const;
 
  private:
   template <class Prepare>
-  const GemmWeights& get(Queue& queue, const std::string& name, Prepare&& prepare);
+  const GemmWeights& get(Queue& queue, const std::string& name, Prepare&& prepare, const PlannedLayer* layer);
 
   mutable std::mutex mutex_;
   std::map<std::string, GemmWeights> weights_;
+  std::filesystem::path plan_directory_;
+  std::unique_ptr<GemmPlanCache> plans_;  // read on the first timed layer
 };
 
 }  // namespace inertialnet

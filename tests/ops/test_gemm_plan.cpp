@@ -1,0 +1,180 @@
+// Timed GEMM plans ($INERTIALNET_PLAN=auto): the on-disk plan cache (round trip, corrupt and
+// foreign files), forced plans over cached ones, and a timed layer that still matches the
+// reference convolution whichever candidate won.
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <string>
+
+#include "inertialnet/ops/conv2d.hpp"
+#include "inertialnet/ops/gemm_plan_cache.hpp"
+#include "reference/conv.hpp"
+#include "support/testing.hpp"
+
+namespace inertialnet {
+namespace {
+
+// Sets $INERTIALNET_PLAN for one test and restores it after.
+class ScopedPlan {
+ public:
+  explicit ScopedPlan(const char* plan) {
+    const char* old = std::getenv(kPlanEnvironmentVariable);
+    had_ = old != nullptr;
+    if (had_) old_ = old;
+    setenv(kPlanEnvironmentVariable, plan, 1);
+  }
+  ~ScopedPlan() {
+    if (had_) {
+      setenv(kPlanEnvironmentVariable, old_.c_str(), 1);
+    } else {
+      unsetenv(kPlanEnvironmentVariable);
+    }
+  }
+
+ private:
+  bool had_ = false;
+  std::string old_;
+};
+
+DeviceInfo fake_device(const std::string& driver) {
+  DeviceInfo info;
+  info.platform_name = "Test platform";
+  info.name = "test device";
+  info.driver_version = driver;
+  info.type = DeviceType::CPU;
+  return info;
+}
+
+void write_text(const std::filesystem::path& file, const std::string& text) {
+  std::filesystem::create_directories(file.parent_path());
+  std::ofstream(file) << text;
+}
+
+const std::string kKey = conv2d_plan_key({1, 8, 12, 16}, {16, 8, 3, 3}, 1, 1);
+
+TEST(GemmPlanCache, StoredPlansAreReadBack) {
+  const std::string dir = testing::temporary_directory("plans");
+  {
+    GemmPlanCache plans(fake_device("1.0"), dir);
+    EXPECT_FALSE(plans.find(kKey));
+    plans.store(kKey, GemmBackend::CLBlast, {{GemmBackend::CLBlast, 0.001}, {GemmBackend::Packed, 0.002}});
+  }
+  GemmPlanCache again(fake_device("1.0"), dir);
+  ASSERT_TRUE(again.find(kKey));
+  EXPECT_EQ(*again.find(kKey), GemmBackend::CLBlast);
+  EXPECT_FALSE(again.find(conv_transpose2d_plan_key({1, 8, 12, 16}, {16, 8, 3, 3}, 1, 1)));
+  // A second writer adds to the file instead of replacing it.
+  GemmPlanCache other(fake_device("1.0"), dir);
+  const std::string key2 = conv2d_plan_key({1, 8, 6, 8}, {16, 8, 3, 3}, 1, 1);
+  again.store(key2, GemmBackend::Packed, {{GemmBackend::Packed, 0.001}});
+  other.store(kKey, GemmBackend::Packed, {{GemmBackend::Packed, 0.001}});
+  GemmPlanCache merged(fake_device("1.0"), dir);
+  EXPECT_EQ(merged.size(), 2u);
+  EXPECT_EQ(*merged.find(key2), GemmBackend::Packed);
+}
+
+TEST(GemmPlanCache, CorruptAndForeignFilesAreIgnoredAndRewritten) {
+  const std::string dir = testing::temporary_directory("plans");
+  const auto file = GemmPlanCache::file_for(fake_device("1.0"), dir);
+  for (const std::string& text :
+       {std::string("{ not json"), std::string("[]"),
+        R"({"format": "inertialnet-gemm-plans-1", "platform": "Test platform", "device": "test device",
+            "driver": "0.9", "plans": {")" + kKey + R"(": {"backend": "packed", "seconds": {}}}})",
+        R"({"format": "inertialnet-gemm-plans-1", "platform": "Test platform", "device": "test device",
+            "driver": "1.0", "plans": {")" + kKey + R"(": {"backend": "systolic", "seconds": {}}}})"}) {
+    SCOPED_TRACE(text);
+    write_text(file, text);
+    GemmPlanCache plans(fake_device("1.0"), dir);
+    EXPECT_FALSE(plans.find(kKey));
+    plans.store(kKey, GemmBackend::Packed, {{GemmBackend::Packed, 0.5}});
+    EXPECT_EQ(*GemmPlanCache(fake_device("1.0"), dir).find(kKey), GemmBackend::Packed);
+  }
+  // Another driver reads the file as foreign: its plans were timed elsewhere.
+  EXPECT_FALSE(GemmPlanCache(fake_device("2.0"), dir).find(kKey));
+}
+
+TEST(GemmPlan, CandidatesStartWithTheDeterministicChoice) {
+  const auto cpu = gemm_candidates(fake_device("1.0"));
+  ASSERT_GE(cpu.size(), 2u);
+  EXPECT_EQ(cpu.front(), GemmBackend::Packed);
+  DeviceInfo gpu = fake_device("1.0");
+  gpu.type = DeviceType::GPU;
+  EXPECT_EQ(gemm_candidates(gpu).front(), GemmBackend::CLBlast);
+  EXPECT_EQ(gemm_backend(fake_device("1.0"), "auto"), GemmBackend::Packed);
+  {
+    ScopedPlan plan("auto");
+    EXPECT_TRUE(gemm_plan_timed());
+  }
+  {
+    ScopedPlan plan("packed");
+    EXPECT_FALSE(gemm_plan_timed());
+  }
+  ScopedPlan plan("fastest");
+  testing::expect_invalid_input([] { gemm_plan_timed(); }, "INERTIALNET_PLAN='fastest'");
+}
+
+// A small convolution prepared through a timed plan; returns the backend it got and checks the
+// result against the reference.
+GemmBackend run_planned_conv(PreparedWeights& prepared, const std::string& name) {
+  Queue& queue = testing::test_queue();
+  reference::ConvShape s{1, 8, 12, 16, 16, 3, 3, 1, 1};
+  const auto input = testing::random_vector(8 * 12 * 16, 201);
+  const auto weight = testing::random_vector(16 * 8 * 3 * 3, 202);
+  const auto bias = testing::random_vector(16, 203);
+  const auto expected = reference::conv2d(s, input, weight, bias, ActivationSpec{});
+  const Tensor in = Tensor::from_host(queue, {1, 8, 12, 16}, input);
+  const Tensor w = Tensor::from_host(queue, {16, 8, 3, 3}, weight);
+  const Tensor b = Tensor::from_host(queue, {16}, bias);
+  const Tensor out = Tensor::empty(queue, {1, 16, 12, 16});
+  Conv2dOptions options;
+  options.stride = 1;
+  options.padding = 1;
+  PlannedLayer layer;
+  layer.key = conv2d_plan_key(in.shape(), w.shape(), 1, 1);
+  int runs = 0;
+  layer.run = [&](const GemmWeights& weights) {
+    Conv2dOptions timed = options;
+    timed.prepared = &weights;
+    conv2d(queue, in, w, b, out, timed);
+    ++runs;
+  };
+  const GemmWeights& chosen = prepared.conv2d(queue, name, w, &layer);
+  options.prepared = &chosen;
+  conv2d(queue, in, w, b, out, options);
+  // The bound of test_conv2d: 1e-5 relative to sqrt(K), the typical output magnitude.
+  EXPECT_TRUE(testing::all_close(out.to_host(queue), expected, 1e-5, std::sqrt(8.0 * 3 * 3)));
+  return chosen.backend;
+}
+
+TEST(GemmPlan, AutoTimesOnceCachesAndMatchesTheReference) {
+  const std::string dir = testing::temporary_directory("plans");
+  ScopedPlan plan("auto");
+  PreparedWeights first(dir);
+  const GemmBackend chosen = run_planned_conv(first, "conv");
+  GemmPlanCache plans(testing::test_device().info(), dir);
+  ASSERT_TRUE(plans.find(kKey));
+  EXPECT_EQ(*plans.find(kKey), chosen);
+
+  // A later start reads the plan instead of timing: write the other backend into the cache
+  // and it is the one used.
+  const GemmBackend other = chosen == GemmBackend::Packed ? GemmBackend::CLBlast : GemmBackend::Packed;
+  plans.store(kKey, other, {});
+  PreparedWeights second(dir);
+  EXPECT_EQ(run_planned_conv(second, "conv"), other);
+}
+
+TEST(GemmPlan, ForcedPlansOverrideTheCache) {
+  const std::string dir = testing::temporary_directory("plans");
+  GemmPlanCache(testing::test_device().info(), dir).store(kKey, GemmBackend::Packed, {});
+  for (const GemmBackend forced : {GemmBackend::CLBlast, GemmBackend::Packed}) {
+    ScopedPlan plan(to_string(forced));
+    PreparedWeights prepared(dir);
+    EXPECT_EQ(run_planned_conv(prepared, "conv"), forced);
+  }
+  ScopedPlan plan("");
+  PreparedWeights prepared(dir);
+  EXPECT_EQ(run_planned_conv(prepared, "conv"), gemm_backend(testing::test_device().info(), ""));
+}
+
+}  // namespace
+}  // namespace inertialnet
