@@ -74,3 +74,9 @@ make_fifo(${flo})
 run(2 ${CLI} predict seq -o rates.csv --save-flow flows)
 expect_match("${flo}: it exists and is not a regular file")
 expect_fifo(${flo})
+
+# 2. eval --plot onto a FIFO: refused by name (exit 2), the FIFO kept.
+make_fifo(pipe_plot.png)
+run(2 ${CLI} eval rates.csv seq --plot pipe_plot.png)
+expect_match("pipe_plot.png: it exists and is not a regular file")
+expect_fifo(pipe_plot.png)
