@@ -80,3 +80,23 @@ make_fifo(pipe_plot.png)
 run(2 ${CLI} eval rates.csv seq --plot pipe_plot.png)
 expect_match("pipe_plot.png: it exists and is not a regular file")
 expect_fifo(pipe_plot.png)
+
+# 3. Standard output that cannot be written (/dev/full as a sink: opened for writing, never
+# replaced) is a runtime failure, exit 1 with a message on stderr, for every command that prints.
+function(run_to_full)
+  execute_process(COMMAND ${ARGN} WORKING_DIRECTORY "${WORK}" RESULT_VARIABLE code OUTPUT_FILE /dev/full
+                  ERROR_VARIABLE err TIMEOUT 300)
+  message("$ ${ARGN} > /dev/full\n${err}(exit ${code})")
+  if(NOT "${code}" STREQUAL "1")
+    message(FATAL_ERROR "expected exit code 1, got ${code}")
+  endif()
+  if(NOT err MATCHES "cannot write to standard output")
+    message(FATAL_ERROR "stderr does not say that standard output could not be written")
+  endif()
+endfunction()
+run_to_full(${CLI} predict seq)
+run_to_full(${CLI} eval rates.csv seq)
+run_to_full(${CLI} eval rates.csv seq --json)
+run_to_full(${CLI} weights --info head.safetensors)
+run_to_full(${CLI} devices --json)
+run_to_full(${CLI} devices)

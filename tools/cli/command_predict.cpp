@@ -190,7 +190,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
         std::printf("%lld,%.9g,%.9g,%.9g", static_cast<long long>(r.t1_ns), w[0], w[1], w[2]);
         for (const double v : more) std::printf(",%.9g", v);
         std::printf("\n");
-        std::fflush(stdout);
+        flush_standard_output();  // a row at a time, so a closed pipe stops the run at once
       }
       if (r.flow) write_flo(std::filesystem::path(o->save_flow) / (std::to_string(r.t1_ns) + ".flo"), *r.flow);
       progress.update(++done);
