@@ -95,7 +95,12 @@ double read_number(const cv::FileNode& node, const fs::path& path, const std::st
   if (!node.isInt() && !node.isReal()) {
     throw invalid_input(path.string() + ": " + key + " should be a number.");
   }
-  return node.real();
+  const double value = node.real();
+  if (!std::isfinite(value)) {
+    const std::string text = std::isnan(value) ? "nan" : value > 0 ? "inf" : "-inf";  // to_string may print "-nan"
+    throw invalid_input(path.string() + ": " + key + " is " + text + "; it should be a finite number.");
+  }
+  return value;
 }
 
 std::vector<double> read_numbers(const cv::FileNode& node, const fs::path& path,
@@ -134,14 +139,15 @@ std::array<double, 16> read_T_BS(const cv::FileStorage& storage, const fs::path&
     for (int j = 0; j < 3; ++j) {
       double dot = 0;
       for (int k = 0; k < 3; ++k) dot += T[4 * i + k] * T[4 * j + k];
-      if (std::abs(dot - (i == j ? 1.0 : 0.0)) > 1e-3) {
+      // Written as "not within" so that a NaN fails the check instead of passing it.
+      if (!(std::abs(dot - (i == j ? 1.0 : 0.0)) <= 1e-3)) {
         throw invalid_input(path.string() + ": the top-left 3×3 of T_BS is not a rotation matrix "
                             "(rows are not orthonormal within 1e-3).");
       }
     }
   }
-  if (std::abs(T[12]) > 1e-9 || std::abs(T[13]) > 1e-9 || std::abs(T[14]) > 1e-9 ||
-      std::abs(T[15] - 1) > 1e-9) {
+  if (!(std::abs(T[12]) <= 1e-9 && std::abs(T[13]) <= 1e-9 && std::abs(T[14]) <= 1e-9 &&
+        std::abs(T[15] - 1) <= 1e-9)) {
     throw invalid_input(path.string() + ": the last row of T_BS should be [0, 0, 0, 1].");
   }
   return T;

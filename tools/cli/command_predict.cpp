@@ -1,5 +1,6 @@
 // `inertialnet predict SEQ`: angular rates for every frame pair of a sequence, through the
 // pipelined scheduler, as a rates CSV (timestamp_ns,wx,wy,wz; rad/s; stamped with t_k).
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -184,6 +185,13 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
       const auto& w = r.rates.front().second;
       std::vector<double> more;
       for (std::size_t i = 1; i < r.rates.size(); ++i) more.insert(more.end(), r.rates[i].second.begin(), r.rates[i].second.end());
+      // Inputs are checked where they enter; a NaN here is a failure of the computation, never a rate.
+      bool finite = std::isfinite(w[0]) && std::isfinite(w[1]) && std::isfinite(w[2]);
+      for (const double v : more) finite = finite && std::isfinite(v);
+      if (!finite) {
+        throw runtime_error("the rates computed for the frame at timestamp " + std::to_string(r.t1_ns) +
+                            " are not finite (NaN or infinity); stopping rather than writing them.");
+      }
       if (file_writer) {
         file_writer->write(r.t1_ns, {w[0], w[1], w[2]}, more);
       } else {
