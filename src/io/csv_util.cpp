@@ -122,6 +122,15 @@ void check_timestamps(const std::filesystem::path& file, const std::vector<std::
                           std::to_string(t_ns[i - 1]) + "); timestamps must strictly increase.");
     }
   }
+  // Every later interval is computed by subtraction; with the order checked, the whole span fitting
+  // in 64 bits means every interval does (timestamps near the int64 limits would overflow).
+  std::int64_t span = 0;
+  if (!t_ns.empty() && __builtin_sub_overflow(t_ns.back(), t_ns.front(), &span)) {
+    throw invalid_input(file.string() + ": the timestamps run from " + std::to_string(t_ns.front()) + " (line " +
+                        std::to_string(lines.front()) + ") to " + std::to_string(t_ns.back()) + " (line " +
+                        std::to_string(lines.back()) + "), more than 292 years of nanoseconds; the span must fit "
+                        "in a signed 64-bit count.");
+  }
   if (!warnings || t_ns.size() < 3) return;
 
   std::vector<std::int64_t> dt(t_ns.size() - 1);

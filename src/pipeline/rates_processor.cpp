@@ -1,4 +1,5 @@
 #include <chrono>
+#include <string>
 #include <opencv2/core.hpp>
 #include <opencv2/video/tracking.hpp>
 
@@ -79,7 +80,13 @@ class RatesProcessor : public PairProcessor {
       t = lap(result, "inertialnet_head", t);
     }
     if (geometric_) {
-      const double dt = static_cast<double>(current.t_ns - previous.t_ns) * 1e-9;
+      std::int64_t dt_ns = 0;
+      if (__builtin_sub_overflow(current.t_ns, previous.t_ns, &dt_ns)) {
+        throw invalid_input("frames at timestamps " + std::to_string(previous.t_ns) + " and " +
+                            std::to_string(current.t_ns) + " ns are too far apart: their interval does not fit in "
+                            "a signed 64-bit count of nanoseconds.");
+      }
+      const double dt = static_cast<double>(dt_ns) * 1e-9;
       const RotationEstimate estimate = geometric_->estimate(q, flow, dt);
       const Vec3 w = to_body(options_.camera_to_body, estimate.omega);
       result.rates.push_back({"geometric", {w[0], w[1], w[2]}});
