@@ -15,6 +15,10 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// DIS matches 8×8 patches and builds its pyramid above them: smaller frames end in an OpenCV
+// assertion. Twice the patch leaves one pyramid level to refine.
+constexpr int kDisMinimumSide = 16;
+
 // 8-bit luminance (BT.601) of a planar RGB frame; a replicated gray frame comes back exactly.
 cv::Mat gray8(const HostImage& image) {
   cv::Mat gray(image.height, image.width, CV_8UC1);
@@ -49,6 +53,7 @@ class RatesProcessor : public PairProcessor {
 
   void process(const Frame& previous, const Frame& current, PairResult& result,
                const std::atomic<bool>& stop) override {
+    check_sizes(previous, current);
     Queue& q = *queue_;
     const int width = current.image.width, height = current.image.height;
     auto t = Clock::now();
@@ -99,6 +104,22 @@ class RatesProcessor : public PairProcessor {
   }
 
  private:
+  // Before OpenCV or the device sees the frames, whose own checks end in assertion text.
+  void check_sizes(const Frame& previous, const Frame& current) const {
+    const auto size = [](const Frame& f) { return std::to_string(f.image.width) + "x" + std::to_string(f.image.height); };
+    const auto name = [](const Frame& f) {
+      return "frame " + std::to_string(f.index) + " (t = " + std::to_string(f.t_ns) + " ns)";
+    };
+    if (previous.image.width != current.image.width || previous.image.height != current.image.height) {
+      throw invalid_input(name(current) + " is " + size(current) + " but " + name(previous) + " is " + size(previous) +
+                          "; every frame of a sequence must have the same size.");
+    }
+    if (dis_ && (current.image.width < kDisMinimumSide || current.image.height < kDisMinimumSide)) {
+      throw invalid_input(name(current) + " is " + size(current) + "; DIS optical flow needs frames of at least " +
+                          std::to_string(kDisMinimumSide) + "x" + std::to_string(kDisMinimumSide) + " pixels.");
+    }
+  }
+
   static Clock::time_point lap(PairResult& result, const char* stage, Clock::time_point start) {
     const auto now = Clock::now();
     result.seconds[stage] += std::chrono::duration<double>(now - start).count();
