@@ -250,7 +250,8 @@ CameraCalibration read_camera_yaml(const fs::path& yaml) {
   }
 
   const auto resolution = read_numbers(storage["resolution"], yaml, "resolution");
-  if (resolution.size() != 2 || resolution[0] < 1 || resolution[1] < 1 ||
+  // The bound keeps the conversion to int defined; real sensors are far below it.
+  if (resolution.size() != 2 || resolution[0] < 1 || resolution[1] < 1 || resolution[0] > 1e6 || resolution[1] > 1e6 ||
       resolution[0] != std::floor(resolution[0]) || resolution[1] != std::floor(resolution[1])) {
     throw invalid_input(yaml.string() + ": resolution should be [width, height] in pixels.");
   }

@@ -55,3 +55,8 @@ file(COPY_FILE "${frame_b}" "${WORK}/mixed/frame2.png")
 file(COPY_FILE "${frame_c}" "${WORK}/mixed/frame3.png")
 run(2 ${CLI} predict mixed --fx 50)
 expect_match("frame 2 \\(t = 100000000 ns\\) is 64x48 but frame 1 \\(t = 50000000 ns\\) is 96x64; every frame")
+
+# 7. A resolution far from the images' is refused before anything is allocated for it.
+copy_with(huge_resolution cam0/sensor.yaml "resolution: [96, 64]" "resolution: [100000, 100000]")
+run(2 ${CLI} predict huge_resolution)
+expect_match("gives the resolution 100000x100000, which does not match the images \\(96x64\\)")

@@ -119,6 +119,15 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
         processor.camera = camera;
       } else if (const auto calibration = source->calibration()) {
         processor.camera = CameraIntrinsics::from_calibration(*calibration);
+        // The geometric head allocates per pixel of the calibrated size: compare it with the
+        // images before, so that a wrong resolution is a clear message, not gigabytes asked for.
+        const HostImage first = source->decode(0);
+        if (first.width != processor.camera->width || first.height != processor.camera->height) {
+          throw invalid_input(source->description() + ": cam0/sensor.yaml gives the resolution " +
+                              std::to_string(processor.camera->width) + "x" + std::to_string(processor.camera->height) +
+                              ", which does not match the images (" + std::to_string(first.width) + "x" +
+                              std::to_string(first.height) + ").");
+        }
         processor.camera_to_body = calibration->rotation_BS();
       } else {
         throw invalid_input("the geometric head needs the camera: " + source->description() +
