@@ -68,6 +68,7 @@ void check_order(const fs::path& path, const std::vector<Row>& rows,
 
 cv::FileStorage open_yaml(const fs::path& path) {
   if (!fs::exists(path)) throw invalid_input("Calibration file " + path.string() + " does not exist.");
+  if (!fs::is_regular_file(path)) throw invalid_input("Calibration file " + path.string() + " is not a regular file.");
   std::ifstream in(path, std::ios::binary);
   std::stringstream buffer;
   buffer << in.rdbuf();

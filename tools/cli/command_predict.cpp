@@ -63,6 +63,23 @@ const char* kNoWeightsHelp =
 
 Command register_predict(CLI::App& app, const GlobalOptions& global) {
   auto o = std::make_shared<PredictOptions>();
+  // NaN passes "> 0" tests as false and was then taken for "not given": refuse it where it is read.
+  const CLI::Validator finite_positive(
+      [](std::string& text) {
+        double value = 0;
+        if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || !(value > 0)) {
+          return "must be a finite positive number, got " + text;
+        }
+        return std::string();
+      },
+      "POSITIVE");
+  const CLI::Validator finite(
+      [](std::string& text) {
+        double value = 0;
+        if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value)) return "must be a finite number, got " + text;
+        return std::string();
+      },
+      "NUMBER");
   app.add_option("sequence", o->sequence, "EuRoC folder, image folder or video")->required();
   app.add_option("-w,--weights", o->weights,
                  "weights (safetensors) holding FlowNet2 and/or the InertialNet head; repeat for several files");
@@ -71,16 +88,24 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
   app.add_option("--head", o->head,
                  "inertialnet (default with weights), geometric (default without), or both");
   app.add_option("--solver", o->solver, "geometric head: motion-field (default) or opengv")->capture_default_str();
-  app.add_option("--fx", o->fx, "focal length x (px), when the sequence has no sensor.yaml");
-  app.add_option("--fy", o->fy, "focal length y (px)");
-  app.add_option("--cx", o->cx, "principal point x (px)");
-  app.add_option("--cy", o->cy, "principal point y (px)");
+  app.add_option("--fx", o->fx, "focal length x (px), when the sequence has no sensor.yaml")->check(finite_positive);
+  app.add_option("--fy", o->fy, "focal length y (px)")->check(finite_positive);
+  app.add_option("--cx", o->cx, "principal point x (px)")->check(finite);
+  app.add_option("--cy", o->cy, "principal point y (px)")->check(finite);
   app.add_option("-o,--output", o->output, "rates CSV to write (default: standard output)");
   app.add_option("--save-flow", o->save_flow, "write each pair's flow as <timestamp>.flo into this folder");
-  app.add_option("--rate", o->rate_hz, "frame rate for image folders and videos without timestamps (Hz)");
+  app.add_option("--rate", o->rate_hz, "frame rate for image folders and videos without timestamps (Hz)")
+      ->check(finite_positive);
   app.add_option("--lanes", o->lanes, "frame pairs in flight per device")->capture_default_str()->check(CLI::Range(1, 16));
   app.add_option("--decode-threads", o->decode_threads, "image decoding threads")->capture_default_str()->check(CLI::Range(1, 64));
-  app.add_option("--max-pairs", o->max_pairs, "stop after this many pairs");
+  app.add_option("--max-pairs", o->max_pairs, "stop after this many pairs")
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            return text.find_first_not_of("0123456789") == std::string::npos && !text.empty()
+                       ? std::string()
+                       : "must be a count of pairs (0 for all), got " + text;
+          },
+          "COUNT"));
   app.add_flag("--stats", o->stats, "print time per stage and pairs per second");
   app.add_flag("--profile", o->profile, "print the device time of every network layer per pair (profiling queues)");
   return [o, &global]() {
