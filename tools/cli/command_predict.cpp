@@ -184,7 +184,15 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
       processor.flow_model = flow_model_of(*weight_sets.front(), o->model);
     }
     const auto factory = rates_processor(weights_of, processor);
-    if (!o->save_flow.empty()) std::filesystem::create_directories(o->save_flow);
+    if (!o->save_flow.empty()) {
+      // Checked here, so that a file in the way is a message, not a raw filesystem_error.
+      std::error_code error;
+      std::filesystem::create_directories(o->save_flow, error);
+      if (error || !std::filesystem::is_directory(o->save_flow)) {
+        throw invalid_input("--save-flow " + o->save_flow + ": cannot use it as a folder (" +
+                            (error ? error.message() : std::string("it exists and is not a folder")) + ").");
+      }
+    }
 
     std::string method = (processor.flow == FlowMethod::DIS ? std::string("DIS flow") : to_string(processor.flow_model));
     method += processor.inertialnet_head && processor.geometric_head ? " + InertialNet and geometric heads"
