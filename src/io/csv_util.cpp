@@ -9,8 +9,13 @@
 
 namespace inertialnet::csv {
 
-LineReader::LineReader(const std::filesystem::path& path, const std::string& what)
-    : path_(path), in_(path, std::ios::binary) {
+LineReader::LineReader(const std::filesystem::path& path, const std::string& what) : path_(path) {
+  // Checked before opening: opening a FIFO with no writer blocks for ever.
+  std::error_code error;
+  if (std::filesystem::exists(path, error) && !std::filesystem::is_regular_file(path, error)) {
+    throw invalid_input(what + " " + path.string() + " is not a regular file.");
+  }
+  in_.open(path, std::ios::binary);
   if (!in_) {
     throw invalid_input(what + " " + path.string() + " cannot be opened" +
                         (std::filesystem::exists(path) ? "." : ": it does not exist."));
