@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/eval/spline.hpp"
@@ -62,7 +63,11 @@ struct StaticEstimate {
 
 StaticEstimate estimate_static_start(const std::vector<ImuSample>& imu, const StaticStartRule& rule) {
   StaticEstimate e;
-  const std::int64_t end = imu.front().t_ns + static_cast<std::int64_t>(std::llround(rule.window_s * 1e9));
+  // Saturates instead of overflowing when the IMU starts near the int64 limit.
+  std::int64_t end = 0;
+  if (__builtin_add_overflow(imu.front().t_ns, static_cast<std::int64_t>(std::llround(rule.window_s * 1e9)), &end)) {
+    end = std::numeric_limits<std::int64_t>::max();
+  }
   Vec3 sum{}, sum2{};
   for (const auto& s : imu) {
     if (s.t_ns > end) break;
@@ -146,6 +151,24 @@ GyroTruth sync_gyro(const std::vector<std::int64_t>& cam, const std::vector<ImuS
                           std::to_string(cam[i]) + ") does not follow timestamp " +
                           std::to_string(i - 1) + " (" + std::to_string(cam[i - 1]) + ").");
     }
+  }
+  // Every time below is a difference of two of these timestamps: check once that the earliest and
+  // the latest of them are less than 2^63 ns apart, so that no subtraction can overflow.
+  for (std::size_t i = 1; i < imu.size(); ++i) {
+    if (imu[i].t_ns <= imu[i - 1].t_ns) {
+      throw invalid_input("Synchronisation: IMU timestamp " + std::to_string(i) + " (" + std::to_string(imu[i].t_ns) +
+                          ") does not follow timestamp " + std::to_string(i - 1) + " (" +
+                          std::to_string(imu[i - 1].t_ns) + ").");
+    }
+  }
+  const std::int64_t earliest = std::min(cam.front(), imu.front().t_ns);
+  const std::int64_t latest = std::max(cam.back(), imu.back().t_ns);
+  std::int64_t span = 0;
+  if (__builtin_sub_overflow(latest, earliest, &span)) {
+    throw invalid_input("Synchronisation: the camera (t = " + std::to_string(cam.front()) + " to " +
+                        std::to_string(cam.back()) + " ns) and the IMU (t = " + std::to_string(imu.front().t_ns) +
+                        " to " + std::to_string(imu.back().t_ns) +
+                        " ns) span more than 2^63 ns (292 years) together; they cannot be on one clock.");
   }
   if (options.camera_frame && !imu_to_camera) {
     throw invalid_input("Synchronisation: rates in the camera frame need the camera's T_BS "

@@ -1,6 +1,7 @@
 #include "inertialnet/eval/plots.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 
@@ -9,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "inertialnet/runtime/error.hpp"
+#include "runtime/atomic_file.hpp"
 
 namespace inertialnet {
 
@@ -143,17 +145,21 @@ void polyline(cv::Mat& img, const Panel& p, const std::vector<double>& t, const 
   cv::polylines(clip, pts, false, colour, 1, cv::LINE_AA, kShift);
 }
 
+// Encoded in memory and written by the one atomic writer: OpenCV's own writer truncates the target
+// first and deletes it after a failed write, and cannot tell a full disk from a missing folder.
 void write_png(const std::filesystem::path& png, const cv::Mat& img) {
-  bool ok = false;
+  std::string extension = png.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (extension != ".png") {
+    throw invalid_input("Cannot write the plot " + png.string() + ": the name must end in .png.");
+  }
+  std::vector<unsigned char> bytes;
   try {
-    ok = cv::imwrite(png.string(), img);
+    if (!cv::imencode(".png", img, bytes)) throw runtime_error("OpenCV could not encode the plot " + png.string() + " as PNG.");
   } catch (const cv::Exception& e) {
-    throw invalid_input("Cannot write the plot " + png.string() + " (OpenCV: " + e.err + " " + e.func + ").");
+    throw runtime_error("OpenCV could not encode the plot " + png.string() + " as PNG: " + e.what());
   }
-  if (!ok) {
-    throw invalid_input("Cannot write the plot " + png.string() +
-                        ": check that its folder exists and that the name ends in .png.");
-  }
+  write_file_atomically(png, bytes.data(), bytes.size());
 }
 
 void check_size(const PlotStyle& style) {

@@ -9,8 +9,13 @@
 
 namespace inertialnet::csv {
 
-LineReader::LineReader(const std::filesystem::path& path, const std::string& what)
-    : path_(path), in_(path, std::ios::binary) {
+LineReader::LineReader(const std::filesystem::path& path, const std::string& what) : path_(path) {
+  // Checked before opening: opening a FIFO with no writer blocks for ever.
+  std::error_code error;
+  if (std::filesystem::exists(path, error) && !std::filesystem::is_regular_file(path, error)) {
+    throw invalid_input(what + " " + path.string() + " is not a regular file.");
+  }
+  in_.open(path, std::ios::binary);
   if (!in_) {
     throw invalid_input(what + " " + path.string() + " cannot be opened" +
                         (std::filesystem::exists(path) ? "." : ": it does not exist."));
@@ -121,6 +126,15 @@ void check_timestamps(const std::filesystem::path& file, const std::vector<std::
                           std::to_string(lines[i - 1]) + " (timestamp " +
                           std::to_string(t_ns[i - 1]) + "); timestamps must strictly increase.");
     }
+  }
+  // Every later interval is computed by subtraction; with the order checked, the whole span fitting
+  // in 64 bits means every interval does (timestamps near the int64 limits would overflow).
+  std::int64_t span = 0;
+  if (!t_ns.empty() && __builtin_sub_overflow(t_ns.back(), t_ns.front(), &span)) {
+    throw invalid_input(file.string() + ": the timestamps run from " + std::to_string(t_ns.front()) + " (line " +
+                        std::to_string(lines.front()) + ") to " + std::to_string(t_ns.back()) + " (line " +
+                        std::to_string(lines.back()) + "), more than 292 years of nanoseconds; the span must fit "
+                        "in a signed 64-bit count.");
   }
   if (!warnings || t_ns.size() < 3) return;
 

@@ -68,6 +68,7 @@ void check_order(const fs::path& path, const std::vector<Row>& rows,
 
 cv::FileStorage open_yaml(const fs::path& path) {
   if (!fs::exists(path)) throw invalid_input("Calibration file " + path.string() + " does not exist.");
+  if (!fs::is_regular_file(path)) throw invalid_input("Calibration file " + path.string() + " is not a regular file.");
   std::ifstream in(path, std::ios::binary);
   std::stringstream buffer;
   buffer << in.rdbuf();
@@ -95,7 +96,12 @@ double read_number(const cv::FileNode& node, const fs::path& path, const std::st
   if (!node.isInt() && !node.isReal()) {
     throw invalid_input(path.string() + ": " + key + " should be a number.");
   }
-  return node.real();
+  const double value = node.real();
+  if (!std::isfinite(value)) {
+    const std::string text = std::isnan(value) ? "nan" : value > 0 ? "inf" : "-inf";  // to_string may print "-nan"
+    throw invalid_input(path.string() + ": " + key + " is " + text + "; it should be a finite number.");
+  }
+  return value;
 }
 
 std::vector<double> read_numbers(const cv::FileNode& node, const fs::path& path,
@@ -134,14 +140,15 @@ std::array<double, 16> read_T_BS(const cv::FileStorage& storage, const fs::path&
     for (int j = 0; j < 3; ++j) {
       double dot = 0;
       for (int k = 0; k < 3; ++k) dot += T[4 * i + k] * T[4 * j + k];
-      if (std::abs(dot - (i == j ? 1.0 : 0.0)) > 1e-3) {
+      // Written as "not within" so that a NaN fails the check instead of passing it.
+      if (!(std::abs(dot - (i == j ? 1.0 : 0.0)) <= 1e-3)) {
         throw invalid_input(path.string() + ": the top-left 3×3 of T_BS is not a rotation matrix "
                             "(rows are not orthonormal within 1e-3).");
       }
     }
   }
-  if (std::abs(T[12]) > 1e-9 || std::abs(T[13]) > 1e-9 || std::abs(T[14]) > 1e-9 ||
-      std::abs(T[15] - 1) > 1e-9) {
+  if (!(std::abs(T[12]) <= 1e-9 && std::abs(T[13]) <= 1e-9 && std::abs(T[14]) <= 1e-9 &&
+        std::abs(T[15] - 1) <= 1e-9)) {
     throw invalid_input(path.string() + ": the last row of T_BS should be [0, 0, 0, 1].");
   }
   return T;
@@ -244,7 +251,8 @@ CameraCalibration read_camera_yaml(const fs::path& yaml) {
   }
 
   const auto resolution = read_numbers(storage["resolution"], yaml, "resolution");
-  if (resolution.size() != 2 || resolution[0] < 1 || resolution[1] < 1 ||
+  // The bound keeps the conversion to int defined; real sensors are far below it.
+  if (resolution.size() != 2 || resolution[0] < 1 || resolution[1] < 1 || resolution[0] > 1e6 || resolution[1] > 1e6 ||
       resolution[0] != std::floor(resolution[0]) || resolution[1] != std::floor(resolution[1])) {
     throw invalid_input(yaml.string() + ": resolution should be [width, height] in pixels.");
   }

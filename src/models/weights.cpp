@@ -1,5 +1,6 @@
 #include "inertialnet/models/weights.hpp"
 
+#include <cmath>
 #include <filesystem>
 
 #include "inertialnet/runtime/error.hpp"
@@ -56,7 +57,16 @@ WeightSet WeightSet::load(Device& device, const std::vector<std::string>& paths)
       set.has_head_config_ = true;
     }
     for (const auto& name : file.names()) {
-      set.add(device, name, file.shape(name), file.to_float32(name), source);
+      const std::vector<float> values = file.to_float32(name);
+      // A NaN or infinite weight poisons every output it reaches; refuse it where it enters.
+      for (std::size_t i = 0; i < values.size(); ++i) {
+        if (!std::isfinite(values[i])) {
+          const std::string text = std::isnan(values[i]) ? "nan" : values[i] > 0 ? "inf" : "-inf";
+          throw invalid_input(path + ": tensor '" + name + "' holds " + text + " at element " +
+                              std::to_string(i) + "; weights must be finite numbers.");
+        }
+      }
+      set.add(device, name, file.shape(name), values, source);
     }
   }
   device.queue().finish();

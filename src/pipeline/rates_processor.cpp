@@ -1,4 +1,5 @@
 #include <chrono>
+#include <string>
 #include <opencv2/core.hpp>
 #include <opencv2/video/tracking.hpp>
 
@@ -13,6 +14,10 @@ namespace inertialnet {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+// DIS matches 8×8 patches and builds its pyramid above them: smaller frames end in an OpenCV
+// assertion. Twice the patch leaves one pyramid level to refine.
+constexpr int kDisMinimumSide = 16;
 
 // 8-bit luminance (BT.601) of a planar RGB frame; a replicated gray frame comes back exactly.
 cv::Mat gray8(const HostImage& image) {
@@ -48,6 +53,7 @@ class RatesProcessor : public PairProcessor {
 
   void process(const Frame& previous, const Frame& current, PairResult& result,
                const std::atomic<bool>& stop) override {
+    check_sizes(previous, current);
     Queue& q = *queue_;
     const int width = current.image.width, height = current.image.height;
     auto t = Clock::now();
@@ -79,7 +85,13 @@ class RatesProcessor : public PairProcessor {
       t = lap(result, "inertialnet_head", t);
     }
     if (geometric_) {
-      const double dt = static_cast<double>(current.t_ns - previous.t_ns) * 1e-9;
+      std::int64_t dt_ns = 0;
+      if (__builtin_sub_overflow(current.t_ns, previous.t_ns, &dt_ns)) {
+        throw invalid_input("frames at timestamps " + std::to_string(previous.t_ns) + " and " +
+                            std::to_string(current.t_ns) + " ns are too far apart: their interval does not fit in "
+                            "a signed 64-bit count of nanoseconds.");
+      }
+      const double dt = static_cast<double>(dt_ns) * 1e-9;
       const RotationEstimate estimate = geometric_->estimate(q, flow, dt);
       const Vec3 w = to_body(options_.camera_to_body, estimate.omega);
       result.rates.push_back({"geometric", {w[0], w[1], w[2]}});
@@ -92,6 +104,22 @@ class RatesProcessor : public PairProcessor {
   }
 
  private:
+  // Before OpenCV or the device sees the frames, whose own checks end in assertion text.
+  void check_sizes(const Frame& previous, const Frame& current) const {
+    const auto size = [](const Frame& f) { return std::to_string(f.image.width) + "x" + std::to_string(f.image.height); };
+    const auto name = [](const Frame& f) {
+      return "frame " + std::to_string(f.index) + " (t = " + std::to_string(f.t_ns) + " ns)";
+    };
+    if (previous.image.width != current.image.width || previous.image.height != current.image.height) {
+      throw invalid_input(name(current) + " is " + size(current) + " but " + name(previous) + " is " + size(previous) +
+                          "; every frame of a sequence must have the same size.");
+    }
+    if (dis_ && (current.image.width < kDisMinimumSide || current.image.height < kDisMinimumSide)) {
+      throw invalid_input(name(current) + " is " + size(current) + "; DIS optical flow needs frames of at least " +
+                          std::to_string(kDisMinimumSide) + "x" + std::to_string(kDisMinimumSide) + " pixels.");
+    }
+  }
+
   static Clock::time_point lap(PairResult& result, const char* stage, Clock::time_point start) {
     const auto now = Clock::now();
     result.seconds[stage] += std::chrono::duration<double>(now - start).count();

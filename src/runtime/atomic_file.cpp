@@ -35,9 +35,33 @@ void sync_folder(const std::filesystem::path& file) {
   ::close(fd);
 }
 
+// The file that writing `path` should replace. A symbolic link is followed on purpose, so that the
+// file it names is written and the link stays; anything that exists and is not a regular file (a
+// device, a FIFO, a socket, a folder) is refused, because renaming over it would destroy it.
+std::filesystem::path regular_target(const std::filesystem::path& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::file_status link = fs::symlink_status(path, ec);
+  if (ec || link.type() == fs::file_type::not_found) return path;
+  fs::path target = path;
+  if (fs::is_symlink(link)) {
+    target = fs::canonical(path, ec);
+    if (ec) {
+      throw invalid_input("cannot write " + path.string() + ": it is a symbolic link that leads nowhere (" +
+                          ec.message() + ").");
+    }
+  }
+  const fs::file_status status = fs::status(target, ec);
+  if (status.type() == fs::file_type::not_found) return target;
+  if (ec || !fs::is_regular_file(status)) {
+    throw invalid_input("cannot write " + path.string() + ": it exists and is not a regular file; refusing to replace it.");
+  }
+  return target;
+}
+
 }  // namespace
 
-AtomicFile::AtomicFile(std::filesystem::path path) : path_(std::move(path)) {
+AtomicFile::AtomicFile(std::filesystem::path path) : path_(regular_target(path)) {
   // Unique per process and per call, so that threads writing the same name never share a temporary.
   static std::atomic<unsigned> counter{0};
   temporary_ = path_;

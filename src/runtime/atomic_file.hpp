@@ -18,7 +18,9 @@ namespace inertialnet {
 // fix them (missing folder, no permission, read-only file system), runtime_error otherwise.
 class AtomicFile {
  public:
-  // Creates the temporary file beside `path`.
+  // Creates the temporary file beside `path`, or beside the file it names when `path` is a symbolic
+  // link (the link is kept and its target replaced). invalid_input when `path` exists and is not a
+  // regular file (a device, a FIFO, a folder): a rename would replace it.
   explicit AtomicFile(std::filesystem::path path);
   AtomicFile(const AtomicFile&) = delete;
   AtomicFile& operator=(const AtomicFile&) = delete;

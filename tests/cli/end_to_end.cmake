@@ -3,21 +3,7 @@
 file(REMOVE_RECURSE "${WORK}")
 file(MAKE_DIRECTORY "${WORK}")
 
-function(run expect_code)
-  execute_process(COMMAND ${ARGN} WORKING_DIRECTORY "${WORK}" RESULT_VARIABLE code OUTPUT_VARIABLE out
-                  ERROR_VARIABLE err TIMEOUT 600)
-  message("$ ${ARGN}\n${out}${err}(exit ${code})")
-  if(NOT "${code}" STREQUAL "${expect_code}")
-    message(FATAL_ERROR "expected exit code ${expect_code}, got ${code}")
-  endif()
-  set(output "${out}${err}" PARENT_SCOPE)
-endfunction()
-
-function(expect_match regex)
-  if(NOT output MATCHES "${regex}")
-    message(FATAL_ERROR "output does not match '${regex}'")
-  endif()
-endfunction()
+include(${CMAKE_CURRENT_LIST_DIR}/run_helpers.cmake)
 
 run(0 ${CLI} synth seq --frames 6 --size 96x64 --seed 3)
 expect_match("6 frames 96x64")

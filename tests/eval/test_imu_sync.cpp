@@ -3,6 +3,9 @@
 
 #include <cmath>
 #include <functional>
+#include <limits>
+#include <string>
+#include <vector>
 
 #include "eval/synthetic_euroc.hpp"
 #include "inertialnet/runtime/error.hpp"
@@ -141,6 +144,24 @@ TEST(ImuSync, NoOverlapIsAnError) {
   const std::vector<std::int64_t> backwards = {seq.frames[2].t_ns, seq.frames[1].t_ns};
   EXPECT_TRUE(contains(invalid_input_message([&] { sync_gyro(backwards, seq.imu, SyncOptions{}); }),
                        "does not follow"));
+}
+
+// Camera and IMU clocks near opposite int64 limits: every time difference would overflow (the
+// spline's abscissae came out negative); refused up front with both ranges in the message.
+TEST(ImuSync, TimestampsThatCannotBeSubtractedAreRefused) {
+  std::vector<ImuSample> imu(3);
+  for (std::size_t i = 0; i < imu.size(); ++i) imu[i].t_ns = std::numeric_limits<std::int64_t>::max() - 20 + 10 * static_cast<std::int64_t>(i);
+  const std::vector<std::int64_t> cam = {std::numeric_limits<std::int64_t>::min() + 5, 0};
+  const std::string msg = invalid_input_message([&] { sync_gyro(cam, imu, SyncOptions{}); });
+  EXPECT_TRUE(contains(msg, "292 years")) << msg;
+  EXPECT_TRUE(contains(msg, std::to_string(imu.back().t_ns))) << msg;
+
+  // The IMU itself near the upper limit, the camera inside it: the static-start window must not
+  // overflow past the end of the int64 range.
+  std::vector<ImuSample> late(50);
+  for (std::size_t i = 0; i < late.size(); ++i) late[i].t_ns = std::numeric_limits<std::int64_t>::max() - 1000 + 20 * static_cast<std::int64_t>(i);
+  const std::vector<std::int64_t> inside = {late[10].t_ns, late[20].t_ns};
+  EXPECT_NO_THROW(sync_gyro(inside, late, SyncOptions{}));
 }
 
 TEST(ImuSync, CameraFrameRotationFollowsEurocTBS) {

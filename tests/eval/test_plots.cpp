@@ -1,5 +1,11 @@
 // PNG plots: written, decodable, of the requested size, with both curves / the bars drawn.
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+
+#include <csignal>
+#include <fstream>
+#include <string>
 
 #include <cmath>
 #include <functional>
@@ -90,4 +96,51 @@ TEST(Plots, UnwritablePathsAndBadInputsAreErrors) {
   PlotStyle tiny;
   tiny.width = 10;
   EXPECT_TRUE(invalid([&] { plot_rates(dir.path() / "x.png", t, v, v, "x", tiny); }));
+}
+
+// A write that fails half way (here the file-size limit, standing in for a full disk) is a runtime
+// error naming the plot, and the plot that was there before is left as it was: OpenCV's own writer
+// truncated it and then deleted it. A FIFO in place of the plot is refused and kept.
+TEST(Plots, AFailedWriteKeepsThePreviousPlotAndNamesIt) {
+  te::TempDir dir("plots_write_error");
+  const std::vector<double> t = {0, 1};
+  const std::vector<Vec3> v = {{0, 0, 0}, {1, 1, 1}};
+  const auto plot = dir.path() / "plot.png";
+  { std::ofstream(plot) << "previous plot"; }
+
+  const auto previous_handler = std::signal(SIGXFSZ, SIG_IGN);
+  rlimit previous_limit{};
+  ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &previous_limit), 0);
+  rlimit small = previous_limit;
+  small.rlim_cur = 1000;
+  ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &small), 0);
+  std::string message;
+  ErrorKind kind = ErrorKind::InvalidInput;
+  try {
+    plot_rates(plot, t, v, v, "x");
+  } catch (const Error& e) {
+    message = e.what();
+    kind = e.kind();
+  }
+  ::setrlimit(RLIMIT_FSIZE, &previous_limit);
+  std::signal(SIGXFSZ, previous_handler);
+
+  EXPECT_EQ(kind, ErrorKind::Runtime) << message;
+  EXPECT_NE(message.find(plot.string()), std::string::npos) << message;
+  EXPECT_EQ(message.find("folder"), std::string::npos) << message;
+  std::string content;
+  std::getline(std::ifstream(plot), content);
+  EXPECT_EQ(content, "previous plot");
+  for (const auto& entry : std::filesystem::directory_iterator(dir.path())) EXPECT_EQ(entry.path(), plot);
+
+  const auto fifo = dir.path() / "fifo.png";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  try {
+    plot_rates(fifo, t, v, v, "x");
+    ADD_FAILURE() << "a FIFO was accepted as the plot";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::InvalidInput);
+    EXPECT_NE(std::string(e.what()).find("not a regular file"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(std::filesystem::is_fifo(std::filesystem::symlink_status(fifo)));
 }

@@ -239,6 +239,27 @@ TEST(Euroc, SensorYamlErrors) {
   EXPECT_TRUE(contains(invalid_input_message([&] { read_camera_yaml(p); }), "not valid YAML"));
 }
 
+// A NaN compares false with everything, so "error > tolerance" lets it through: every number of
+// sensor.yaml must be finite, and the rotation check must fail for NaN.
+TEST(Euroc, SensorYamlNonFiniteNumbersAreRefused) {
+  te::TempDir dir("euroc_yaml_nan");
+  const fs::path p = dir.path() / "sensor.yaml";
+  const std::string body = te::kCamYamlBody;
+  for (const std::string bad : {".nan", ".inf", "-.inf"}) {
+    std::string rotation = body;
+    rotation.replace(rotation.find("0.0148655429818"), 15, bad);
+    std::ofstream(p) << "%YAML:1.0\n" << rotation;
+    const std::string message = invalid_input_message([&] { read_camera_yaml(p); });
+    EXPECT_TRUE(contains(message, p.string()) && contains(message, "T_BS.data[0]") && contains(message, "finite"))
+        << message;
+
+    std::string focal = body;
+    focal.replace(focal.find("458.654"), 7, bad);
+    std::ofstream(p) << "%YAML:1.0\n" << focal;
+    EXPECT_TRUE(contains(invalid_input_message([&] { read_camera_yaml(p); }), "intrinsics[0]"));
+  }
+}
+
 TEST(ImageFolder, NaturalOrderAndRate) {
   te::TempDir dir("imgdir");
   for (const char* n : {"frame10.png", "frame2.png", "frame1.PNG", "notes.txt", "frame3.jpg"}) {

@@ -1,5 +1,6 @@
 // Middlebury .flo files and the Middlebury flow colour coding.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <cmath>
 #include <cstdint>
@@ -207,6 +208,33 @@ TEST(Flo, WriterRejectsBadFieldsAndUnwritablePaths) {
   const std::string missing = invalid_input_message([&] { write_flo(dir / "no" / "such" / "x.flo", FlowField(1, 1)); });
   EXPECT_TRUE(contains(missing, (dir / "no" / "such").string())) << missing;
   EXPECT_FALSE(fs::exists(dir / "bad.flo"));
+}
+
+// A FIFO stands for every non-regular target (a device node, a socket): renaming over it would
+// destroy it, so the writers refuse it; a symbolic link is written through and kept.
+TEST(Flo, WritersRefuseNonRegularTargetsAndWriteThroughSymbolicLinks) {
+  const auto dir = fs::path(it::temporary_directory("flo_targets"));
+  const fs::path fifo = dir / "pipe.flo";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::string refused = invalid_input_message([&] { write_flo(fifo, FlowField(2, 2)); });
+  EXPECT_TRUE(contains(refused, fifo.string()) && contains(refused, "not a regular file")) << refused;
+  const std::string refused_png = invalid_input_message([&] { write_flow_png(fifo, FlowField(2, 2)); });
+  EXPECT_TRUE(contains(refused_png, fifo.string())) << refused_png;
+  EXPECT_TRUE(fs::is_fifo(fs::symlink_status(fifo)));
+
+  write_flo(dir / "target.flo", FlowField(1, 1));
+  fs::create_symlink("target.flo", dir / "link.flo");
+  FlowField field(2, 1);
+  field.u[1] = 7.0f;
+  write_flo(dir / "link.flo", field);
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(dir / "link.flo")));
+  EXPECT_EQ(read_flo(dir / "target.flo").u[1], 7.0f);
+
+  fs::create_symlink("pipe.flo", dir / "to_pipe.flo");
+  EXPECT_TRUE(contains(invalid_input_message([&] { write_flo(dir / "to_pipe.flo", field); }), "not a regular file"));
+  fs::create_symlink("nowhere/x.flo", dir / "dangling.flo");
+  EXPECT_TRUE(contains(invalid_input_message([&] { write_flo(dir / "dangling.flo", field); }), "leads nowhere"));
+  EXPECT_TRUE(fs::is_fifo(fs::symlink_status(fifo)));
 }
 
 TEST(Flo, ReaderErrorsNameTheFileAndTheProblem) {

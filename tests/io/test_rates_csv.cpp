@@ -102,6 +102,21 @@ TEST(RatesCsv, ReadingErrors) {
   EXPECT_TRUE(contains(invalid_input_message([&] { read_rates_csv(dir.path() / "absent.csv"); }), "does not exist"));
 }
 
+// Timestamps near the int64 limits: their interval overflows a signed subtraction (undefined
+// behaviour, then nonsense gaps); the reader refuses a span that does not fit, naming both lines.
+TEST(RatesCsv, TimestampSpanThatOverflowsIsRefused) {
+  te::TempDir dir("rates_overflow");
+  const std::string m = invalid_input_message([&] {
+    read_rates_csv(write_text(dir, "timestamp_ns,wx,wy,wz\n-9223372036854775807,0,0,0\n0,0,0,0\n"
+                                   "9223372036854775807,0,0,0\n"));
+  });
+  EXPECT_TRUE(contains(m, "-9223372036854775807 (line 2)")) << m;
+  EXPECT_TRUE(contains(m, "9223372036854775807 (line 4)")) << m;
+  EXPECT_TRUE(contains(m, "64-bit")) << m;
+  // The largest span that fits is accepted.
+  EXPECT_EQ(read_rates_csv(write_text(dir, "timestamp_ns,wx,wy,wz\n0,0,0,0\n9223372036854775807,0,0,0\n")).size(), 2u);
+}
+
 TEST(RatesCsv, WriterRefusesBadTables) {
   te::TempDir dir("rates_w");
   const auto p = dir.path() / "out.csv";

@@ -3,9 +3,14 @@
 // configuration, all with synthetic weights of seed 1 and the configuration from the fixture.
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "inertialnet/models/inertialnet_head.hpp"
 #include "inertialnet/io/safetensors.hpp"
+#include "inertialnet/io/safetensors_writer.hpp"
 #include "support/testing.hpp"
 
 namespace inertialnet {
@@ -65,6 +70,22 @@ TEST(Head, WeightsOfAnotherSizeAreRefused) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("head.fc1.weight"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("wrong shape"), std::string::npos) << e.what();
+  }
+}
+
+// A NaN or an infinity in a weight file is refused when the file is loaded, naming the file and
+// the tensor, instead of turning every rate into NaN.
+TEST(Head, NonFiniteWeightsAreRefusedWhenLoaded) {
+  const std::string dir = testing::temporary_directory("nan_weights");
+  for (const auto& [bad, text] : {std::pair<float, const char*>{std::numeric_limits<float>::quiet_NaN(), "holds nan"},
+                                  {-std::numeric_limits<float>::infinity(), "holds -inf"}}) {
+    const std::string path = dir + "/bad.safetensors";
+    write_safetensors(path, std::vector<HostTensor>{{"head.fc1.bias", {3}, {0.5f, bad, 1.0f}}});
+    const std::string message =
+        testing::invalid_input_message([&] { WeightSet::load(testing::test_device(), {path}); });
+    EXPECT_NE(message.find(path), std::string::npos) << message;
+    EXPECT_NE(message.find("'head.fc1.bias'"), std::string::npos) << message;
+    EXPECT_NE(message.find(std::string(text) + " at element 1"), std::string::npos) << message;
   }
 }
 

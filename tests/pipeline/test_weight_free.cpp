@@ -4,6 +4,9 @@
 // axis) on small sequences; a sign flip, swapped axes or a unit slip misses them by tens of
 // deg/s, since the rates reach ±40 deg/s.
 #include <cmath>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "inertialnet/io/frame_source.hpp"
 #include "inertialnet/pipeline/rates_processor.hpp"
@@ -87,6 +90,54 @@ TEST(WeightFree, BodyFrameRatesFollowTheCameraMounting) {
   // frame checks the rotation is applied, and in the right direction.
   const Outcome o = run(SynthOptions::Rotation, 23, /*body_frame=*/true);
   for (int i = 0; i < 3; ++i) EXPECT_LE(o.rmse_deg_s[i], 1.0) << "axis " << i;
+}
+
+// Frames given as sizes: each frame is a mid-grey image of its size.
+class SizedFrames : public FrameSource {
+ public:
+  explicit SizedFrames(std::vector<std::pair<int, int>> sizes) : sizes_(std::move(sizes)) {}
+  std::size_t size() const override { return sizes_.size(); }
+  std::int64_t timestamp_ns(std::size_t index) const override { return 50'000'000 * static_cast<std::int64_t>(index); }
+  HostImage decode(std::size_t index) override {
+    HostImage image;
+    image.width = sizes_.at(index).first;
+    image.height = sizes_.at(index).second;
+    image.data.assign(3 * image.plane_size(), 128.0f);
+    return image;
+  }
+  std::string description() const override { return "sized frames"; }
+
+ private:
+  std::vector<std::pair<int, int>> sizes_;
+};
+
+// The message DIS gives for frames of mixed sizes or too small: OpenCV's assertion text used to
+// reach the user as a runtime failure; now an invalid_input naming the frame and its size.
+std::string dis_error(std::vector<std::pair<int, int>> sizes) {
+  SizedFrames source(std::move(sizes));
+  RatesProcessorOptions processor;
+  processor.flow = FlowMethod::DIS;
+  processor.inertialnet_head = false;
+  processor.geometric_head = true;
+  CameraIntrinsics camera;
+  camera.width = source.decode(0).width;
+  camera.height = source.decode(0).height;
+  camera.fx = camera.fy = 50;
+  camera.cx = (camera.width - 1) / 2.0;
+  camera.cy = (camera.height - 1) / 2.0;
+  processor.camera = camera;
+  return testing::invalid_input_message(
+      [&] { run_pipeline(source, {&testing::test_device()}, rates_processor({}, processor), [](const PairResult&) {}); });
+}
+
+TEST(WeightFree, FramesOfMixedSizesOrTooSmallAreNamed) {
+  const std::string mixed = dis_error({{64, 48}, {64, 48}, {32, 48}});
+  EXPECT_NE(mixed.find("frame 2 (t = 100000000 ns) is 32x48 but frame 1 (t = 50000000 ns) is 64x48"), std::string::npos)
+      << mixed;
+  // 4×4: the geometric head takes it (it refuses 1×1 itself), DIS would end in an assertion.
+  const std::string tiny = dis_error({{4, 4}, {4, 4}});
+  EXPECT_NE(tiny.find("frame 1 (t = 50000000 ns) is 4x4"), std::string::npos) << tiny;
+  EXPECT_NE(tiny.find("at least 16x16"), std::string::npos) << tiny;
 }
 
 }  // namespace

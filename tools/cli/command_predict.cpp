@@ -1,5 +1,6 @@
 // `inertialnet predict SEQ`: angular rates for every frame pair of a sequence, through the
 // pipelined scheduler, as a rates CSV (timestamp_ns,wx,wy,wz; rad/s; stamped with t_k).
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -62,6 +63,23 @@ const char* kNoWeightsHelp =
 
 Command register_predict(CLI::App& app, const GlobalOptions& global) {
   auto o = std::make_shared<PredictOptions>();
+  // NaN passes "> 0" tests as false and was then taken for "not given": refuse it where it is read.
+  const CLI::Validator finite_positive(
+      [](std::string& text) {
+        double value = 0;
+        if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || !(value > 0)) {
+          return "must be a finite positive number, got " + text;
+        }
+        return std::string();
+      },
+      "POSITIVE");
+  const CLI::Validator finite(
+      [](std::string& text) {
+        double value = 0;
+        if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value)) return "must be a finite number, got " + text;
+        return std::string();
+      },
+      "NUMBER");
   app.add_option("sequence", o->sequence, "EuRoC folder, image folder or video")->required();
   app.add_option("-w,--weights", o->weights,
                  "weights (safetensors) holding FlowNet2 and/or the InertialNet head; repeat for several files");
@@ -70,16 +88,24 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
   app.add_option("--head", o->head,
                  "inertialnet (default with weights), geometric (default without), or both");
   app.add_option("--solver", o->solver, "geometric head: motion-field (default) or opengv")->capture_default_str();
-  app.add_option("--fx", o->fx, "focal length x (px), when the sequence has no sensor.yaml");
-  app.add_option("--fy", o->fy, "focal length y (px)");
-  app.add_option("--cx", o->cx, "principal point x (px)");
-  app.add_option("--cy", o->cy, "principal point y (px)");
+  app.add_option("--fx", o->fx, "focal length x (px), when the sequence has no sensor.yaml")->check(finite_positive);
+  app.add_option("--fy", o->fy, "focal length y (px)")->check(finite_positive);
+  app.add_option("--cx", o->cx, "principal point x (px)")->check(finite);
+  app.add_option("--cy", o->cy, "principal point y (px)")->check(finite);
   app.add_option("-o,--output", o->output, "rates CSV to write (default: standard output)");
   app.add_option("--save-flow", o->save_flow, "write each pair's flow as <timestamp>.flo into this folder");
-  app.add_option("--rate", o->rate_hz, "frame rate for image folders and videos without timestamps (Hz)");
+  app.add_option("--rate", o->rate_hz, "frame rate for image folders and videos without timestamps (Hz)")
+      ->check(finite_positive);
   app.add_option("--lanes", o->lanes, "frame pairs in flight per device")->capture_default_str()->check(CLI::Range(1, 16));
   app.add_option("--decode-threads", o->decode_threads, "image decoding threads")->capture_default_str()->check(CLI::Range(1, 64));
-  app.add_option("--max-pairs", o->max_pairs, "stop after this many pairs");
+  app.add_option("--max-pairs", o->max_pairs, "stop after this many pairs")
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            return text.find_first_not_of("0123456789") == std::string::npos && !text.empty()
+                       ? std::string()
+                       : "must be a count of pairs (0 for all), got " + text;
+          },
+          "COUNT"));
   app.add_flag("--stats", o->stats, "print time per stage and pairs per second");
   app.add_flag("--profile", o->profile, "print the device time of every network layer per pair (profiling queues)");
   return [o, &global]() {
@@ -118,6 +144,15 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
         processor.camera = camera;
       } else if (const auto calibration = source->calibration()) {
         processor.camera = CameraIntrinsics::from_calibration(*calibration);
+        // The geometric head allocates per pixel of the calibrated size: compare it with the
+        // images before, so that a wrong resolution is a clear message, not gigabytes asked for.
+        const HostImage first = source->decode(0);
+        if (first.width != processor.camera->width || first.height != processor.camera->height) {
+          throw invalid_input(source->description() + ": cam0/sensor.yaml gives the resolution " +
+                              std::to_string(processor.camera->width) + "x" + std::to_string(processor.camera->height) +
+                              ", which does not match the images (" + std::to_string(first.width) + "x" +
+                              std::to_string(first.height) + ").");
+        }
         processor.camera_to_body = calibration->rotation_BS();
       } else {
         throw invalid_input("the geometric head needs the camera: " + source->description() +
@@ -149,7 +184,15 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
       processor.flow_model = flow_model_of(*weight_sets.front(), o->model);
     }
     const auto factory = rates_processor(weights_of, processor);
-    if (!o->save_flow.empty()) std::filesystem::create_directories(o->save_flow);
+    if (!o->save_flow.empty()) {
+      // Checked here, so that a file in the way is a message, not a raw filesystem_error.
+      std::error_code error;
+      std::filesystem::create_directories(o->save_flow, error);
+      if (error || !std::filesystem::is_directory(o->save_flow)) {
+        throw invalid_input("--save-flow " + o->save_flow + ": cannot use it as a folder (" +
+                            (error ? error.message() : std::string("it exists and is not a folder")) + ").");
+      }
+    }
 
     std::string method = (processor.flow == FlowMethod::DIS ? std::string("DIS flow") : to_string(processor.flow_model));
     method += processor.inertialnet_head && processor.geometric_head ? " + InertialNet and geometric heads"
@@ -184,13 +227,20 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
       const auto& w = r.rates.front().second;
       std::vector<double> more;
       for (std::size_t i = 1; i < r.rates.size(); ++i) more.insert(more.end(), r.rates[i].second.begin(), r.rates[i].second.end());
+      // Inputs are checked where they enter; a NaN here is a failure of the computation, never a rate.
+      bool finite = std::isfinite(w[0]) && std::isfinite(w[1]) && std::isfinite(w[2]);
+      for (const double v : more) finite = finite && std::isfinite(v);
+      if (!finite) {
+        throw runtime_error("the rates computed for the frame at timestamp " + std::to_string(r.t1_ns) +
+                            " are not finite (NaN or infinity); stopping rather than writing them.");
+      }
       if (file_writer) {
         file_writer->write(r.t1_ns, {w[0], w[1], w[2]}, more);
       } else {
         std::printf("%lld,%.9g,%.9g,%.9g", static_cast<long long>(r.t1_ns), w[0], w[1], w[2]);
         for (const double v : more) std::printf(",%.9g", v);
         std::printf("\n");
-        std::fflush(stdout);
+        flush_standard_output();  // a row at a time, so a closed pipe stops the run at once
       }
       if (r.flow) write_flo(std::filesystem::path(o->save_flow) / (std::to_string(r.t1_ns) + ".flo"), *r.flow);
       progress.update(++done);

@@ -1,5 +1,8 @@
 #include "common.hpp"
 
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <iostream>
 #include <regex>
 
@@ -30,6 +33,19 @@ void warn_if_synthetic(const WeightSet& weights) {
   for (const auto& s : weights.synthetic_sources()) sources += (sources.empty() ? "" : ", ") + s;
   std::cerr << "inertialnet: note: synthetic weights (" << sources
             << "): the output exercises the network but is not a measurement\n";
+}
+
+void flush_standard_output() {
+  // std::cout shares stdout's buffer (sync_with_stdio), so one flush and one error flag cover both.
+  errno = 0;
+  std::cout.flush();
+  const bool flushed = std::fflush(stdout) == 0;
+  const int err = errno;
+  if (!flushed || std::ferror(stdout) || !std::cout) {
+    std::clearerr(stdout);
+    throw runtime_error(std::string("cannot write to standard output: ") +
+                        (err ? std::strerror(err) : "the write failed"));
+  }
 }
 
 }  // namespace inertialnet::cli

@@ -22,4 +22,8 @@ std::pair<std::int64_t, std::int64_t> parse_size(const std::string& text);
 // One line on stderr when any weights are synthetic: their output is not a measurement.
 void warn_if_synthetic(const WeightSet& weights);
 
+// Pushes what is buffered for standard output to it; runtime_error when it cannot be written
+// (a full disk, a closed pipe, /dev/full), so that no command reports success with its output lost.
+void flush_standard_output();
+
 }  // namespace inertialnet::cli

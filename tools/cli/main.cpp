@@ -5,6 +5,7 @@
 #include <map>
 
 #include "commands.hpp"
+#include "common.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/runtime/program_cache.hpp"
 
@@ -58,7 +59,11 @@ int main(int argc, char** argv) {
   if (global.no_cache) ::setenv(kNoCacheEnvironmentVariable, "1", 1);
   try {
     for (auto& [sub, run] : commands) {
-      if (sub->parsed()) return run();
+      if (!sub->parsed()) continue;
+      const int code = run();
+      // Output that never reached standard output is a failure, whatever the command did.
+      cli::flush_standard_output();
+      return code;
     }
     return 2;
   } catch (const Error& e) {

@@ -1,0 +1,87 @@
+# Where the CLI's output goes: it never replaces what is not a regular file, writes through
+# symbolic links, and never exits 0 when an output (standard output included) could not be written.
+# Non-regular targets are private FIFOs in the scratch folder, never the system's /dev.
+#   cmake -DCLI=<inertialnet> -DWORK=<scratch dir> -P outputs.cmake
+file(REMOVE_RECURSE "${WORK}")
+file(MAKE_DIRECTORY "${WORK}")
+
+include(${CMAKE_CURRENT_LIST_DIR}/run_helpers.cmake)
+
+function(make_fifo name)
+  file(REMOVE "${WORK}/${name}")
+  execute_process(COMMAND mkfifo "${WORK}/${name}" RESULT_VARIABLE code)
+  if(NOT code EQUAL 0)
+    message(FATAL_ERROR "mkfifo ${name} failed")
+  endif()
+endfunction()
+
+function(expect_fifo name)
+  execute_process(COMMAND test -p "${WORK}/${name}" RESULT_VARIABLE code)
+  if(NOT code EQUAL 0)
+    message(FATAL_ERROR "${name} is no longer a FIFO")
+  endif()
+endfunction()
+
+run(0 ${CLI} synth seq --frames 3 --size 96x64 --seed 5)
+
+# 1. weights -o, flow -o / --png, predict --save-flow: a FIFO is refused (exit 2) and kept.
+make_fifo(pipe.safetensors)
+run(2 ${CLI} weights --synthetic InertialNetHead --size 32x32 -o pipe.safetensors)
+expect_match("pipe.safetensors: it exists and is not a regular file")
+expect_fifo(pipe.safetensors)
+run(0 ${CLI} weights --synthetic InertialNetHead --size 32x32 -o head.safetensors)
+file(CREATE_LINK head.safetensors "${WORK}/link.safetensors" SYMBOLIC)
+run(0 ${CLI} weights --synthetic InertialNetHead --size 40x32 -o link.safetensors)
+if(NOT IS_SYMLINK "${WORK}/link.safetensors")
+  message(FATAL_ERROR "weights -o replaced the symbolic link")
+endif()
+run(0 ${CLI} weights --info head.safetensors)
+expect_match("\"input_width\":40")
+run(0 ${CLI} weights --synthetic FlowNet2-C -o real.safetensors)
+
+file(GLOB frames "${WORK}/seq/mav0/cam0/data/*.png")
+list(SORT frames)
+list(GET frames 0 first)
+list(GET frames 1 second)
+make_fifo(pipe.flo)
+run(2 ${CLI} flow ${first} ${second} -w real.safetensors -o pipe.flo)
+expect_match("pipe.flo: it exists and is not a regular file")
+expect_fifo(pipe.flo)
+make_fifo(pipe.png)
+run(2 ${CLI} flow ${first} ${second} -w real.safetensors --png pipe.png)
+expect_match("pipe.png: it exists and is not a regular file")
+expect_fifo(pipe.png)
+
+run(0 ${CLI} predict seq -o rates.csv --save-flow flows)
+file(GLOB flows RELATIVE "${WORK}" "${WORK}/flows/*.flo")
+list(GET flows 0 flo)
+make_fifo(${flo})
+run(2 ${CLI} predict seq -o rates.csv --save-flow flows)
+expect_match("${flo}: it exists and is not a regular file")
+expect_fifo(${flo})
+
+# 2. eval --plot onto a FIFO: refused by name (exit 2), the FIFO kept.
+make_fifo(pipe_plot.png)
+run(2 ${CLI} eval rates.csv seq --plot pipe_plot.png)
+expect_match("pipe_plot.png: it exists and is not a regular file")
+expect_fifo(pipe_plot.png)
+
+# 3. Standard output that cannot be written (/dev/full as a sink: opened for writing, never
+# replaced) is a runtime failure, exit 1 with a message on stderr, for every command that prints.
+function(run_to_full)
+  execute_process(COMMAND ${ARGN} WORKING_DIRECTORY "${WORK}" RESULT_VARIABLE code OUTPUT_FILE /dev/full
+                  ERROR_VARIABLE err TIMEOUT 300)
+  message("$ ${ARGN} > /dev/full\n${err}(exit ${code})")
+  if(NOT "${code}" STREQUAL "1")
+    message(FATAL_ERROR "expected exit code 1, got ${code}")
+  endif()
+  if(NOT err MATCHES "cannot write to standard output")
+    message(FATAL_ERROR "stderr does not say that standard output could not be written")
+  endif()
+endfunction()
+run_to_full(${CLI} predict seq)
+run_to_full(${CLI} eval rates.csv seq)
+run_to_full(${CLI} eval rates.csv seq --json)
+run_to_full(${CLI} weights --info head.safetensors)
+run_to_full(${CLI} devices --json)
+run_to_full(${CLI} devices)

@@ -1,0 +1,19 @@
+# What the CLI scripts share (end_to_end, outputs, bad_inputs): run a command in ${WORK}, check
+# its exit code, and match its output.
+
+# run(<expected exit code> <command>...): runs in ${WORK}; sets `output` to stdout + stderr.
+function(run expect_code)
+  execute_process(COMMAND ${ARGN} WORKING_DIRECTORY "${WORK}" RESULT_VARIABLE code OUTPUT_VARIABLE out
+                  ERROR_VARIABLE err TIMEOUT 600)
+  message("$ ${ARGN}\n${out}${err}(exit ${code})")
+  if(NOT "${code}" STREQUAL "${expect_code}")
+    message(FATAL_ERROR "expected exit code ${expect_code}, got ${code}")
+  endif()
+  set(output "${out}${err}" PARENT_SCOPE)
+endfunction()
+
+function(expect_match regex)
+  if(NOT output MATCHES "${regex}")
+    message(FATAL_ERROR "output does not match '${regex}'")
+  endif()
+endfunction()
