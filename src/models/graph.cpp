@@ -297,7 +297,10 @@ void Executor::run(Queue& queue, const std::map<std::string, Tensor>& inputs, co
     gemm_weights_.assign(nodes.size(), nullptr);
     for (std::size_t i = 0; i < nodes.size(); ++i) {
       const Node& node = nodes[i];
-      if (node.kind == OpKind::Conv2d) gemm_weights_[i] = &prepared->conv2d(queue, node.weight, param(node.weight));
+      if (node.kind == OpKind::Conv2d) {
+        const int stride = node.options_as<Conv2dOptions>().stride;
+        gemm_weights_[i] = &prepared->conv2d(queue, node.weight, param(node.weight), stride);
+      }
       if (node.kind == OpKind::ConvTranspose2d) {
         gemm_weights_[i] = &prepared->conv_transpose2d(queue, node.weight, param(node.weight));
       }

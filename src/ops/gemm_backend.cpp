@@ -6,13 +6,24 @@
 
 namespace inertialnet {
 
-const char* to_string(GemmBackend backend) { return backend == GemmBackend::Packed ? "packed" : "clblast"; }
+const char* to_string(GemmBackend backend) {
+  switch (backend) {
+    case GemmBackend::Packed:
+      return "packed";
+    case GemmBackend::Winograd:
+      return "winograd";
+    case GemmBackend::CLBlast:
+      break;
+  }
+  return "clblast";
+}
 
 GemmBackend gemm_backend(const DeviceInfo& device, const std::string& plan) {
   if (plan == "clblast") return GemmBackend::CLBlast;
   if (plan == "packed") return GemmBackend::Packed;
+  if (plan == "winograd") return GemmBackend::Winograd;
   if (!plan.empty()) {
-    throw invalid_input(std::string(kPlanEnvironmentVariable) + "='" + plan + "' is not a plan: use clblast or packed");
+    throw invalid_input(std::string(kPlanEnvironmentVariable) + "='" + plan + "' is not a plan: use clblast, packed or winograd");
   }
   // The packed kernels are written for CPUs (one register tile per work-item, work-groups of
   // one); on GPUs CLBlast's tuned kernels are the ones to use.

@@ -3,8 +3,11 @@
 // with a direct convolution for layers of very few output channels and a GEMV for
 // one-sample fully connected layers).
 //
-// Without timing the choice is deterministic: $INERTIALNET_PLAN=clblast|packed forces one
-// backend everywhere (tests run every suite under both; `bench` compares them), otherwise CPU
+// `Winograd` is the packed backend with Winograd F(2×2, 3×3) for the 3×3 stride-1 convolutions
+// of at least 16 output channels (src/ops/winograd.hpp); every other layer runs as on `Packed`.
+//
+// Without timing the choice is deterministic: $INERTIALNET_PLAN=clblast|packed|winograd forces
+// one backend everywhere (tests run every suite under each; `bench` compares them), otherwise CPU
 // devices use the packed kernels and every other device CLBlast.
 #pragma once
 
@@ -14,9 +17,17 @@
 
 namespace inertialnet {
 
-enum class GemmBackend { CLBlast, Packed };
+enum class GemmBackend { CLBlast, Packed, Winograd };
 
-const char* to_string(GemmBackend backend);  // "clblast", "packed"
+const char* to_string(GemmBackend backend);  // "clblast", "packed", "winograd"
+
+// Whether `backend` runs the project's packed kernels (Packed and Winograd).
+inline bool uses_packed_kernels(GemmBackend backend) { return backend != GemmBackend::CLBlast; }
+
+// The backend that runs a layer other than a Winograd convolution (what profiles report for it).
+inline GemmBackend without_winograd(GemmBackend backend) {
+  return backend == GemmBackend::Winograd ? GemmBackend::Packed : backend;
+}
 
 inline constexpr const char* kPlanEnvironmentVariable = "INERTIALNET_PLAN";
 

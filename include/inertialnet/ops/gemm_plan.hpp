@@ -6,12 +6,14 @@
 // graph but shares one WeightSet, so the packed weights are kept per WeightSet (one cache per
 // device's weights), not per graph: pipeline lanes do not duplicate them. Layers with very few
 // output channels (predict_flow*) run a direct convolution and need no packing; fully connected
-// layers read their weights in place (GEMV).
+// layers read their weights in place (GEMV). On the winograd plan, the 3×3 stride-1 layers keep
+// their 16 Winograd-transformed weight matrices packed instead (src/ops/winograd.hpp).
 #pragma once
 
 #include <map>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include "inertialnet/ops/gemm_backend.hpp"
 #include "inertialnet/ops/gemm_packed.hpp"
@@ -21,27 +23,29 @@
 namespace inertialnet {
 
 // A layer's weights as its backend reads them. `packed` is defined only where the layer runs
-// the packed GEMM; everything else reads the original weight tensor.
+// the packed GEMM on im2col panels, `winograd` (16 matrices) only where it runs Winograd;
+// everything else reads the original weight tensor.
 struct GemmWeights {
   GemmBackend backend = GemmBackend::CLBlast;
   PackedPanels packed;
+  std::vector<PackedPanels> winograd;
 };
 
 // Convolutions with at most this many output channels run the direct kernel on the packed
 // backend (FlowNet's predict_flow*: 2).
 inline constexpr std::int64_t kDirectConvMaxChannels = 4;
 
-// Prepares conv2d weights [co, ci, kh, kw] / conv_transpose2d weights [ci, co, kh, kw] for
-// `backend`, packing on `queue` into long-lived storage of `device`. Wait for `queue` before
-// another queue uses the result.
-GemmWeights prepare_conv2d_weights(Queue& queue, const Tensor& weight, GemmBackend backend);
+// Prepares conv2d weights [co, ci, kh, kw] (of a layer of `stride`) / conv_transpose2d weights
+// [ci, co, kh, kw] for `backend`, packing on `queue` into long-lived storage of `device`. Wait
+// for `queue` before another queue uses the result.
+GemmWeights prepare_conv2d_weights(Queue& queue, const Tensor& weight, GemmBackend backend, int stride);
 GemmWeights prepare_conv_transpose2d_weights(Queue& queue, const Tensor& weight, GemmBackend backend);
 
 // The prepared weights of a set of layers on one device, by parameter name, made on first use
 // and then shared by every queue (thread-safe).
 class PreparedWeights {
  public:
-  const GemmWeights& conv2d(Queue& queue, const std::string& name, const Tensor& weight);
+  const GemmWeights& conv2d(Queue& queue, const std::string& name, const Tensor& weight, int stride);
   const GemmWeights& conv_transpose2d(Queue& queue, const std::string& name, const Tensor& weight);
   std::size_t packed_bytes() const;
 
