@@ -1,6 +1,7 @@
-// Winograd F(2×2, 3×3) convolution for the packed (CPU) plan: 3×3 stride-1 layers of at least
-// kWinogradMinChannels output channels do 16 GEMMs of [co × ci]·[ci × tiles] (4 multiplies per
-// output pixel and channel pair instead of 9) plus two cheap transforms (kernels_cl/winograd.cl).
+// Winograd F(2×2, 3×3) convolution for the winograd plan on CPU devices: 3×3 stride-1 layers
+// of at least kWinogradMinChannels output and kWinogradMinInputChannels input channels do 16
+// GEMMs of [co × ci]·[ci × tiles] (4 multiplies per output pixel and channel pair instead of 9)
+// plus two transforms (kernels_cl/winograd.cl).
 //
 // The weights are transformed (U = G g Gᵀ) and packed into 16 sets of A panels once per layer
 // (ops/gemm_plan.hpp). Per call, the input transform writes V = Bᵀ d B of a range of 2×2 output
@@ -20,6 +21,11 @@ namespace inertialnet::detail {
 
 // Output channels from which a 3×3 stride-1 layer runs Winograd on the winograd plan.
 inline constexpr std::int64_t kWinogradMinChannels = 16;
+// Input channels from which it does: each GEMM's depth is ci, and with a shallow one the 16
+// products (16·co floats per 2×2 tile) cost more memory traffic than the 9·ci taps save
+// (measured at 512×384: FlowNetSD conv0, ci = 6, and FlowNetFusion conv0, ci = 11, ran 4–6×
+// slower than the im2col GEMM; the InertialNet head's conv2, ci = 16, 2.5×).
+inline constexpr std::int64_t kWinogradMinInputChannels = 32;
 
 // Whether a convolution with weights [co, ci, kh, kw] and `stride` runs Winograd on that plan.
 bool winograd_eligible(const Shape& weight, int stride);

@@ -1,7 +1,7 @@
 // Winograd F(2×2, 3×3) (the winograd plan's 3×3 stride-1 convolutions) against the direct
-// convolution of tests/reference/conv.cpp: every FlowNet2 3×3 stride-1 shape of ≥ 16 output
-// channels at a 64×64 network input, odd sizes, batch 3, channel-slice inputs and outputs, tile
-// ranges, other paddings, and the layers the plan leaves on the packed GEMM.
+// convolution of tests/reference/conv.cpp: every FlowNet2 3×3 stride-1 shape of ≥ 16 output and
+// ≥ 32 input channels at a 64×64 network input, odd sizes, batch 3, channel-slice inputs and
+// outputs, tile ranges, other paddings, and the layers the plan leaves on the packed GEMM.
 //
 // Error bound: direct convolution is held to 1e-5 of (|reference| + sqrt(K)) (K = ci·9, the
 // typical output magnitude; tests/ops/test_conv2d.cpp). Winograd sums the same K products in a
@@ -77,7 +77,7 @@ TEST_P(FlowNetWinogradShapes, MatchTheReference) { expect_winograd_matches(GetPa
 std::vector<Case> flownet2_winograd_cases() {
   std::vector<Case> cases;
   for (const auto& l : flownet_layers::flownet2_layers(64, 64, flownet_layers::LayerKind::Conv)) {
-    if (l.k != 3 || l.stride != 1 || l.co < 16) continue;
+    if (l.k != 3 || l.stride != 1 || l.co < 16 || l.ci < 32) continue;
     cases.push_back({l.identifier(), l.ci, l.co, l.h, l.w, l.stride, l.padding, l.bias, l.activation});
   }
   return cases;
@@ -91,36 +91,38 @@ TEST(Winograd, FlowNet2HasEligibleLayers) { EXPECT_GE(flownet2_winograd_cases().
 TEST(Winograd, OddSizesBatchThree) {
   // Odd output sizes leave half tiles on the bottom row and the right column.
   const auto leaky = ActivationSpec::leaky_relu(0.1f);
-  expect_winograd_matches({"odd_37x23", 5, 17, 37, 23, 1, 1, true, leaky}, {3});
-  expect_winograd_matches({"odd_5x3", 3, 16, 5, 3, 1, 1, false, ActivationSpec::relu()}, {3});
-  expect_winograd_matches({"one_pixel", 4, 16, 1, 1, 1, 1, true, ActivationSpec::none()}, {3});
-  expect_winograd_matches({"even_38x22", 9, 33, 38, 22, 1, 1, true, leaky}, {3});
+  expect_winograd_matches({"odd_37x23", 35, 17, 37, 23, 1, 1, true, leaky}, {3});
+  expect_winograd_matches({"odd_5x3", 32, 16, 5, 3, 1, 1, false, ActivationSpec::relu()}, {3});
+  expect_winograd_matches({"one_pixel", 40, 16, 1, 1, 1, 1, true, ActivationSpec::none()}, {3});
+  expect_winograd_matches({"even_38x22", 33, 33, 38, 22, 1, 1, true, leaky}, {3});
 }
 
 TEST(Winograd, OtherPaddings) {
-  expect_winograd_matches({"pad0", 6, 20, 37, 23, 1, 0, true, ActivationSpec::relu()}, {3});
-  expect_winograd_matches({"pad2", 6, 20, 17, 13, 1, 2, false, ActivationSpec::none()}, {2});
+  expect_winograd_matches({"pad0", 36, 20, 37, 23, 1, 0, true, ActivationSpec::relu()}, {3});
+  expect_winograd_matches({"pad2", 36, 20, 17, 13, 1, 2, false, ActivationSpec::none()}, {2});
 }
 
 TEST(Winograd, WritesIntoAChannelSliceAndReadsFromOne) {
   const auto leaky = ActivationSpec::leaky_relu(0.1f);
-  expect_winograd_matches({"slice", 6, 18, 37, 23, 1, 1, true, leaky}, {3, 2, 3, 5, 4, 0});
-  expect_winograd_matches({"slice_first", 3, 16, 16, 16, 1, 1, true, ActivationSpec::none()}, {3, 0, 1, 0, 7});
-  expect_winograd_matches({"slice_last", 3, 16, 16, 16, 1, 1, true, ActivationSpec::none()}, {3, 1, 0, 7, 0});
+  expect_winograd_matches({"slice", 36, 18, 37, 23, 1, 1, true, leaky}, {3, 2, 3, 5, 4, 0});
+  expect_winograd_matches({"slice_first", 32, 16, 16, 16, 1, 1, true, ActivationSpec::none()}, {3, 0, 1, 0, 7});
+  expect_winograd_matches({"slice_last", 32, 16, 16, 16, 1, 1, true, ActivationSpec::none()}, {3, 1, 0, 7, 0});
 }
 
 TEST(Winograd, SmallBudgetProcessesTileRanges) {
-  // 16·20 floats per tile: a budget of 40 tiles gives ranges of 32 tiles (whole panels), the last
+  // 16·40 floats per tile: a budget of 40 tiles gives ranges of 32 tiles (whole panels), the last
   // one partial; a budget of 1 float processes one tile at a time.
   const auto leaky = ActivationSpec::leaky_relu(0.1f);
-  expect_winograd_matches({"ranges", 5, 20, 37, 23, 1, 1, true, leaky}, {3, 1, 1, 2, 2, 16 * 20 * 40});
-  expect_winograd_matches({"one_tile", 2, 16, 5, 4, 1, 1, true, ActivationSpec::relu()}, {2, 0, 0, 0, 0, 1});
+  expect_winograd_matches({"ranges", 40, 20, 37, 23, 1, 1, true, leaky}, {3, 1, 1, 2, 2, 16 * 40 * 40});
+  expect_winograd_matches({"one_tile", 32, 16, 5, 4, 1, 1, true, ActivationSpec::relu()}, {2, 0, 0, 0, 0, 1});
 }
 
 TEST(Winograd, IneligibleLayersRunPacked) {
-  // Stride 2, fewer than 16 output channels: the plan keeps the packed GEMM (and direct conv).
-  expect_winograd_matches({"stride2", 5, 20, 37, 23, 2, 1, true, ActivationSpec::relu()}, {2}, false);
-  expect_winograd_matches({"co8", 5, 8, 37, 23, 1, 1, true, ActivationSpec::relu()}, {2}, false);
+  // Stride 2, fewer than 16 output or 32 input channels: the plan keeps the packed GEMM (and
+  // the direct convolution).
+  expect_winograd_matches({"stride2", 36, 20, 37, 23, 2, 1, true, ActivationSpec::relu()}, {2}, false);
+  expect_winograd_matches({"co8", 36, 8, 37, 23, 1, 1, true, ActivationSpec::relu()}, {2}, false);
+  expect_winograd_matches({"ci6", 6, 64, 37, 23, 1, 1, true, ActivationSpec::relu()}, {2}, false);
   expect_winograd_matches({"co2_direct", 5, 2, 37, 23, 1, 1, true, ActivationSpec::none()}, {2}, false);
 }
 
