@@ -8,6 +8,7 @@
 #include "inertialnet/ops/bias_activation.hpp"
 #include "inertialnet/ops/gemm.hpp"
 #include "ops/op_support.hpp"
+#include "ops/winograd.hpp"
 
 namespace inertialnet {
 
@@ -22,7 +23,7 @@ void conv2d_packed(Queue& queue, const Tensor& input, const Tensor& weight, cons
                    const Conv2dOptions& options) {
   const bool prepared = options.prepared && options.prepared->packed.data.defined();
   const PackedPanels weights = prepared ? options.prepared->packed
-                                        : prepare_conv2d_weights(queue, weight, GemmBackend::Packed).packed;
+                                        : prepare_conv2d_weights(queue, weight, GemmBackend::Packed, options.stride).packed;
   const std::size_t reduction = weights.depth;
   const auto out_h = static_cast<int>(output.h()), out_w = static_cast<int>(output.w());
   const std::size_t pixels = static_cast<std::size_t>(out_h) * static_cast<std::size_t>(out_w);
@@ -108,12 +109,19 @@ void conv2d(Queue& queue, const Tensor& input, const Tensor& weight, const Tenso
 
   Device& device = queue.device();
   const GemmBackend backend = options.prepared ? options.prepared->backend : gemm_backend(device.info());
-  if (backend == GemmBackend::Packed) {
+  if (backend == GemmBackend::Winograd && detail::winograd_eligible(weight.shape(), options.stride)) {
+    detail::report_backend(queue, to_string(backend));
+    const bool prepared = options.prepared && !options.prepared->winograd.empty();
+    detail::conv2d_winograd(queue, input, prepared ? options.prepared->winograd : detail::winograd_weights(queue, weight, nullptr),
+                            bias, output, options);
+    return;
+  }
+  if (uses_packed_kernels(backend)) {
     if (weight.dim(0) <= kDirectConvMaxChannels) {
       detail::report_backend(queue, "direct");
       conv2d_direct(queue, input, weight, bias, output, options);
     } else {
-      detail::report_backend(queue, to_string(backend));
+      detail::report_backend(queue, to_string(GemmBackend::Packed));
       conv2d_packed(queue, input, weight, bias, output, options);
     }
     return;

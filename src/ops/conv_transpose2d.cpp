@@ -68,11 +68,11 @@ void conv_transpose2d(Queue& queue, const Tensor& input, const Tensor& weight, c
   std::size_t block =
       std::clamp<std::size_t>(detail::column_budget(device, options.max_column_floats) / (taps * in_pixels), 1, out_channels);
   const GemmBackend backend = options.prepared ? options.prepared->backend : gemm_backend(device.info());
-  detail::report_backend(queue, to_string(backend));
+  detail::report_backend(queue, to_string(without_winograd(backend)));
   // The packed backend multiplies Wᵀ packed once per layer (or now) by the input packed per
   // sample; a block of channels is then a range of whole A panels.
   PackedPanels packed_weight, packed_input;
-  if (backend == GemmBackend::Packed) {
+  if (uses_packed_kernels(backend)) {
     const bool prepared = options.prepared && options.prepared->packed.data.defined();
     packed_weight = prepared ? options.prepared->packed
                              : prepare_conv_transpose2d_weights(queue, weight, GemmBackend::Packed).packed;
@@ -99,7 +99,7 @@ void conv_transpose2d(Queue& queue, const Tensor& input, const Tensor& weight, c
   for (std::int64_t n = 0; n < input.n(); ++n) {
     const Tensor in_n = input.sample(n);
     const Tensor out_n = output.sample(n);
-    if (backend == GemmBackend::Packed) {
+    if (uses_packed_kernels(backend)) {
       packed_input = pack_b(queue, Transpose::No, in_channels, in_pixels, MatrixView::of(in_n, in_pixels),
                             packed_input.data);
     }
@@ -107,7 +107,7 @@ void conv_transpose2d(Queue& queue, const Tensor& input, const Tensor& weight, c
       const std::size_t count = std::min(block, out_channels - first);
       // columns[count·taps, H·W] = Wᵀ · X: W is stored [ci, co·taps], so the block's rows of Wᵀ
       // are columns [first·taps, (first + count)·taps) of W.
-      if (backend == GemmBackend::Packed) {
+      if (uses_packed_kernels(backend)) {
         gemm_packed(queue, packed_weight.rows(first * taps, count * taps), packed_input,
                     MatrixView::of(columns, in_pixels));
       } else {

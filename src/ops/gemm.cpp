@@ -73,7 +73,7 @@ void gemm(Queue& queue, GemmBackend backend, Transpose transpose_a, Transpose tr
           std::size_t n, std::size_t k, float alpha, const MatrixView& a, const MatrixView& b, float beta,
           const MatrixView& c) {
   check_problem(transpose_a, transpose_b, m, n, k, a, 0, b, 0, c, 0, 1);
-  if (backend == GemmBackend::Packed) {
+  if (uses_packed_kernels(backend)) {
     const PackedPanels packed_a = pack_a(queue, transpose_a, m, k, a);
     const PackedPanels packed_b = pack_b(queue, transpose_b, k, n, b);
     gemm_packed(queue, packed_a, packed_b, c, GemmEpilogue{alpha, beta, Tensor(), ActivationSpec::none()});
@@ -94,7 +94,7 @@ void gemm_strided_batched(Queue& queue, Transpose transpose_a, Transpose transpo
                           std::size_t batch) {
   check_problem(transpose_a, transpose_b, m, n, k, a, stride_a, b, stride_b, c, stride_c, batch);
   const GemmBackend backend = gemm_backend(queue.device().info());
-  if (batch == 1 || backend == GemmBackend::Packed) {
+  if (batch == 1 || uses_packed_kernels(backend)) {
     // The packed kernels have no batched form: one product per batch entry.
     for (std::size_t i = 0; i < batch; ++i) {
       auto at = [i](MatrixView view, std::size_t stride) {

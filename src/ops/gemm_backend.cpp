@@ -13,12 +13,24 @@ std::string plan_from_environment() {
   return plan ? std::string(plan) : std::string();
 }
 
+constexpr GemmBackend kAllBackends[] = {GemmBackend::CLBlast, GemmBackend::Packed, GemmBackend::Winograd};
+
 }  // namespace
 
-const char* to_string(GemmBackend backend) { return backend == GemmBackend::Packed ? "packed" : "clblast"; }
+const char* to_string(GemmBackend backend) {
+  switch (backend) {
+    case GemmBackend::Packed:
+      return "packed";
+    case GemmBackend::Winograd:
+      return "winograd";
+    case GemmBackend::CLBlast:
+      break;
+  }
+  return "clblast";
+}
 
 std::optional<GemmBackend> parse_gemm_backend(const std::string& name) {
-  for (const GemmBackend backend : {GemmBackend::CLBlast, GemmBackend::Packed}) {
+  for (const GemmBackend backend : kAllBackends) {
     if (name == to_string(backend)) return backend;
   }
   return std::nullopt;
@@ -27,7 +39,7 @@ std::optional<GemmBackend> parse_gemm_backend(const std::string& name) {
 std::vector<GemmBackend> gemm_candidates(const DeviceInfo& device) {
   const GemmBackend first = gemm_backend(device, "");
   std::vector<GemmBackend> candidates{first};
-  for (const GemmBackend backend : {GemmBackend::CLBlast, GemmBackend::Packed}) {
+  for (const GemmBackend backend : kAllBackends) {
     if (backend != first) candidates.push_back(backend);
   }
   return candidates;
@@ -37,7 +49,7 @@ GemmBackend gemm_backend(const DeviceInfo& device, const std::string& plan) {
   if (const auto forced = parse_gemm_backend(plan)) return *forced;
   if (!plan.empty() && plan != kPlanAuto) {
     throw invalid_input(std::string(kPlanEnvironmentVariable) + "='" + plan +
-                        "' is not a plan: use clblast, packed or auto");
+                        "' is not a plan: use clblast, packed, winograd or auto");
   }
   // The packed kernels are written for CPUs (one register tile per work-item, work-groups of
   // one); on GPUs CLBlast's tuned kernels are the ones to use.

@@ -6,6 +6,7 @@
 
 #include "inertialnet/ops/gemm_plan_cache.hpp"
 #include "inertialnet/runtime/device.hpp"
+#include "ops/winograd.hpp"
 
 namespace inertialnet {
 
@@ -53,14 +54,16 @@ GemmWeights time_candidates(Queue& queue, const PlannedLayer& layer, Prepare& pr
 PreparedWeights::PreparedWeights(std::filesystem::path plan_directory) : plan_directory_(std::move(plan_directory)) {}
 PreparedWeights::~PreparedWeights() = default;
 
-GemmWeights prepare_conv2d_weights(Queue& queue, const Tensor& weight, GemmBackend backend) {
+GemmWeights prepare_conv2d_weights(Queue& queue, const Tensor& weight, GemmBackend backend, int stride) {
   if (weight.rank() != 4 || !weight.contiguous()) {
     throw invalid_input("conv2d weights must be a contiguous [co, ci, kh, kw] tensor, got " + to_string(weight.shape()));
   }
   GemmWeights prepared;
   prepared.backend = backend;
   const auto rows = static_cast<std::size_t>(weight.dim(0));
-  if (backend == GemmBackend::Packed && weight.dim(0) > kDirectConvMaxChannels) {
+  if (backend == GemmBackend::Winograd && detail::winograd_eligible(weight.shape(), stride)) {
+    prepared.winograd = detail::winograd_weights(queue, weight, &queue.device());
+  } else if (uses_packed_kernels(backend) && weight.dim(0) > kDirectConvMaxChannels) {
     const std::size_t depth = static_cast<std::size_t>(weight.numel()) / rows;
     prepared.packed = pack_a(queue, Transpose::No, rows, depth, MatrixView::of(weight, depth), 0, &queue.device());
   }
@@ -74,7 +77,7 @@ GemmWeights prepare_conv_transpose2d_weights(Queue& queue, const Tensor& weight,
   }
   GemmWeights prepared;
   prepared.backend = backend;
-  if (backend == GemmBackend::Packed) {
+  if (uses_packed_kernels(backend)) {
     // The GEMM's A is Wᵀ: [co·kh·kw, ci] from W stored [ci, co·kh·kw].
     const auto depth = static_cast<std::size_t>(weight.dim(0));
     const std::size_t rows = static_cast<std::size_t>(weight.numel()) / depth;
@@ -106,10 +109,10 @@ const GemmWeights& PreparedWeights::get(Queue& queue, const std::string& name, P
   return weights_.emplace(name, std::move(prepared)).first->second;
 }
 
-const GemmWeights& PreparedWeights::conv2d(Queue& queue, const std::string& name, const Tensor& weight,
+const GemmWeights& PreparedWeights::conv2d(Queue& queue, const std::string& name, const Tensor& weight, int stride,
                                             const PlannedLayer* layer) {
   return get(
-      queue, name, [&](GemmBackend backend) { return prepare_conv2d_weights(queue, weight, backend); }, layer);
+      queue, name, [&](GemmBackend backend) { return prepare_conv2d_weights(queue, weight, backend, stride); }, layer);
 }
 
 const GemmWeights& PreparedWeights::conv_transpose2d(Queue& queue, const std::string& name, const Tensor& weight,
@@ -124,6 +127,7 @@ std::size_t PreparedWeights::packed_bytes() const {
   std::size_t bytes = 0;
   for (const auto& [name, w] : weights_) {
     if (w.packed.data.defined()) bytes += static_cast<std::size_t>(w.packed.data.numel()) * sizeof(float);
+    for (const PackedPanels& p : w.winograd) bytes += static_cast<std::size_t>(p.data.numel()) * sizeof(float);
   }
   return bytes;
 }

@@ -53,7 +53,7 @@ void linear(Queue& queue, const Tensor& input, const Tensor& weight, const Tenso
   const auto out_features = static_cast<std::size_t>(expected[1]);
   const auto in_features = static_cast<std::size_t>(weight.dim(1));
   const GemmBackend backend = gemm_backend(queue.device().info());
-  if (backend == GemmBackend::Packed && batch <= kGemvMaxBatch) {
+  if (uses_packed_kernels(backend) && batch <= kGemvMaxBatch) {
     // A few samples: one pass over W per sample, W read in place, bias and activation fused.
     detail::report_backend(queue, "gemv");
     for (std::size_t n = 0; n < batch; ++n) {
@@ -63,7 +63,7 @@ void linear(Queue& queue, const Tensor& input, const Tensor& weight, const Tenso
     }
     return;
   }
-  detail::report_backend(queue, to_string(backend));
+  detail::report_backend(queue, to_string(without_winograd(backend)));
   // Row i of A is sample i (contiguous within the sample, batch_stride apart), row i of C the
   // output sample (possibly a slice of wider rows); B = Wᵀ with W stored [out, in].
   gemm(queue, backend, Transpose::No, Transpose::Yes, batch, out_features, in_features, 1.0f,

@@ -3,8 +3,12 @@
 // with a direct convolution for layers of very few output channels and a GEMV for
 // one-sample fully connected layers).
 //
-// Without timing the choice is deterministic: $INERTIALNET_PLAN=clblast|packed forces one
-// backend everywhere (tests run every suite under both; `bench` compares them), otherwise CPU
+// `Winograd` is the packed backend with Winograd F(2×2, 3×3) for the 3×3 stride-1 convolutions
+// of at least 16 output and 32 input channels (src/ops/winograd.hpp); every other layer runs as
+// on `Packed`.
+//
+// Without timing the choice is deterministic: $INERTIALNET_PLAN=clblast|packed|winograd forces
+// one backend everywhere (tests run every suite under each; `bench` compares them), otherwise CPU
 // devices use the packed kernels and every other device CLBlast.
 //
 // $INERTIALNET_PLAN=auto opts in to timing: each GEMM layer of a model times every candidate of
@@ -22,15 +26,23 @@
 
 namespace inertialnet {
 
-enum class GemmBackend { CLBlast, Packed };
+enum class GemmBackend { CLBlast, Packed, Winograd };
 
-const char* to_string(GemmBackend backend);  // "clblast", "packed"
+const char* to_string(GemmBackend backend);  // "clblast", "packed", "winograd"
 // The backend a name denotes; nullopt for anything else.
 std::optional<GemmBackend> parse_gemm_backend(const std::string& name);
 
 // The backends a timed plan may choose from on `device`, the deterministic choice first (so a
 // tie keeps it). A new backend joins the plan by joining this list.
 std::vector<GemmBackend> gemm_candidates(const DeviceInfo& device);
+
+// Whether `backend` runs the project's packed kernels (Packed and Winograd).
+inline bool uses_packed_kernels(GemmBackend backend) { return backend != GemmBackend::CLBlast; }
+
+// The backend that runs a layer other than a Winograd convolution (what profiles report for it).
+inline GemmBackend without_winograd(GemmBackend backend) {
+  return backend == GemmBackend::Winograd ? GemmBackend::Packed : backend;
+}
 
 inline constexpr const char* kPlanEnvironmentVariable = "INERTIALNET_PLAN";
 

@@ -6,7 +6,8 @@
 // graph but shares one WeightSet, so the packed weights are kept per WeightSet (one cache per
 // device's weights), not per graph: pipeline lanes do not duplicate them. Layers with very few
 // output channels (predict_flow*) run a direct convolution and need no packing; fully connected
-// layers read their weights in place (GEMV).
+// layers read their weights in place (GEMV). On the winograd plan, the 3×3 stride-1 layers keep
+// their 16 Winograd-transformed weight matrices packed instead (src/ops/winograd.hpp).
 //
 // Under $INERTIALNET_PLAN=auto the backend of a layer comes from timing: the layer runs on its
 // real shape with the weights prepared for each candidate of gemm_candidates() (one warm-up,
@@ -21,6 +22,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include "inertialnet/ops/gemm_backend.hpp"
 #include "inertialnet/ops/gemm_packed.hpp"
@@ -30,20 +32,22 @@
 namespace inertialnet {
 
 // A layer's weights as its backend reads them. `packed` is defined only where the layer runs
-// the packed GEMM; everything else reads the original weight tensor.
+// the packed GEMM on im2col panels, `winograd` (16 matrices) only where it runs Winograd;
+// everything else reads the original weight tensor.
 struct GemmWeights {
   GemmBackend backend = GemmBackend::CLBlast;
   PackedPanels packed;
+  std::vector<PackedPanels> winograd;
 };
 
 // Convolutions with at most this many output channels run the direct kernel on the packed
 // backend (FlowNet's predict_flow*: 2).
 inline constexpr std::int64_t kDirectConvMaxChannels = 4;
 
-// Prepares conv2d weights [co, ci, kh, kw] / conv_transpose2d weights [ci, co, kh, kw] for
-// `backend`, packing on `queue` into long-lived storage of `device`. Wait for `queue` before
-// another queue uses the result.
-GemmWeights prepare_conv2d_weights(Queue& queue, const Tensor& weight, GemmBackend backend);
+// Prepares conv2d weights [co, ci, kh, kw] (of a layer of `stride`) / conv_transpose2d weights
+// [ci, co, kh, kw] for `backend`, packing on `queue` into long-lived storage of `device`. Wait
+// for `queue` before another queue uses the result.
+GemmWeights prepare_conv2d_weights(Queue& queue, const Tensor& weight, GemmBackend backend, int stride);
 GemmWeights prepare_conv_transpose2d_weights(Queue& queue, const Tensor& weight, GemmBackend backend);
 
 class GemmPlanCache;
@@ -67,7 +71,7 @@ class PreparedWeights {
   // Timed plans are cached in `plan_directory` (empty: the device's program-cache directory).
   explicit PreparedWeights(std::filesystem::path plan_directory = {});
   ~PreparedWeights();
-  const GemmWeights& conv2d(Queue& queue, const std::string& name, const Tensor& weight,
+  const GemmWeights& conv2d(Queue& queue, const std::string& name, const Tensor& weight, int stride,
                             const PlannedLayer* layer = nullptr);
   const GemmWeights& conv_transpose2d(Queue& queue, const std::string& name, const Tensor& weight,
                                       const PlannedLayer* layer = nullptr);
