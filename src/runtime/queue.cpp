@@ -60,11 +60,8 @@ Queue::~Queue() {
   if (queue_) clFinish(queue_.get());
 }
 
-Kernel& Queue::kernel(const std::string& family, const std::string& name, const KernelDefines& defines) {
-  return kernel(family, name, defines.str());
-}
-
-Kernel& Queue::kernel(const std::string& family, const std::string& name, const std::string& defines) {
+Kernel& Queue::kernel(const std::string& family, const std::string& name, const KernelDefines& kernel_defines) {
+  const std::string defines = kernel_defines.str();
   const std::string key = family + '\n' + name + '\n' + defines;
   auto found = kernels_.find(key);
   if (found != kernels_.end()) return *found->second;

@@ -125,7 +125,6 @@ class Queue {
   // The kernel `name` of the embedded family `family` built with `defines`; created once per
   // queue and reused.
   Kernel& kernel(const std::string& family, const std::string& name, const KernelDefines& defines = {});
-  Kernel& kernel(const std::string& family, const std::string& name, const std::string& defines);
 
   // Enqueues `kernel` over `global` work-items. With `local` given, global is rounded up to a
   // multiple of it (kernels guard their index against the true size). Returns the event when
