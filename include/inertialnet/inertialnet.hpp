@@ -70,6 +70,7 @@
 #include "inertialnet/eval/metrics.hpp"
 #include "inertialnet/eval/plots.hpp"
 #include "inertialnet/eval/spline.hpp"
+#include "inertialnet/eval/time_offset.hpp"
 
 // pipeline
 #include "inertialnet/pipeline/pipeline.hpp"

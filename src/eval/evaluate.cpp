@@ -44,16 +44,80 @@ EvalReport evaluate(const RatesTable& rates, const EurocSequence& seq, const Eva
   r.frames_in_sequence = seq.frames.size();
   r.imu_samples = seq.imu.size();
   r.warnings = seq.warnings;
-  const std::vector<Vec3> predicted = rates.rates(options.head_suffix);
+  std::vector<Vec3> predicted = rates.rates(options.head_suffix);
   r.head = "wx" + options.head_suffix + ",wy" + options.head_suffix + ",wz" + options.head_suffix;
+  SyncOptions sync = options.sync;
+  std::vector<std::string> notes;
 
-  const GyroTruth truth = sync_gyro(seq, options.sync);
+  const std::string estimator_key = "estimator" + options.head_suffix;
+  if (const auto estimator = rates.meta(estimator_key); options.choose_target && estimator) {
+    if (*estimator == "inter_frame") {
+      sync.target = SyncTarget::Mean;
+    } else if (*estimator == "network") {
+      sync.target = SyncTarget::Spline;
+    }
+    notes.push_back("Target " + to_string(sync.target) + " chosen for the estimator the rates file states (" +
+                    estimator_key + ": " + *estimator + "); --target overrides it.");
+  }
+
+  const bool compare_in_camera = sync.camera_frame;
+  const auto column_frame = rates.meta("frame" + options.head_suffix);
+  if (const auto frame = column_frame ? column_frame : rates.meta("frame")) {
+    if (*frame != "body" && *frame != "camera") {
+      throw invalid_input("The rates file states the frame \"" + *frame + "\"; expected body or camera.");
+    }
+    r.rates_frame = *frame;
+    if ((*frame == "camera") != compare_in_camera) {
+      const Mat3 r_cs = imu_to_camera_rotation(seq);
+      for (auto& w : predicted) w = compare_in_camera ? mul(r_cs, w) : mul_transposed(r_cs, w);
+      r.predictions_rotated = true;
+      notes.push_back(std::string("Predictions rotated from the ") + *frame + " frame (as the rates file states) into the " +
+                      (compare_in_camera ? "camera" : "body") + " frame with cam0's T_BS.");
+    }
+  } else {
+    notes.push_back(std::string("The rates file does not state its frame; its rates are taken to be in the ") +
+                    (compare_in_camera ? "camera" : "body (IMU)") + " frame of the comparison.");
+  }
+
+  const double offset = options.time_offset_s ? *options.time_offset_s : rates.meta_number("time_offset_s").value_or(0.0);
+  const double readout = options.readout_time_s ? *options.readout_time_s : rates.meta_number("readout_time_s").value_or(0.0);
+  if (!(readout >= 0) || readout > 1) {
+    throw invalid_input("The readout time should be between 0 and 1 s, found " + std::to_string(readout) + " s.");
+  }
+  sync.time_offset_s = offset + readout / 2;
+  if (readout > 0) {
+    notes.push_back("Rolling shutter: rates belong to mid-exposure, " + std::to_string(readout * 500) +
+                    " ms (half the readout time) after each frame stamp.");
+  }
+  if (options.estimate_time_offset) {
+    // Every row on a camera frame with a previous frame is a pair (t_{k-1}, t_k).
+    std::vector<std::int64_t> from, to;
+    std::vector<Vec3> imu_frame;
+    std::optional<Mat3> r_cs;
+    if (compare_in_camera) r_cs = imu_to_camera_rotation(seq);
+    std::size_t f = 0;
+    for (std::size_t i = 0; i < rates.size(); ++i) {
+      while (f < seq.frames.size() && seq.frames[f].t_ns < rates.t_ns[i]) ++f;
+      if (f == 0 || f >= seq.frames.size() || seq.frames[f].t_ns != rates.t_ns[i]) continue;
+      from.push_back(seq.frames[f - 1].t_ns);
+      to.push_back(seq.frames[f].t_ns);
+      imu_frame.push_back(r_cs ? mul_transposed(*r_cs, predicted[i]) : predicted[i]);
+    }
+    const TimeOffsetEstimate estimate = estimate_time_offset(from, to, imu_frame, seq.imu, options.time_offset_search);
+    sync.time_offset_s = estimate.offset_s;
+    r.time_offset_estimate = estimate;
+    notes.push_back("Estimated " + estimate.summary() + "; applied (it includes any readout shift).");
+  }
+  r.time_offset_s = sync.time_offset_s;
+
+  const GyroTruth truth = sync_gyro(seq, sync);
   r.target = truth.target;
   r.camera_frame = truth.camera_frame;
   r.bias_source = truth.bias_source;
   r.bias_imu_frame = truth.bias_imu_frame;
   r.imu_samples_in_span = truth.imu_samples_in_span;
-  r.notes = truth.notes;
+  r.notes = notes;
+  r.notes.insert(r.notes.end(), truth.notes.begin(), truth.notes.end());
   const std::vector<Vec3> corrected = truth.corrected();
 
   // Both lists are sorted by time: one merge pass matches rows to targets and, separately, to
@@ -140,7 +204,15 @@ std::string EvalReport::table() const {
   s += "  ground truth: gyro, target " + to_string(target) + ", " +
        (camera_frame ? "camera frame" : "IMU frame") + ", bias " + to_string(bias_source);
   if (bias_source != BiasSource::None) s += " " + fmt3(bias_imu_frame, "%.5f") + " rad/s (IMU frame)";
-  s += "\n\n";
+  s += "\n";
+  if (time_offset_s != 0 || time_offset_estimate) {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "  time offset applied: %+.3f ms (t_imu = t_cam + offset)%s\n", time_offset_s * 1e3,
+                  time_offset_estimate ? ", estimated" : "");
+    s += buf;
+    if (time_offset_estimate) s += "  " + time_offset_estimate->summary() + "\n";
+  }
+  s += "\n";
 
   std::vector<RmseRow> rows;
   rows.push_back({sequence, frames_in_sequence, imu_samples, frames_evaluated(), raw.rmse, "raw gyro"});
@@ -173,6 +245,15 @@ std::string EvalReport::json(bool include_series) const {
   j["rows_without_truth"] = rows_without_truth;
   j["target"] = to_string(target);
   j["frame"] = camera_frame ? "camera" : "imu";
+  j["rates_frame"] = rates_frame;
+  j["time_offset_s"] = time_offset_s;
+  if (time_offset_estimate) {
+    const auto& e = *time_offset_estimate;
+    j["time_offset_estimate"] = {{"offset_s", e.offset_s},       {"std_error_s", e.std_error_s},
+                                 {"contrast", e.contrast},       {"confidence", e.confidence()},
+                                 {"at_range_edge", e.at_range_edge}, {"pairs", e.pairs},
+                                 {"rmse_deg_s", e.rmse_deg_s},   {"rmse_at_zero_deg_s", e.rmse_at_zero_deg_s}};
+  }
   j["bias"] = {{"source", to_string(bias_source)}};
   if (bias_source != BiasSource::None) j["bias"]["imu_frame_rad_s"] = vec_json(bias_imu_frame);
   j["raw"] = stats_json(raw);

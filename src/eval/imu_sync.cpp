@@ -137,9 +137,23 @@ std::vector<Vec3> GyroTruth::corrected() const {
   return out;
 }
 
-GyroTruth sync_gyro(const std::vector<std::int64_t>& cam, const std::vector<ImuSample>& imu,
+GyroTruth sync_gyro(const std::vector<std::int64_t>& camera_t_ns, const std::vector<ImuSample>& imu,
                     const SyncOptions& options, const std::vector<GroundTruthSample>* ground_truth,
                     const Mat3* imu_to_camera) {
+  // Everything below works on the camera times moved onto the IMU's clock; the output keeps the
+  // camera's own stamps, which is what rates files carry.
+  if (!std::isfinite(options.time_offset_s) || std::abs(options.time_offset_s) > 3600) {
+    throw invalid_input("Synchronisation: the camera-IMU time offset should be finite and within an hour, found " +
+                        fmt("%g", options.time_offset_s) + " s.");
+  }
+  const std::int64_t shift_ns = std::llround(options.time_offset_s * 1e9);
+  std::vector<std::int64_t> cam(camera_t_ns.size());
+  for (std::size_t i = 0; i < cam.size(); ++i) {
+    if (__builtin_add_overflow(camera_t_ns[i], shift_ns, &cam[i])) {
+      throw invalid_input("Synchronisation: camera timestamp " + std::to_string(camera_t_ns[i]) +
+                          " shifted by the time offset leaves the int64 range.");
+    }
+  }
   if (cam.empty()) throw invalid_input("Synchronisation: there are no camera timestamps.");
   if (imu.size() < 2) {
     throw invalid_input("Synchronisation: the IMU has " + std::to_string(imu.size()) +
@@ -206,6 +220,10 @@ GyroTruth sync_gyro(const std::vector<std::int64_t>& cam, const std::vector<ImuS
   } else {
     out.notes.push_back("Target: natural cubic spline evaluated at each camera timestamp.");
   }
+  if (shift_ns != 0) {
+    out.notes.push_back("Camera times shifted by " + fmt("%+.3f", options.time_offset_s * 1e3) +
+                        " ms onto the IMU clock (t_imu = t_cam + offset) before synchronisation.");
+  }
   if (first > first_possible) {
     out.notes.push_back("The IMU starts " + fmt("%.3f", seconds(t0, cam.front())) +
                         " s after the first camera frame: " +
@@ -236,7 +254,7 @@ GyroTruth sync_gyro(const std::vector<std::int64_t>& cam, const std::vector<ImuS
   std::vector<std::int64_t> bias_time(n);
   for (std::size_t j = 0; j < n; ++j) {
     const std::size_t k = first + j;
-    out.t_ns[j] = cam[k];
+    out.t_ns[j] = camera_t_ns[k];
     out.frame_index[j] = k;
     if (mean) {
       const double a = seconds(cam[k - 1], t0), b = seconds(cam[k], t0);

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <set>
 
@@ -52,6 +53,24 @@ void RatesTable::validate() const {
   }
 }
 
+std::optional<std::string> RatesTable::meta(const std::string& key) const {
+  for (const auto& [k, v] : metadata) {
+    if (k == key) return v;
+  }
+  return std::nullopt;
+}
+
+std::optional<double> RatesTable::meta_number(const std::string& key) const {
+  const auto text = meta(key);
+  if (!text) return std::nullopt;
+  char* end = nullptr;
+  const double v = std::strtod(text->c_str(), &end);
+  if (text->empty() || *end != '\0' || !std::isfinite(v)) {
+    throw invalid_input("Rates file metadata " + key + ": \"" + *text + "\" is not a number.");
+  }
+  return v;
+}
+
 std::vector<double> RatesTable::column(const std::string& name) const {
   for (int k = 0; k < 3; ++k) {
     if (name == kAxes[k]) {
@@ -91,7 +110,17 @@ RatesTable read_rates_csv(const fs::path& path) {
     if (!have_header) {
       // A EuRoC-style "#timestamp_ns,..." header is a header, not a comment.
       if (csv::trim(line).rfind("#timestamp_ns", 0) == 0) line = std::string(csv::trim(line).substr(1));
-      if (csv::is_blank_or_comment(line)) continue;
+      if (csv::is_blank_or_comment(line)) {
+        // "# key: value" states metadata; any other comment is only a comment.
+        const std::string text(csv::trim(line));
+        const auto colon = text.find(':');
+        if (text.size() > 1 && text[0] == '#' && colon != std::string::npos) {
+          const std::string key(csv::trim(std::string_view(text).substr(1, colon - 1)));
+          const std::string value(csv::trim(std::string_view(text).substr(colon + 1)));
+          if (!key.empty() && key.find_first_of(" \t") == std::string::npos) table.metadata.emplace_back(key, value);
+        }
+        continue;
+      }
       const auto fields = csv::split(line);
       n_fields = fields.size();
       if (fields[0] != "timestamp_ns") {
@@ -159,15 +188,29 @@ struct RatesCsvWriter::Stream {
   std::ofstream file;
 };
 
-RatesCsvWriter::RatesCsvWriter(const fs::path& path, const std::vector<std::string>& extra_names)
+std::string rates_csv_header(const std::vector<std::string>& extra_names,
+                             const std::vector<std::pair<std::string, std::string>>& metadata) {
+  std::string s;
+  for (const auto& [key, value] : metadata) {
+    if (key.empty() || key.find_first_of(" \t:\n\r") != std::string::npos || value.find_first_of("\n\r") != std::string::npos) {
+      throw invalid_input("Rates file metadata \"" + key + "\": keys are single words, values single lines.");
+    }
+    s += "# " + key + ": " + value + "\n";
+  }
+  s += "timestamp_ns,wx,wy,wz";
+  for (const auto& name : extra_names) s += "," + name;
+  return s + "\n";
+}
+
+RatesCsvWriter::RatesCsvWriter(const fs::path& path, const std::vector<std::string>& extra_names,
+                               const std::vector<std::pair<std::string, std::string>>& metadata)
     : path_(path), extra_count_(extra_names.size()), out_(std::make_unique<Stream>()) {
+  const std::string header = rates_csv_header(extra_names, metadata);
   out_->file.open(path, std::ios::binary | std::ios::trunc);
   if (!out_->file) {
     throw invalid_input("Cannot open " + path.string() + " for writing.");
   }
-  out_->file << "timestamp_ns,wx,wy,wz";
-  for (const auto& name : extra_names) out_->file << ',' << name;
-  out_->file << '\n' << std::flush;
+  out_->file << header << std::flush;
 }
 
 RatesCsvWriter::~RatesCsvWriter() = default;
@@ -206,7 +249,7 @@ void RatesCsvWriter::write(std::int64_t t_ns, const Vec3& w, const std::vector<d
 
 void write_rates_csv(const fs::path& path, const RatesTable& table) {
   table.validate();
-  RatesCsvWriter writer(path, table.extra_names);
+  RatesCsvWriter writer(path, table.extra_names, table.metadata);
   std::vector<double> extra(table.extra.size());
   for (std::size_t i = 0; i < table.size(); ++i) {
     for (std::size_t c = 0; c < extra.size(); ++c) extra[c] = table.extra[c][i];

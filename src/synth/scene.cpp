@@ -71,8 +71,10 @@ std::vector<Plane> build_scene(const SynthOptions& o, const SynthTrajectory& tra
   Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
   // The footprint moves at most ≈5·f·|ω| + translation texels per second; sampling at 200 Hz
   // and a margin of a tenth of the frame keeps every frame inside (render() checks it).
-  const long samples = static_cast<long>(std::ceil(synth_horizon_s(o) * 200));
-  for (long i = 0; i <= samples; ++i) {
+  // A camera-IMU time offset shows the scene up to |offset| before or after the horizon.
+  const long first = static_cast<long>(std::floor(std::min(0.0, o.time_offset_s) * 200));
+  const long samples = static_cast<long>(std::ceil((synth_horizon_s(o) + std::max(0.0, o.time_offset_s)) * 200));
+  for (long i = first; i <= samples; ++i) {
     const double t = static_cast<double>(i) / 200;
     extend_footprint(wall, cam, to_eigen(traj.rotation(t)), to_eigen(traj.position(t)), lo, hi);
   }

@@ -53,6 +53,10 @@ void SynthOptions::validate() const {
                         "than a quarter of the frame rate); the most is " + std::to_string(limit) +
                         " deg/s.");
   }
+  if (!(std::isfinite(o.time_offset_s) && std::abs(o.time_offset_s) <= 0.5)) {
+    throw invalid_input("synth: the camera-IMU time offset should be within +-0.5 s, found " +
+                        std::to_string(o.time_offset_s) + " s.");
+  }
   if (o.motion != SynthOptions::Rotation && o.motion != SynthOptions::General) {
     throw invalid_input("synth: unknown motion kind " + std::to_string(static_cast<int>(o.motion)) + ".");
   }

@@ -158,11 +158,12 @@ SynthReport write_synthetic_sequence(const fs::path& out_dir, const SynthOptions
     write_text(imu_dir / "sensor.yaml", imu_yaml(o));
     write_text(cam_dir / "sensor.yaml", camera_yaml(o, report.intrinsics));
 
-    // Rates the images encode.
+    // Rates the images encode: a frame stamped t shows the scene at t + offset.
+    const auto shown = [&](std::int64_t tn) { return rel(tn) + o.time_offset_s; };
     for (int k = 0; k < o.frames; ++k) {
-      const double t = rel(report.camera_t_ns[static_cast<std::size_t>(k)]);
+      const double t = shown(report.camera_t_ns[static_cast<std::size_t>(k)]);
       report.camera_rates.push_back(traj.camera_rate(t));
-      if (k > 0) report.interval_rates.push_back(traj.mean_camera_rate(rel(report.camera_t_ns[static_cast<std::size_t>(k) - 1]), t));
+      if (k > 0) report.interval_rates.push_back(traj.mean_camera_rate(shown(report.camera_t_ns[static_cast<std::size_t>(k) - 1]), t));
     }
 
     // Frames.
@@ -176,7 +177,7 @@ SynthReport write_synthetic_sequence(const fs::path& out_dir, const SynthOptions
     std::string listing = "#timestamp [ns],filename\n";
     const std::vector<int> png{cv::IMWRITE_PNG_COMPRESSION, 3};
     for (std::int64_t tn : report.camera_t_ns) {
-      const double t = rel(tn);
+      const double t = shown(tn);
       const cv::Mat frame = render(scene, cam, to_eigen(traj.rotation(t)), to_eigen(traj.position(t)), tn);
       const std::string name = std::to_string(tn) + ".png";
       bool ok = false;

@@ -139,3 +139,29 @@ TEST(RatesCsv, WriterRefusesBadTables) {
   EXPECT_TRUE(contains(invalid_input_message([&] { write_rates_csv(dir.path() / "no" / "dir.csv", RatesTable{}); }),
                        "Cannot open"));
 }
+
+// "# key: value" lines before the header state what the columns are; other comments stay comments,
+// and files without them (written before they existed) read as before.
+TEST(RatesCsv, MetadataRoundTripAndOldFiles) {
+  te::TempDir dir("rates_meta");
+  RatesTable t;
+  t.t_ns = {10, 20};
+  t.w = {{0.1, 0.2, 0.3}, {0.4, 0.5, 0.6}};
+  t.metadata = {{"frame", "body"}, {"estimator", "inter_frame"}, {"time_offset_s", "0.04"}};
+  const auto path = dir.path() / "meta.csv";
+  write_rates_csv(path, t);
+  const RatesTable back = read_rates_csv(path);
+  EXPECT_EQ(back.metadata, t.metadata);
+  EXPECT_EQ(back.meta("frame").value_or(""), "body");
+  EXPECT_FALSE(back.meta("readout_time_s").has_value());
+  EXPECT_NEAR(back.meta_number("time_offset_s").value_or(0), 0.04, 1e-15);
+  EXPECT_EQ(rates_csv_header({"wx_g"}, {{"frame", "camera"}}), "# frame: camera\ntimestamp_ns,wx,wy,wz,wx_g\n");
+  EXPECT_THROW(rates_csv_header({}, {{"two words", "x"}}), Error);
+
+  const auto old = write_text(dir, "# written by an older predict\ntimestamp_ns,wx,wy,wz\n5,1,2,3\n");
+  const RatesTable o = read_rates_csv(old);
+  EXPECT_TRUE(o.metadata.empty());
+  EXPECT_EQ(o.size(), 1u);
+  const auto bad = write_text(dir, "# time_offset_s: soon\ntimestamp_ns,wx,wy,wz\n5,1,2,3\n");
+  EXPECT_THROW(read_rates_csv(bad).meta_number("time_offset_s"), Error);
+}

@@ -12,7 +12,8 @@ namespace inertialnet::cli {
 
 namespace {
 struct EvalCliOptions {
-  std::string rates, sequence, plot, target = "spline", gyro_bias, head;
+  std::string rates, sequence, plot, target, gyro_bias, head, time_offset, readout_time;
+  double offset_range = 0.2;
   bool json = false, series = false, camera_frame = false;
 };
 }  // namespace
@@ -22,8 +23,16 @@ Command register_eval(CLI::App& app, const GlobalOptions&) {
   app.add_option("rates", o->rates, "rates CSV written by predict")->required()->check(CLI::ExistingFile);
   app.add_option("sequence", o->sequence, "EuRoC sequence with mav0/imu0")->required()->check(CLI::ExistingDirectory);
   app.add_option("--plot", o->plot, "write time-series plots to this PNG (and histograms beside it, *_hist.png)");
-  app.add_option("--target", o->target, "ground truth at each frame: spline (the paper) or mean (interval mean)")
+  app.add_option("--target", o->target,
+                 "ground truth at each frame: spline (the paper) or mean (interval mean); default: the one that fits "
+                 "the estimator the rates file states (mean for an inter-frame rotation), else spline");
+  app.add_option("--time-offset", o->time_offset,
+                 "camera-IMU time offset in seconds (t_imu = t_cam + offset), or auto to estimate it from the data; "
+                 "default: what the rates file states, else 0");
+  app.add_option("--time-offset-range", o->offset_range, "with --time-offset auto: search +-this many seconds")
       ->capture_default_str();
+  app.add_option("--readout-time", o->readout_time,
+                 "rolling-shutter readout time in seconds (rates belong to mid-exposure); default: the rates file's");
   app.add_option("--gyro-bias", o->gyro_bias, "gyro bias x,y,z in rad/s (IMU frame); default: ground truth or static start");
   app.add_flag("--camera-frame", o->camera_frame, "rotate the gyro into the camera frame with cam0's T_BS");
   app.add_option("--head", o->head, "compare columns wx<_HEAD>…, e.g. --head geometric");
@@ -31,7 +40,15 @@ Command register_eval(CLI::App& app, const GlobalOptions&) {
   app.add_flag("--series", o->series, "with --json: include the per-frame values");
   return [o]() {
     EvalOptions options;
-    options.sync.target = parse_sync_target(o->target);
+    options.choose_target = o->target.empty();
+    options.sync.target = parse_sync_target(o->target.empty() ? "spline" : o->target);
+    if (o->time_offset == "auto") {
+      options.estimate_time_offset = true;
+      options.time_offset_search.range_s = o->offset_range;
+    } else if (!o->time_offset.empty()) {
+      options.time_offset_s = parse_seconds(o->time_offset, "--time-offset");
+    }
+    if (!o->readout_time.empty()) options.readout_time_s = parse_seconds(o->readout_time, "--readout-time");
     options.sync.camera_frame = o->camera_frame;
     if (!o->gyro_bias.empty()) {
       options.sync.bias = BiasSource::Given;
@@ -58,6 +75,10 @@ Command register_eval(CLI::App& app, const GlobalOptions&) {
         options.plot = plot.parent_path() / (plot.stem().string() + suffixes[i] + plot.extension().string());
       }
       const EvalReport report = evaluate(o->rates, o->sequence, options);
+      if (!o->json) {
+        std::cerr << "inertialnet: target " << to_string(report.target)
+                  << (o->target.empty() ? " (chosen for the estimator; --target spline|mean to change it)" : "") << "\n";
+      }
       if (o->json) {
         json += report.json(o->series) + (i + 1 < suffixes.size() ? ",\n" : "");
       } else {

@@ -17,6 +17,7 @@
 #include "inertialnet/pipeline/pipeline.hpp"
 #include "inertialnet/pipeline/rates_processor.hpp"
 #include "inertialnet/io/rates_csv.hpp"
+#include "inertialnet/eval/time_offset.hpp"
 #include "profile.hpp"
 #include "progress.hpp"
 
@@ -38,6 +39,7 @@ struct PredictOptions {
   std::string output;
   std::string save_flow;
   double rate_hz = 0;
+  std::string time_offset, readout_time;
   int lanes = 2;
   int decode_threads = 2;
   std::size_t max_pairs = 0;
@@ -96,6 +98,10 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
   app.add_option("--save-flow", o->save_flow, "write each pair's flow as <timestamp>.flo into this folder");
   app.add_option("--rate", o->rate_hz, "frame rate for image folders and videos without timestamps (Hz)")
       ->check(finite_positive);
+  app.add_option("--time-offset", o->time_offset,
+                 "camera-IMU time offset in seconds (t_imu = t_cam + offset), stated in the CSV for eval");
+  app.add_option("--readout-time", o->readout_time,
+                 "rolling-shutter readout time in seconds (rates belong to mid-exposure), stated in the CSV for eval");
   app.add_option("--lanes", o->lanes, "frame pairs in flight per device")->capture_default_str()->check(CLI::Range(1, 16));
   app.add_option("--decode-threads", o->decode_threads, "image decoding threads")->capture_default_str()->check(CLI::Range(1, 64));
   app.add_option("--max-pairs", o->max_pairs, "stop after this many pairs")
@@ -213,13 +219,33 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
     // Columns: the first estimator is wx,wy,wz; a second one adds wx_<name>,wy_<name>,wz_<name>.
     std::vector<std::string> extra;
     if (processor.inertialnet_head && processor.geometric_head) extra = {"wx_geometric", "wy_geometric", "wz_geometric"};
-    std::unique_ptr<RatesCsvWriter> file_writer;
-    if (!o->output.empty()) file_writer = std::make_unique<RatesCsvWriter>(o->output, extra);
-    if (!file_writer) {
-      std::cout << "timestamp_ns,wx,wy,wz";
-      for (const auto& e : extra) std::cout << "," << e;
-      std::cout << "\n";
+    // What the columns are, stated in the file (docs/data_conventions.md, "Rates CSV").
+    std::vector<std::pair<std::string, std::string>> metadata;
+    const auto format_number = [](double v) {
+      char buf[32];
+      std::snprintf(buf, sizeof buf, "%.9g", v);
+      return std::string(buf);
+    };
+    const char* geometric_frame = processor.camera_to_body ? "body" : "camera";
+    if (processor.inertialnet_head) {
+      // InertialNet is trained against the gyro, so it answers in the body (IMU) frame.
+      metadata = {{"frame", "body"}, {"estimator", "network"}};
+      if (processor.geometric_head) {
+        metadata.push_back({"frame_geometric", geometric_frame});
+        metadata.push_back({"estimator_geometric", "inter_frame"});
+      }
+    } else {
+      metadata = {{"frame", geometric_frame}, {"estimator", "inter_frame"}};
     }
+    if (!o->time_offset.empty()) {
+      metadata.push_back({"time_offset_s", format_number(parse_seconds(o->time_offset, "--time-offset"))});
+    }
+    if (!o->readout_time.empty()) {
+      metadata.push_back({"readout_time_s", format_number(parse_seconds(o->readout_time, "--readout-time"))});
+    }
+    std::unique_ptr<RatesCsvWriter> file_writer;
+    if (!o->output.empty()) file_writer = std::make_unique<RatesCsvWriter>(o->output, extra, metadata);
+    if (!file_writer) std::cout << rates_csv_header(extra, metadata);
 
     Progress progress("predict", pairs);
     std::size_t done = 0;

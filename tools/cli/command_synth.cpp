@@ -15,7 +15,7 @@ struct SynthCliOptions {
   std::string out, motion = "rotation", size = "752x480";
   int frames = 40;
   std::uint64_t seed = 1;
-  double max_rate = 60;
+  double max_rate = 60, time_offset = 0;
   bool no_noise = false, overwrite = false;
 };
 }  // namespace
@@ -29,6 +29,9 @@ Command register_synth(CLI::App& app, const GlobalOptions&) {
   app.add_option("--seed", o->seed, "seed of the motion, texture and noise")->capture_default_str();
   app.add_option("--size", o->size, "image size WxH")->capture_default_str();
   app.add_option("--max-rate", o->max_rate, "peak angular rate per axis, deg/s")->capture_default_str();
+  app.add_option("--time-offset", o->time_offset,
+                 "camera-IMU time offset in seconds (t_imu = t_cam + offset): frames show the scene this much later")
+      ->capture_default_str();
   app.add_flag("--no-noise", o->no_noise, "exact IMU: no white noise, no bias");
   app.add_flag("--overwrite", o->overwrite, "replace an existing sequence in OUT_DIR");
   return [o]() {
@@ -41,6 +44,7 @@ Command register_synth(CLI::App& app, const GlobalOptions&) {
     options.height = static_cast<int>(height);
     options.max_rate_deg_s = o->max_rate;
     options.noise = !o->no_noise;
+    options.time_offset_s = o->time_offset;
     options.overwrite = o->overwrite;
     const SynthReport report = write_synthetic_sequence(o->out, options);
     std::printf("wrote %s: %d frames %dx%d (%s motion, %.2f s), %d IMU samples\n", report.mav0.string().c_str(),

@@ -4,6 +4,18 @@
 // the pair's second frame t_k) and compared with the gyro synchronised onto that frame
 // (imu_sync.hpp). Metrics are reported against the raw gyro and, when a bias is known, against
 // gyro − bias; the RMS(t) series, histograms and plots use gyro − bias when there is one.
+//
+// What the rates file states (rates_csv.hpp's metadata) is used:
+//   frame      — predictions in the body frame are rotated into the camera frame for a
+//                camera-frame comparison, and camera-frame predictions into the body frame for
+//                a body-frame one; a file that does not say is taken to be in the comparison's
+//                frame (what older files meant), and a note says so;
+//   estimator  — with `choose_target`, an inter-frame estimator is compared with the gyro's mean
+//                over the frame interval and a network with the spline at t_k;
+//   time_offset_s, readout_time_s — the camera–IMU offset plus half the readout time shift the
+//                targets onto the IMU clock (time_offset.hpp), unless the options override them.
+// With `estimate_time_offset` the offset is estimated from the data first (time_offset.hpp) and
+// then applied; the estimate is reported.
 #pragma once
 
 #include <array>
@@ -18,6 +30,7 @@
 #include "inertialnet/eval/imu_sync.hpp"
 #include "inertialnet/eval/metrics.hpp"
 #include "inertialnet/eval/plots.hpp"
+#include "inertialnet/eval/time_offset.hpp"
 #include "inertialnet/io/rates_csv.hpp"
 
 namespace inertialnet {
@@ -30,6 +43,14 @@ struct EvalOptions {
   // added to the stem (out.png → out_hist.png).
   std::filesystem::path plot;
   PlotStyle style;
+  // Pick the target from the file's estimator metadata (sync.target when it states none).
+  bool choose_target = false;
+  // Override the file's time_offset_s / readout_time_s (seconds). sync.time_offset_s is ignored:
+  // the offset applied is time_offset + readout / 2.
+  std::optional<double> time_offset_s;
+  std::optional<double> readout_time_s;
+  bool estimate_time_offset = false;
+  TimeOffsetOptions time_offset_search;
 };
 
 struct EvalReport {
@@ -47,6 +68,10 @@ struct EvalReport {
   bool camera_frame = false;
   BiasSource bias_source = BiasSource::None;
   Vec3 bias_imu_frame{};             // rad/s
+  std::string rates_frame = "unstated";  // what the file says: "body", "camera" or "unstated"
+  bool predictions_rotated = false;  // rotated from the file's frame into the comparison's
+  double time_offset_s = 0;          // shift applied: t_imu = t_cam + this (offset + readout / 2)
+  std::optional<TimeOffsetEstimate> time_offset_estimate;  // with estimate_time_offset
 
   // Matched frames, in time order.
   std::vector<std::int64_t> t_ns;

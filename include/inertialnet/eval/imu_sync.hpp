@@ -7,6 +7,7 @@
 //   spline — the spline's value at each camera time t_k (what the paper does);
 //   mean   — the spline's exact mean over [t_{k−1}, t_k], since the rotation between two frames
 //            is an average of the rate over that interval; frame 0 has no target.
+// With a time offset the targets are taken on the shifted times (see SyncOptions).
 // Frames whose target needs IMU data outside the IMU's time span are dropped (the spline never
 // extrapolates) and counted; `notes` says why, one sentence per cause.
 //
@@ -59,6 +60,10 @@ struct SyncOptions {
   BiasSource bias = BiasSource::Automatic;
   Vec3 gyro_bias{};               // with BiasSource::Given: IMU frame, rad/s
   StaticStartRule static_start;
+  // Camera–IMU time offset (time_offset.hpp's convention t_imu = t_cam + offset): targets are
+  // taken at the camera times plus this shift; the output keeps the camera's own timestamps.
+  // A rolling shutter's mid-exposure shift (readout / 2) is added here too.
+  double time_offset_s = 0;
 };
 
 struct GyroTruth {

@@ -25,6 +25,10 @@ struct SynthOptions {
   // White gyro/accel noise with EuRoC's noise densities and a constant seeded bias (a few
   // hundredths of rad/s on the gyro); off: the IMU holds the exact rates and specific force.
   bool noise = true;
+  // Camera–IMU time offset (t_imu = t_cam + offset, eval/time_offset.hpp): the frame stamped t
+  // shows the scene at t + offset on the IMU's clock, as with a camera whose stamps run early.
+  // |offset| ≤ 0.5 s.
+  double time_offset_s = 0;
   // An existing, non-empty output folder is an error unless this is set; then only its mav0/
   // folder is replaced, whatever else it holds is left alone.
   bool overwrite = false;

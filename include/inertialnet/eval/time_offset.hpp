@@ -1,0 +1,64 @@
+// The camera–IMU time offset, estimated from the data: the shift of the camera timestamps that
+// best aligns predicted angular rates with the gyro.
+//
+// Convention (Kalibr's): t_imu = t_cam + offset. A frame stamped t_cam on the camera's clock was
+// taken at t_cam + offset on the IMU's clock, so a positive offset means the camera's stamps run
+// early. eval applies an offset by comparing frame pair (t_{k−1}, t_k) with the gyro over
+// [t_{k−1} + offset, t_k + offset].
+//
+// Estimation: for every candidate offset τ on a grid over [−range, range] the gyro's interval mean
+// over each shifted frame interval (a natural cubic spline, as in imu_sync.hpp) is compared with
+// the predictions; the cost is the sum of squared residuals after removing their per-axis mean,
+// so that a constant gyro bias (which images cannot see) does not pull the estimate. Only frame
+// pairs whose shifted interval stays inside the IMU's span for every τ take part, so every
+// candidate is judged on the same pairs. The grid minimum is refined to a fraction of the step by
+// a parabola through it and its two neighbours.
+//
+// Confidence: treating the residuals as Gaussian with the variance left at the minimum (σ² =
+// cost_min / (3N − 3)), the cost's curvature c at the minimum gives the offset's standard error
+// sqrt(2σ² / c). `contrast` is cost_min over the median cost of the grid: near 0 for a sharp,
+// well-defined minimum, near 1 for a flat curve (a still camera carries no timing information).
+// An estimate at the edge of the range is flagged.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "inertialnet/core/vec3.hpp"
+#include "inertialnet/io/euroc.hpp"
+
+namespace inertialnet {
+
+struct TimeOffsetOptions {
+  double range_s = 0.2;    // candidates over [−range_s, range_s]
+  double step_s = 0.001;   // grid step before the parabolic refinement
+};
+
+struct TimeOffsetEstimate {
+  double offset_s = 0;         // t_imu = t_cam + offset_s
+  double std_error_s = 0;      // 1σ, from the cost's curvature (infinite when the curve is flat)
+  double contrast = 1;         // cost at the minimum / median cost over the grid (smaller: sharper)
+  bool at_range_edge = false;  // the minimum lies on the search range's edge: widen the range
+  std::size_t pairs = 0;       // frame pairs used
+  double rmse_deg_s = 0;       // per-axis-mean-removed RMS residual at the estimate (over 3 axes)
+  double rmse_at_zero_deg_s = 0;  // the same with no offset
+  std::string summary() const; // one line for reports
+  // A rough verdict: "high" (σ < 2 ms and contrast < 0.5), "low" (flat or at the edge), else "medium".
+  std::string confidence() const;
+};
+
+// `pairs_from[i]`, `pairs_to[i]`: frame pair i's times on the camera clock (t_{k−1}, t_k);
+// `predicted[i]`: its predicted rate, in the IMU frame (rad/s); `imu`: the gyro. Throws
+// invalid_input when the sizes differ, the options are not positive, or fewer than 3 pairs lie
+// inside the IMU's span over the whole search range.
+TimeOffsetEstimate estimate_time_offset(const std::vector<std::int64_t>& pairs_from,
+                                        const std::vector<std::int64_t>& pairs_to,
+                                        const std::vector<Vec3>& predicted, const std::vector<ImuSample>& imu,
+                                        const TimeOffsetOptions& options = {});
+
+// "0.04" (seconds) → 0.04; "40ms", "-12.5 ms" also accepted; throws invalid_input naming `what`.
+double parse_seconds(const std::string& text, const std::string& what);
+
+}  // namespace inertialnet

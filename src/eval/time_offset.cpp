@@ -1,0 +1,153 @@
+#include "inertialnet/eval/time_offset.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+
+#include "inertialnet/eval/metrics.hpp"
+#include "inertialnet/eval/spline.hpp"
+#include "inertialnet/runtime/error.hpp"
+
+namespace inertialnet {
+
+namespace {
+
+// Sum over axes of the squared residuals after removing each axis's mean (a constant bias).
+double centred_cost(const std::vector<Vec3>& predicted, const std::vector<Vec3>& truth) {
+  Vec3 mean{};
+  const double n = static_cast<double>(predicted.size());
+  for (std::size_t i = 0; i < predicted.size(); ++i) {
+    for (int k = 0; k < 3; ++k) mean[k] += (predicted[i][k] - truth[i][k]) / n;
+  }
+  double cost = 0;
+  for (std::size_t i = 0; i < predicted.size(); ++i) {
+    for (int k = 0; k < 3; ++k) {
+      const double r = predicted[i][k] - truth[i][k] - mean[k];
+      cost += r * r;
+    }
+  }
+  return cost;
+}
+
+}  // namespace
+
+std::string TimeOffsetEstimate::confidence() const {
+  if (at_range_edge || !std::isfinite(std_error_s) || contrast > 0.9) return "low";
+  if (std_error_s < 0.002 && contrast < 0.5) return "high";
+  return "medium";
+}
+
+std::string TimeOffsetEstimate::summary() const {
+  char buf[320];
+  std::snprintf(buf, sizeof buf,
+                "camera-IMU time offset %+.2f ms (t_imu = t_cam + offset) +- %.2f ms (1 sigma), confidence %s "
+                "(cost contrast %.3f, %zu frame pairs; residual %.3f deg/s, %.3f deg/s without the offset)%s",
+                offset_s * 1e3, std_error_s * 1e3, confidence().c_str(), contrast, pairs, rmse_deg_s,
+                rmse_at_zero_deg_s, at_range_edge ? "; the minimum lies at the edge of the search range" : "");
+  return buf;
+}
+
+TimeOffsetEstimate estimate_time_offset(const std::vector<std::int64_t>& from, const std::vector<std::int64_t>& to,
+                                        const std::vector<Vec3>& predicted, const std::vector<ImuSample>& imu,
+                                        const TimeOffsetOptions& options) {
+  if (from.size() != to.size() || from.size() != predicted.size()) {
+    throw invalid_input("Time offset: " + std::to_string(from.size()) + " pair starts, " + std::to_string(to.size()) +
+                        " pair ends and " + std::to_string(predicted.size()) + " predictions should agree.");
+  }
+  if (!(options.range_s > 0) || !(options.step_s > 0) || !std::isfinite(options.range_s) ||
+      options.step_s > options.range_s) {
+    throw invalid_input("Time offset: the search range and step should be positive, with the step below the range.");
+  }
+  if (imu.size() < 2) throw invalid_input("Time offset: the IMU has fewer than 2 samples.");
+
+  // Splines in seconds since the first IMU sample (as imu_sync does, for precision).
+  const std::int64_t t0 = imu.front().t_ns;
+  std::vector<double> x(imu.size()), y[3];
+  for (auto& a : y) a.resize(imu.size());
+  for (std::size_t i = 0; i < imu.size(); ++i) {
+    x[i] = static_cast<double>(imu[i].t_ns - t0) * 1e-9;
+    for (int k = 0; k < 3; ++k) y[k][i] = imu[i].gyro[k];
+  }
+  const CubicSpline spline[3] = {CubicSpline(x, y[0]), CubicSpline(x, y[1]), CubicSpline(x, y[2])};
+
+  // Pairs whose interval stays inside the IMU's span for every candidate.
+  std::vector<double> a, b;
+  std::vector<Vec3> pred;
+  for (std::size_t i = 0; i < from.size(); ++i) {
+    const double s = static_cast<double>(from[i] - t0) * 1e-9, e = static_cast<double>(to[i] - t0) * 1e-9;
+    if (!(e > s)) continue;
+    if (s - options.range_s < x.front() || e + options.range_s > x.back()) continue;
+    a.push_back(s);
+    b.push_back(e);
+    pred.push_back(predicted[i]);
+  }
+  if (pred.size() < 3) {
+    throw invalid_input("Time offset: only " + std::to_string(pred.size()) +
+                        " frame pairs lie inside the IMU's span over the whole search range of +-" +
+                        std::to_string(options.range_s) + " s; at least 3 are needed (narrow the range?).");
+  }
+  std::vector<Vec3> truth(pred.size());
+  const auto cost_at = [&](double tau) {
+    for (std::size_t i = 0; i < pred.size(); ++i) {
+      for (int k = 0; k < 3; ++k) truth[i][k] = spline[k].mean(a[i] + tau, b[i] + tau);
+    }
+    return centred_cost(pred, truth);
+  };
+
+  const long steps = std::lround(options.range_s / options.step_s);
+  const double step = options.range_s / static_cast<double>(steps);
+  std::vector<double> cost(static_cast<std::size_t>(2 * steps + 1));
+  std::size_t best = 0;
+  for (long j = -steps; j <= steps; ++j) {
+    const auto idx = static_cast<std::size_t>(j + steps);
+    cost[idx] = cost_at(static_cast<double>(j) * step);
+    if (cost[idx] < cost[best]) best = idx;
+  }
+
+  TimeOffsetEstimate e;
+  e.pairs = pred.size();
+  double tau = (static_cast<double>(best) - static_cast<double>(steps)) * step;
+  double curvature = 0;  // d²cost/dτ²
+  e.at_range_edge = best == 0 || best + 1 == cost.size();
+  if (!e.at_range_edge) {
+    const double cm = cost[best - 1], c0 = cost[best], cp = cost[best + 1];
+    curvature = (cm - 2 * c0 + cp) / (step * step);
+    if (curvature > 0) tau += std::clamp(0.5 * step * (cm - cp) / (cm - 2 * c0 + cp), -step, step);
+  }
+  e.offset_s = tau;
+  const double cost_min = std::min(cost_at(tau), cost[best]);
+  const double dof = std::max(1.0, 3.0 * static_cast<double>(pred.size()) - 3.0);
+  const double sigma2 = cost_min / dof;
+  e.std_error_s = curvature > 0 ? std::sqrt(2 * sigma2 / curvature) : std::numeric_limits<double>::infinity();
+  std::vector<double> sorted = cost;
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(sorted.size() / 2), sorted.end());
+  const double median = sorted[sorted.size() / 2];
+  e.contrast = median > 0 ? cost_min / median : 1.0;
+  const double n3 = 3.0 * static_cast<double>(pred.size());
+  e.rmse_deg_s = std::sqrt(cost_min / n3) * kDegreesPerRadian;
+  e.rmse_at_zero_deg_s = std::sqrt(cost[static_cast<std::size_t>(steps)] / n3) * kDegreesPerRadian;
+  return e;
+}
+
+double parse_seconds(const std::string& text, const std::string& what) {
+  std::string t = text;
+  t.erase(std::remove_if(t.begin(), t.end(), [](unsigned char c) { return std::isspace(c); }), t.end());
+  double scale = 1;
+  if (t.size() > 2 && t.compare(t.size() - 2, 2, "ms") == 0) {
+    scale = 1e-3;
+    t.resize(t.size() - 2);
+  } else if (t.size() > 1 && t.back() == 's') {
+    t.pop_back();
+  }
+  char* end = nullptr;
+  const double v = std::strtod(t.c_str(), &end);
+  if (t.empty() || *end != '\0' || !std::isfinite(v)) {
+    throw invalid_input(what + " should be a number of seconds (e.g. 0.04 or 40ms), found \"" + text + "\".");
+  }
+  return v * scale;
+}
+
+}  // namespace inertialnet
