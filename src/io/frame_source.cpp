@@ -1,6 +1,7 @@
 #include "inertialnet/io/frame_source.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <opencv2/videoio.hpp>
 
 #include "inertialnet/runtime/error.hpp"
@@ -13,57 +14,108 @@ namespace {
 constexpr double kDefaultRateHz = 20.0;  // EuRoC's camera rate
 
 // Listed frames on disk (EuRoC or an image folder): random access, decoded on any thread.
+std::string format_rate(double hz) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", hz);
+  return buf;
+}
+
 class ListedFrames : public FrameSource {
  public:
-  ListedFrames(std::vector<CameraFrame> frames, std::optional<CameraCalibration> calibration, std::string description)
-      : frames_(std::move(frames)), calibration_(std::move(calibration)), description_(std::move(description)) {}
+  ListedFrames(std::vector<CameraFrame> frames, std::optional<CameraCalibration> calibration, std::string description,
+               std::vector<std::string> notes = {})
+      : frames_(std::move(frames)),
+        calibration_(std::move(calibration)),
+        description_(std::move(description)),
+        notes_(std::move(notes)) {}
   std::size_t size() const override { return frames_.size(); }
   std::int64_t timestamp_ns(std::size_t i) const override { return frames_.at(i).t_ns; }
   HostImage decode(std::size_t i) override { return load_rgb_image(frames_.at(i).path); }
   std::optional<CameraCalibration> calibration() const override { return calibration_; }
   std::string description() const override { return description_; }
+  std::vector<std::string> notes() const override { return notes_; }
 
  private:
   std::vector<CameraFrame> frames_;
   std::optional<CameraCalibration> calibration_;
   std::string description_;
+  std::vector<std::string> notes_;
 };
 
 class VideoFrames : public FrameSource {
  public:
   VideoFrames(const std::filesystem::path& path, std::optional<double> rate_hz) : path_(path) {
-    if (!capture_.open(path.string()) || !capture_.isOpened()) {
-      throw invalid_input("cannot open '" + path.string() + "' as a video (OpenCV VideoCapture)");
+    open();
+    const double fps = capture_.get(cv::CAP_PROP_FPS);
+    // One pass over the container for its frame times (and a true frame count: the announced
+    // one is an estimate for some containers), then back to the start for decoding.
+    std::vector<std::int64_t> stamps;
+    bool increasing = true;
+    while (capture_.grab()) {
+      const double ms = capture_.get(cv::CAP_PROP_POS_MSEC);
+      const std::int64_t t = std::isfinite(ms) ? std::llround(ms * 1e6) : 0;
+      if (!stamps.empty() && t <= stamps.back()) increasing = false;
+      stamps.push_back(t);
     }
-    const double frames = capture_.get(cv::CAP_PROP_FRAME_COUNT);
-    const double fps = rate_hz ? *rate_hz : capture_.get(cv::CAP_PROP_FPS);
-    if (!(frames >= 2)) throw invalid_input("video '" + path.string() + "' reports fewer than two frames");
-    count_ = static_cast<std::size_t>(frames);
-    period_ns_ = std::llround(1e9 / (fps > 0 ? fps : kDefaultRateHz));
+    count_ = stamps.size();
+    if (count_ < 2) throw invalid_input("video '" + path.string() + "' holds fewer than two frames");
+    open();
+    if (rate_hz) {
+      period_ns_ = std::llround(1e9 / *rate_hz);
+      if (increasing) {
+        notes_.push_back("--rate " + format_rate(*rate_hz) + " Hz overrides the frame times the video " +
+                         path.filename().string() + " carries.");
+      }
+    } else if (increasing) {
+      stamps_ = std::move(stamps);
+    } else {
+      period_ns_ = std::llround(1e9 / (fps > 0 ? fps : kDefaultRateHz));
+      notes_.push_back("The video " + path.filename().string() + " carries no increasing frame times; frames are " +
+                       "taken to be " + format_rate(fps > 0 ? fps : kDefaultRateHz) + " Hz apart (" +
+                       (fps > 0 ? "its nominal rate" : "assumed") + "); give --rate to change it.");
+    }
   }
   std::size_t size() const override { return count_; }
-  std::int64_t timestamp_ns(std::size_t i) const override { return static_cast<std::int64_t>(i) * period_ns_; }
+  std::int64_t timestamp_ns(std::size_t i) const override {
+    return stamps_.empty() ? static_cast<std::int64_t>(i) * period_ns_ : stamps_.at(i);
+  }
   bool sequential() const override { return true; }
   HostImage decode(std::size_t i) override {
-    if (i != next_) throw runtime_error("video frames must be decoded in order");
+    if (i + 1 == next_ && last_) return *last_;
+    if (i != next_) {
+      throw runtime_error("video frames must be decoded in order: frame " + std::to_string(i) + " was asked for after frame " +
+                          std::to_string(next_) + " of '" + path_.string() + "'");
+    }
     cv::Mat frame;
     if (!capture_.read(frame) || frame.empty()) {
       throw invalid_input("video '" + path_.string() + "' ended at frame " + std::to_string(i) + " of the " +
-                          std::to_string(count_) + " it announced");
+                          std::to_string(count_) + " it held when opened");
     }
     ++next_;
-    return host_image_from_mat(frame, "frame " + std::to_string(i) + " of video '" + path_.string() + "'");
+    last_ = host_image_from_mat(frame, "frame " + std::to_string(i) + " of video '" + path_.string() + "'");
+    return *last_;
   }
   std::string description() const override {
     return "video " + path_.filename().string() + " (" + std::to_string(count_) + " frames)";
   }
+  std::vector<std::string> notes() const override { return notes_; }
 
  private:
+  void open() {
+    capture_.release();
+    if (!capture_.open(path_.string()) || !capture_.isOpened()) {
+      throw invalid_input("cannot open '" + path_.string() + "' as a video (OpenCV VideoCapture)");
+    }
+  }
+
   std::filesystem::path path_;
   cv::VideoCapture capture_;
   std::size_t count_ = 0;
   std::size_t next_ = 0;
+  std::optional<HostImage> last_;   // the frame decoded last, which may be asked for again
+  std::vector<std::int64_t> stamps_;  // the container's frame times, when used
   std::int64_t period_ns_ = 0;
+  std::vector<std::string> notes_;
 };
 
 }  // namespace
@@ -78,14 +130,28 @@ std::unique_ptr<FrameSource> open_frame_source(const std::filesystem::path& path
     options.read_ground_truth = false;
     EurocSequence sequence = read_euroc(path, options);
     const std::string description = "EuRoC sequence " + sequence.name + " (" + std::to_string(sequence.frames.size()) + " frames)";
-    source = std::make_unique<ListedFrames>(std::move(sequence.frames), sequence.camera, description);
+    std::vector<std::string> notes;
+    if (rate_hz) notes.push_back("--rate is ignored: the EuRoC sequence's cam0/data.csv gives every frame's timestamp.");
+    source = std::make_unique<ListedFrames>(std::move(sequence.frames), sequence.camera, description, std::move(notes));
   } else if (std::filesystem::is_directory(path, error)) {
-    // Nanosecond stamps in the file names win over an assumed rate; a given rate wins over both.
-    ImageFolder folder = list_image_folder(path, rate_hz);
-    if (!folder.timestamps_known) folder = list_image_folder(path, kDefaultRateHz);
-    const std::string description = "image folder " + path.filename().string() + " (" +
-                                    std::to_string(folder.frames.size()) + " frames)";
-    source = std::make_unique<ListedFrames>(std::move(folder.frames), std::nullopt, description);
+    // Nanosecond stamps in the file names win over an assumed rate; a given rate wins over both,
+    // and either choice that is not the names' own stamps is said.
+    ImageFolder folder = list_image_folder(path);
+    std::vector<std::string> notes;
+    const std::string name = path.filename().string();
+    if (rate_hz) {
+      if (folder.timestamps_known) {
+        notes.push_back("--rate " + format_rate(*rate_hz) + " Hz overrides the nanosecond timestamps in the file names of " +
+                        name + ".");
+      }
+      folder = list_image_folder(path, rate_hz);
+    } else if (!folder.timestamps_known) {
+      folder = list_image_folder(path, kDefaultRateHz);
+      notes.push_back("The file names in " + name + " are not nanosecond timestamps: frames are taken to be " +
+                      format_rate(kDefaultRateHz) + " Hz apart; give --rate to change it.");
+    }
+    const std::string description = "image folder " + name + " (" + std::to_string(folder.frames.size()) + " frames)";
+    source = std::make_unique<ListedFrames>(std::move(folder.frames), std::nullopt, description, std::move(notes));
   } else {
     source = std::make_unique<VideoFrames>(path, rate_hz);
   }

@@ -135,6 +135,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
       throw invalid_input("unknown solver '" + o->solver + "'; expected motion-field or opengv");
     }
     auto source = open_frame_source(o->sequence, o->rate_hz > 0 ? std::optional<double>(o->rate_hz) : std::nullopt);
+    for (const auto& note : source->notes()) std::cerr << "inertialnet: note: " << note << "\n";
     if (processor.geometric_head) {
       const bool given = o->fx > 0 || o->fy > 0;
       if (given) {

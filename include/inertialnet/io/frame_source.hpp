@@ -8,6 +8,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "inertialnet/io/euroc.hpp"
 #include "inertialnet/io/image_io.hpp"
@@ -20,18 +21,24 @@ class FrameSource {
   virtual std::size_t size() const = 0;
   virtual std::int64_t timestamp_ns(std::size_t index) const = 0;
   // Decodes frame `index`. Thread-safe unless sequential() is true, in which case frames must
-  // be asked for in order 0, 1, 2, … from one thread (a video decoder cannot seek cheaply).
+  // be asked for in order 0, 1, 2, … from one thread (a video decoder cannot seek cheaply); the
+  // frame decoded last may be asked for again (a caller may look at frame 0 to learn the size).
   virtual HostImage decode(std::size_t index) = 0;
   virtual bool sequential() const { return false; }
   // Camera calibration when the source has one (EuRoC's sensor.yaml).
   virtual std::optional<CameraCalibration> calibration() const { return std::nullopt; }
   virtual std::string description() const = 0;
+  // What was assumed or overridden in opening the source (an assumed frame rate, a rate that
+  // overrides timestamped names or a video's own frame times), one sentence each, for the user.
+  virtual std::vector<std::string> notes() const { return {}; }
 };
 
 // Opens `path`: a EuRoC folder (mav0/cam0/data.csv), a folder of images (sorted by name;
-// timestamps from the names when they are nanosecond stamps, else from `rate_hz`, else
-// 20 Hz), or a video file (timestamps from its frame rate). Fewer than two frames, an empty or
-// unreadable source are invalid_input.
+// timestamps from `rate_hz` when given, else from the names when they are nanosecond stamps,
+// else 20 Hz), or a video file (timestamps from `rate_hz` when given, else the container's own
+// frame times (CAP_PROP_POS_MSEC, read in one pass over the video when it is opened) when they
+// increase, else its nominal frame rate). notes() says which was used when it was not the
+// sequence's own stamps. Fewer than two frames, an empty or unreadable source are invalid_input.
 std::unique_ptr<FrameSource> open_frame_source(const std::filesystem::path& path,
                                                std::optional<double> rate_hz = std::nullopt);
 
