@@ -1,6 +1,8 @@
 #include "inertialnet/eval/evaluate.hpp"
 
+#include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include <nlohmann/json.hpp>
 
@@ -109,6 +111,49 @@ EvalReport evaluate(const RatesTable& rates, const EurocSequence& seq, const Eva
     notes.push_back("Estimated " + estimate.summary() + "; applied (it includes any readout shift).");
   }
   r.time_offset_s = sync.time_offset_s;
+
+  // Gyro bias fitted against the predictions, or a vibrating start that the images show still.
+  if (sync.bias == BiasSource::LeastSquares) {
+    SyncOptions plain = sync;
+    plain.bias = BiasSource::None;
+    const GyroTruth first = sync_gyro(seq, plain);
+    Vec3 sum{};
+    std::size_t n = 0;
+    for (std::size_t i = 0, j = 0; i < rates.size(); ++i) {
+      while (j < first.t_ns.size() && first.t_ns[j] < rates.t_ns[i]) ++j;
+      if (j == first.t_ns.size() || first.t_ns[j] != rates.t_ns[i]) continue;
+      sum = sum + (first.raw[j] - predicted[i]);
+      ++n;
+    }
+    if (n == 0) throw invalid_input("Fitting a gyro bias: no rates row matches a camera frame with ground truth.");
+    Vec3 mean{};
+    for (int k = 0; k < 3; ++k) mean[k] = sum[k] / static_cast<double>(n);
+    sync.gyro_bias = sync.camera_frame ? mul_transposed(imu_to_camera_rotation(seq), mean) : mean;
+  } else if (sync.bias == BiasSource::Automatic && !(seq.ground_truth && !seq.ground_truth->empty()) &&
+             !seq.imu.empty()) {
+    const StaticStartCheck still = check_static_start(seq.imu, sync.static_start);
+    const std::int64_t end = seq.imu.front().t_ns + std::llround(sync.static_start.window_s * 1e9);
+    double sum2 = 0;
+    std::size_t rows_in_window = 0;
+    for (std::size_t i = 0; i < rates.size() && rates.t_ns[i] <= end; ++i) {
+      if (rates.t_ns[i] < seq.imu.front().t_ns) continue;
+      sum2 += predicted[i][0] * predicted[i][0] + predicted[i][1] * predicted[i][1] + predicted[i][2] * predicted[i][2];
+      ++rows_in_window;
+    }
+    const double image_rms = rows_in_window ? std::sqrt(sum2 / static_cast<double>(rows_in_window)) : 0;
+    if (!still.is_static && rows_in_window >= 3 && image_rms < sync.static_start.max_image_rate_rad_s) {
+      sync.bias = BiasSource::StaticStart;
+      sync.static_start.max_std_rad_s = std::numeric_limits<double>::infinity();
+      char buf[320];
+      std::snprintf(buf, sizeof buf,
+                    "The gyro moves over the first %.2f s (std %.4g, %.4g, %.4g rad/s, above the static limit %.3g) "
+                    "but the images show no rotation there (predicted |w| RMS %.4f rad/s over %zu frame pairs): "
+                    "taken as vibration on a still platform, so the static-start bias is used.",
+                    sync.static_start.window_s, still.std[0], still.std[1], still.std[2], options.sync.static_start.max_std_rad_s,
+                    image_rms, rows_in_window);
+      notes.push_back(buf);
+    }
+  }
 
   const GyroTruth truth = sync_gyro(seq, sync);
   r.target = truth.target;

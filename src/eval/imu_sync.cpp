@@ -62,6 +62,7 @@ struct StaticEstimate {
 };
 
 StaticEstimate estimate_static_start(const std::vector<ImuSample>& imu, const StaticStartRule& rule) {
+  if (imu.empty()) return {};
   StaticEstimate e;
   // Saturates instead of overflowing when the IMU starts near the int64 limit.
   std::int64_t end = 0;
@@ -90,6 +91,11 @@ StaticEstimate estimate_static_start(const std::vector<ImuSample>& imu, const St
 
 }  // namespace
 
+StaticStartCheck check_static_start(const std::vector<ImuSample>& imu, const StaticStartRule& rule) {
+  const StaticEstimate e = estimate_static_start(imu, rule);
+  return {e.ok, e.mean, e.std, e.samples};
+}
+
 std::string to_string(SyncTarget target) { return target == SyncTarget::Spline ? "spline" : "mean"; }
 
 std::string to_string(BiasSource source) {
@@ -99,6 +105,7 @@ std::string to_string(BiasSource source) {
     case BiasSource::GroundTruth: return "ground_truth";
     case BiasSource::StaticStart: return "static_start";
     case BiasSource::Automatic: return "automatic";
+    case BiasSource::LeastSquares: return "least_squares";
   }
   return "unknown";
 }
@@ -285,8 +292,10 @@ GyroTruth sync_gyro(const std::vector<std::int64_t>& camera_t_ns, const std::vec
       if (!still.ok) {
         out.notes.push_back("No gyro bias: the sequence has no ground truth and its first " +
                             fmt("%.2f", options.static_start.window_s) +
-                            " s of IMU data are not static (gyro std " + vec_str(still.std) +
-                            " rad/s); pass a bias explicitly to correct for it.");
+                            " s of IMU data are not static (gyro std " + vec_str(still.std) + " rad/s, limit " +
+                            fmt("%.3g", options.static_start.max_std_rad_s) +
+                            " rad/s); give a bias (eval --gyro-bias x,y,z) or fit a constant one against the "
+                            "predictions (eval --gyro-bias auto).");
       }
     }
   }
@@ -296,9 +305,14 @@ GyroTruth sync_gyro(const std::vector<std::int64_t>& camera_t_ns, const std::vec
     case BiasSource::Automatic:
       break;
     case BiasSource::Given:
+    case BiasSource::LeastSquares:
       bias.assign(n, options.gyro_bias);
       out.bias_imu_frame = options.gyro_bias;
-      out.notes.push_back("Gyro bias given: " + vec_str(options.gyro_bias) + " rad/s (IMU frame).");
+      out.notes.push_back(source == BiasSource::Given
+                              ? "Gyro bias given: " + vec_str(options.gyro_bias) + " rad/s (IMU frame)."
+                              : "Gyro bias fitted by least squares as a constant against the predictions (the mean "
+                                "of gyro - prediction): " + vec_str(options.gyro_bias) +
+                                    " rad/s (IMU frame); it absorbs any constant error of the predictions too.");
       break;
     case BiasSource::GroundTruth: {
       if (!have_gt) {
@@ -332,7 +346,8 @@ GyroTruth sync_gyro(const std::vector<std::int64_t>& camera_t_ns, const std::vec
                               fmt("%.2f", options.static_start.window_s) +
                               " s of IMU data are not static (gyro std " + vec_str(still.std) +
                               " rad/s, limit " + fmt("%.3g", options.static_start.max_std_rad_s) +
-                              " rad/s on every axis), so no static-start bias can be estimated.");
+                              " rad/s on every axis), so no static-start bias can be estimated; give a bias "
+                              "(eval --gyro-bias x,y,z) or fit one against the predictions (eval --gyro-bias auto).");
         }
       }
       bias.assign(n, still.mean);

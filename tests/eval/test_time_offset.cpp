@@ -28,14 +28,15 @@ te::SineRate fast_rate() {
 
 // Body-frame rows for frames 1..N−1: the exact mean rate over the frame interval as the camera
 // saw it — the scene at t + offset for a frame stamped t — ± kError.
-RatesTable inter_frame_rows(const EurocSequence& seq, const te::SineRate& rate, double offset_s) {
+template <typename Rate>
+RatesTable inter_frame_rows(const EurocSequence& seq, const Rate& rate, double offset_s, double error_scale = 1) {
   RatesTable t;
   t.metadata = {{"frame", "body"}, {"estimator", "inter_frame"}};
   for (std::size_t k = 1; k < seq.frames.size(); ++k) {
     const double a = te::rel_s(seq.frames[k - 1].t_ns) + offset_s, b = te::rel_s(seq.frames[k].t_ns) + offset_s;
     Vec3 w = rate.mean(a, b);
     const double s = k % 2 ? 1.0 : -1.0;
-    for (int c = 0; c < 3; ++c) w[c] += s * kError[c];
+    for (int c = 0; c < 3; ++c) w[c] += s * kError[c] * error_scale;
     t.t_ns.push_back(seq.frames[k].t_ns);
     t.w.push_back(w);
   }
@@ -184,4 +185,57 @@ TEST_F(TimeOffset, CameraAndBodyFrameEvalOfOneFileAgree) {
   bool noted = false;
   for (const auto& n : unstated.notes) noted = noted || n.find("does not state its frame") != std::string::npos;
   EXPECT_TRUE(noted);
+}
+
+// --gyro-bias auto: a constant fitted against the predictions (their errors here average out).
+TEST_F(TimeOffset, LeastSquaresBias) {
+  EvalOptions options;
+  options.sync.target = SyncTarget::Mean;
+  options.sync.bias = BiasSource::LeastSquares;
+  const EvalReport r = evaluate(inter_frame_rows(seq, fast_rate(), 0.0), seq, options);
+  EXPECT_EQ(r.bias_source, BiasSource::LeastSquares);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(r.bias_imu_frame[k], spec.bias[k], 1e-5) << k;
+  EXPECT_NE(r.table().find("least_squares"), std::string::npos) << r.table();
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(r.corrected->rmse[k], std::abs(kError[k]) * kDegreesPerRadian, 1e-3);
+}
+
+// A still platform that vibrates: the gyro's std is far above the static limit, but the images
+// show no rotation over the first second, so the static start is used after all (and said);
+// when the images do show rotation there, it is not.
+TEST_F(TimeOffset, VibratingStillStartAcceptedWhenTheImagesShowNoRotation) {
+  // Still for the first 1.5 s after the first frame (the IMU starts 0.4 s before it), then moving.
+  struct LateRate {
+    te::SineRate moving = fast_rate();
+    Vec3 operator()(double t) const { return t < 1.5 ? Vec3{0, 0, 0} : moving(t); }
+    Vec3 mean(double a, double b) const {
+      if (b <= 1.5) return {0, 0, 0};
+      if (a >= 1.5) return moving.mean(a, b);
+      Vec3 m = moving.mean(1.5, b);
+      for (auto& v : m) v *= (b - 1.5) / (b - a);
+      return m;
+    }
+  };
+  te::Spec vib = spec;
+  vib.rate = LateRate{};
+  vib.ground_truth = false;
+  vib.noise_std = 0.08;  // rotor vibration as seen by the gyro
+  te::write(dir.path() / "vib", vib);
+  const EurocSequence s = read_euroc(dir.path() / "vib");
+  EvalOptions options;
+  options.sync.target = SyncTarget::Mean;
+  const EvalReport still = evaluate(inter_frame_rows(s, LateRate{}, 0.0, 0.01), s, options);
+  EXPECT_EQ(still.bias_source, BiasSource::StaticStart);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(still.bias_imu_frame[k], vib.bias[k], 0.02) << k;
+  bool said = false;
+  for (const auto& n : still.notes) said = said || n.find("vibration on a still platform") != std::string::npos;
+  EXPECT_TRUE(said);
+
+  // Images that rotate at the start: no static start, and the note names the flags to use.
+  RatesTable moving = inter_frame_rows(s, LateRate{}, 0.0, 0.01);
+  for (auto& w : moving.w) w = w + Vec3{0.2, 0, 0};
+  const EvalReport none = evaluate(moving, s, options);
+  EXPECT_EQ(none.bias_source, BiasSource::None);
+  bool told = false;
+  for (const auto& n : none.notes) told = told || n.find("--gyro-bias auto") != std::string::npos;
+  EXPECT_TRUE(told);
 }

@@ -33,7 +33,8 @@ Command register_eval(CLI::App& app, const GlobalOptions&) {
       ->capture_default_str();
   app.add_option("--readout-time", o->readout_time,
                  "rolling-shutter readout time in seconds (rates belong to mid-exposure); default: the rates file's");
-  app.add_option("--gyro-bias", o->gyro_bias, "gyro bias x,y,z in rad/s (IMU frame); default: ground truth or static start");
+  app.add_option("--gyro-bias", o->gyro_bias, "gyro bias x,y,z in rad/s (IMU frame), or auto: a constant fitted against the predictions by least squares; "
+                 "default: ground truth, else a static start (vibration allowed when the images show no rotation)");
   app.add_flag("--camera-frame", o->camera_frame, "rotate the gyro into the camera frame with cam0's T_BS");
   app.add_option("--head", o->head, "compare columns wx<_HEAD>…, e.g. --head geometric");
   app.add_flag("--json", o->json, "machine-readable report");
@@ -50,7 +51,9 @@ Command register_eval(CLI::App& app, const GlobalOptions&) {
     }
     if (!o->readout_time.empty()) options.readout_time_s = parse_seconds(o->readout_time, "--readout-time");
     options.sync.camera_frame = o->camera_frame;
-    if (!o->gyro_bias.empty()) {
+    if (o->gyro_bias == "auto") {
+      options.sync.bias = BiasSource::LeastSquares;
+    } else if (!o->gyro_bias.empty()) {
       options.sync.bias = BiasSource::Given;
       options.sync.gyro_bias = parse_vec3(o->gyro_bias, "--gyro-bias");
     }

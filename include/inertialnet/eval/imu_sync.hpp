@@ -24,7 +24,9 @@
 //   static_start — the per-axis gyro mean over the first `window_s` seconds of IMU data, used
 //                  only when that window is static: every axis's standard deviation ≤
 //                  `max_std_rad_s`. Otherwise it is an error (explicit choice) or no bias (auto);
-//   automatic    — ground truth when present, else a static start when the rule holds, else none.
+//   automatic    — ground truth when present, else a static start when the rule holds, else none;
+//   least_squares — a constant the caller fitted against predictions (eval's --gyro-bias auto:
+//                  the mean of gyro − prediction), passed in gyro_bias like a given one.
 #pragma once
 
 #include <cstddef>
@@ -39,10 +41,11 @@
 namespace inertialnet {
 
 enum class SyncTarget { Spline, Mean };
-enum class BiasSource { None, Given, GroundTruth, StaticStart, Automatic };
+enum class BiasSource { None, Given, GroundTruth, StaticStart, Automatic, LeastSquares };
 
 std::string to_string(SyncTarget target);   // "spline", "mean"
-std::string to_string(BiasSource source);   // "none", "given", "ground_truth", "static_start", "automatic"
+// "none", "given", "ground_truth", "static_start", "automatic", "least_squares"
+std::string to_string(BiasSource source);
 SyncTarget parse_sync_target(const std::string& text);   // throws invalid_input listing the choices
 // "x,y,z" (whitespace allowed) → Vec3; throws invalid_input naming `what`.
 Vec3 parse_vec3(const std::string& text, const std::string& what);
@@ -52,13 +55,26 @@ struct StaticStartRule {
   // White gyro noise of EuRoC's ADIS16448 is ≈1.7e-4 rad/s/√Hz, ≈2.4e-3 rad/s per sample at
   // 200 Hz; a hand-held or flying start moves by tenths of rad/s. 0.01 rad/s separates the two.
   double max_std_rad_s = 0.01;
+  // eval only (it has the predictions): a start whose gyro std exceeds the limit is still taken
+  // as static when the images show no rotation there — the RMS of the predicted |ω| over at least
+  // 3 frame pairs in the window stays under this — since a still platform may vibrate (rotor
+  // vibration: a gyro std of ~0.08 rad/s) while the camera sees nothing move.
+  double max_image_rate_rad_s = 0.02;
 };
+
+// The static-start rule's measurement on the first window_s seconds of IMU data.
+struct StaticStartCheck {
+  bool is_static = false;          // every axis's std ≤ max_std_rad_s
+  Vec3 mean{}, std{};              // rad/s
+  std::size_t samples = 0;
+};
+StaticStartCheck check_static_start(const std::vector<ImuSample>& imu, const StaticStartRule& rule);
 
 struct SyncOptions {
   SyncTarget target = SyncTarget::Spline;
   bool camera_frame = false;
   BiasSource bias = BiasSource::Automatic;
-  Vec3 gyro_bias{};               // with BiasSource::Given: IMU frame, rad/s
+  Vec3 gyro_bias{};               // with BiasSource::Given or LeastSquares: IMU frame, rad/s
   StaticStartRule static_start;
   // Camera–IMU time offset (time_offset.hpp's convention t_imu = t_cam + offset): targets are
   // taken at the camera times plus this shift; the output keeps the camera's own timestamps.
