@@ -13,6 +13,8 @@
 
 #include "inertialnet/models/geometric_head.hpp"
 
+#include <algorithm>
+
 #include <cmath>
 #include <string>
 #include <utility>
@@ -46,6 +48,9 @@ void GeometricHeadOptions::validate() const {
     throw invalid_input("geometric head: the inlier threshold must be a positive number of pixels");
   }
   if (max_iterations < 2) throw invalid_input("geometric head: at least 2 iterations are needed");
+  if (!(readout_time_s >= 0) || readout_time_s > 1) {
+    throw invalid_input("geometric head: the readout time must be between 0 and 1 s");
+  }
   if (opengv_correspondences < 10) {
     throw invalid_input("geometric head: OpenGV needs at least 10 correspondences, got " +
                         std::to_string(opengv_correspondences));
@@ -95,12 +100,27 @@ RotationEstimate GeometricHead::estimate(Queue& queue, const Tensor& flow, doubl
     throw invalid_input("geometric head: the frame interval dt must be a positive number of seconds, got " + std::to_string(dt));
   }
   check_queue(queue);
-  if (options_.solver == GeometricSolver::OpenGV) {
-    return detail::solve_opengv(motion_field_correspondences(queue, flow, map_, options_.stride), dt,
-                                camera_.mean_focal(), options_);
+  const auto solve = [&](const Tensor& f) {
+    if (options_.solver == GeometricSolver::OpenGV) {
+      return detail::solve_opengv(motion_field_correspondences(queue, f, map_, options_.stride), dt,
+                                  camera_.mean_focal(), options_);
+    }
+    return detail::solve_motion_field([&](const MotionFieldParams& p) { return motion_field_moments(queue, f, map_, p); },
+                                      dt, camera_.mean_focal(), options_);
+  };
+  if (options_.readout_time_s <= 0) return solve(flow);
+  // Rolling shutter: each vector spans its own interval (GeometricHeadOptions::readout_time_s).
+  // A host pass: the flow is 2·H·W floats, small next to the solve.
+  std::vector<float> f = flow.to_host(queue);
+  const std::size_t plane = f.size() / 2;
+  const double per_row = options_.readout_time_s / std::max(1, camera_.height - 1);
+  for (std::size_t i = 0; i < plane; ++i) {
+    const double interval = dt + per_row * f[plane + i];
+    const double scale = dt / std::max(interval, 0.1 * dt);  // a vector across most of the frame stays finite
+    f[i] = static_cast<float>(f[i] * scale);
+    f[plane + i] = static_cast<float>(f[plane + i] * scale);
   }
-  return detail::solve_motion_field([&](const MotionFieldParams& p) { return motion_field_moments(queue, flow, map_, p); },
-                                    dt, camera_.mean_focal(), options_);
+  return solve(Tensor::from_host(queue, flow.shape(), f));
 }
 
 RotationEstimate GeometricHead::estimate(Queue& queue, const FlowField& flow, double dt) {

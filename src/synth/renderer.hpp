@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -17,5 +18,13 @@ namespace inertialnet::detail {
 // runtime_error (naming t_ns) when a sub-sample misses every plane.
 cv::Mat render(const std::vector<Plane>& planes, const SynthCamera& cam, const Eigen::Matrix3d& R_WC,
                const Eigen::Vector3d& c, std::int64_t t_ns);
+
+// The same with a rolling shutter and motion blur: row y is seen at t + readout·y/(height − 1),
+// and with an exposure each row averages `kExposureSamples` renders spread evenly over
+// [row time − exposure/2, row time + exposure/2]. `pose(t)` gives (R_WC, c) at time t (s).
+constexpr int kExposureSamples = 5;
+using PoseAt = std::function<std::pair<Eigen::Matrix3d, Eigen::Vector3d>(double)>;
+cv::Mat render_exposed(const std::vector<Plane>& planes, const SynthCamera& cam, const PoseAt& pose, double t,
+                       double readout_s, double exposure_s, std::int64_t t_ns);
 
 }  // namespace inertialnet::detail

@@ -63,7 +63,8 @@ std::vector<Plane> build_scene(const SynthOptions& o, const SynthTrajectory& tra
   std::vector<Plane> planes;
 
   Plane wall;
-  const double depth = 6.0;
+  const bool close = o.motion == SynthOptions::CloseRange;
+  const double depth = close ? 1.0 : 6.0;
   wall.texel = depth / f;
   wall.a = Eigen::Vector3d::UnitX();
   wall.b = Eigen::Vector3d::UnitY();
@@ -72,8 +73,11 @@ std::vector<Plane> build_scene(const SynthOptions& o, const SynthTrajectory& tra
   // The footprint moves at most ≈5·f·|ω| + translation texels per second; sampling at 200 Hz
   // and a margin of a tenth of the frame keeps every frame inside (render() checks it).
   // A camera-IMU time offset shows the scene up to |offset| before or after the horizon.
-  const long first = static_cast<long>(std::floor(std::min(0.0, o.time_offset_s) * 200));
-  const long samples = static_cast<long>(std::ceil((synth_horizon_s(o) + std::max(0.0, o.time_offset_s)) * 200));
+  // A rolling shutter's readout and an exposure extend that further.
+  const double before = std::min(0.0, o.time_offset_s) - o.exposure_time_s / 2;
+  const double after = std::max(0.0, o.time_offset_s) + o.readout_time_s + o.exposure_time_s / 2;
+  const long first = static_cast<long>(std::floor(before * 200));
+  const long samples = static_cast<long>(std::ceil((synth_horizon_s(o) + after) * 200));
   for (long i = first; i <= samples; ++i) {
     const double t = static_cast<double>(i) / 200;
     extend_footprint(wall, cam, to_eigen(traj.rotation(t)), to_eigen(traj.position(t)), lo, hi);
@@ -91,13 +95,14 @@ std::vector<Plane> build_scene(const SynthOptions& o, const SynthTrajectory& tra
   wall.texture = make_texture(static_cast<int>(cols), static_cast<int>(rows), max_shape, wall_rng, 128);
   planes.push_back(std::move(wall));
 
-  if (o.motion == SynthOptions::General) {
-    // Four panels at 1.5–4.5 m, one per depth band, placed in the reference view and tilted so
-    // that depth also varies across each of them.
+  if (o.motion == SynthOptions::General || close) {
+    // Four panels at 1.5–4.5 m (0.3–0.9 m at close range), one per depth band, placed in the
+    // reference view and tilted so that depth also varies across each of them.
     SplitMix64 layout(o.seed, kLayout);
     const double half_x = (cam.K(0, 2) + 0.5) / cam.K(0, 0), half_y = (cam.K(1, 2) + 0.5) / cam.K(1, 1);
+    const double near = close ? 0.3 : 1.5, band = close ? 0.15 : 0.75;
     for (int i = 0; i < 4; ++i) {
-      const double z = layout.uniform(1.5 + 0.75 * i, 1.5 + 0.75 * (i + 1));
+      const double z = layout.uniform(near + band * i, near + band * (i + 1));
       const Eigen::Vector3d centre(z * half_x * layout.uniform(-0.65, 0.65),
                                    z * half_y * layout.uniform(-0.65, 0.65), z);
       const double width = 2 * z * half_x * layout.uniform(0.2, 0.4);

@@ -57,7 +57,16 @@ void SynthOptions::validate() const {
     throw invalid_input("synth: the camera-IMU time offset should be within +-0.5 s, found " +
                         std::to_string(o.time_offset_s) + " s.");
   }
-  if (o.motion != SynthOptions::Rotation && o.motion != SynthOptions::General) {
+  if (!(std::isfinite(o.readout_time_s) && o.readout_time_s >= 0 && o.readout_time_s <= 0.1)) {
+    throw invalid_input("synth: the rolling-shutter readout time should be within 0..0.1 s, found " +
+                        std::to_string(o.readout_time_s) + " s.");
+  }
+  if (!(std::isfinite(o.exposure_time_s) && o.exposure_time_s >= 0 && o.exposure_time_s <= 0.05)) {
+    throw invalid_input("synth: the exposure time should be within 0..0.05 s, found " +
+                        std::to_string(o.exposure_time_s) + " s.");
+  }
+  if (o.motion != SynthOptions::Rotation && o.motion != SynthOptions::General &&
+      o.motion != SynthOptions::CloseRange) {
     throw invalid_input("synth: unknown motion kind " + std::to_string(static_cast<int>(o.motion)) + ".");
   }
 }
@@ -67,11 +76,12 @@ SynthOptions::Motion parse_synth_motion(const std::string& name) {
   std::transform(n.begin(), n.end(), n.begin(), [](unsigned char c) { return std::tolower(c); });
   if (n == "rotation") return SynthOptions::Rotation;
   if (n == "general") return SynthOptions::General;
-  throw invalid_input("synth: unknown motion \"" + name + "\"; expected rotation or general.");
+  if (n == "close" || n == "close-range") return SynthOptions::CloseRange;
+  throw invalid_input("synth: unknown motion \"" + name + "\"; expected rotation, general or close.");
 }
 
 const char* to_string(SynthOptions::Motion motion) {
-  return motion == SynthOptions::General ? "general" : "rotation";
+  return motion == SynthOptions::General ? "general" : motion == SynthOptions::CloseRange ? "close" : "rotation";
 }
 
 std::array<double, 4> synth_intrinsics(int width, int height) {

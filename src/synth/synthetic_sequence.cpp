@@ -178,7 +178,14 @@ SynthReport write_synthetic_sequence(const fs::path& out_dir, const SynthOptions
     const std::vector<int> png{cv::IMWRITE_PNG_COMPRESSION, 3};
     for (std::int64_t tn : report.camera_t_ns) {
       const double t = shown(tn);
-      const cv::Mat frame = render(scene, cam, to_eigen(traj.rotation(t)), to_eigen(traj.position(t)), tn);
+      const cv::Mat frame =
+          o.readout_time_s > 0 || o.exposure_time_s > 0
+              ? detail::render_exposed(scene, cam,
+                                       [&](double ts) {
+                                         return std::make_pair(to_eigen(traj.rotation(ts)), to_eigen(traj.position(ts)));
+                                       },
+                                       t, o.readout_time_s, o.exposure_time_s, tn)
+              : render(scene, cam, to_eigen(traj.rotation(t)), to_eigen(traj.position(t)), tn);
       const std::string name = std::to_string(tn) + ".png";
       bool ok = false;
       try {

@@ -55,16 +55,20 @@ SynthTrajectory::SynthTrajectory(const SynthOptions& o) {
         for (auto& s : axis) s.amplitude *= scale;
     }
   }
-  if (o.motion == SynthOptions::General) {
+  if (o.motion == SynthOptions::General || o.motion == SynthOptions::CloseRange) {
     // Peak speeds per world axis (right, down, forward) in m/s; positions stay within ±0.32 m so
-    // the nearest panel (1.5 m) stays well in front.
+    // the nearest panel (1.5 m) stays well in front. At close range a hand's faster, shorter
+    // strokes: ≈0.5 m/s over 0.8–1.6 Hz keeps the travel within ±0.1 m of the 0.3 m panels.
+    const bool close = o.motion == SynthOptions::CloseRange;
     SplitMix64 trng(o.seed, kTranslation);
-    const double speed[3] = {0.30, 0.12, 0.25};
+    const double general_speed[3] = {0.30, 0.12, 0.25}, close_speed[3] = {0.5, 0.3, 0.2};
+    const double* speed = close ? close_speed : general_speed;
+    const double f_lo = close ? 0.8 : 0.15, f_hi = close ? 1.6 : 0.45;
     for (int k = 0; k < 3; ++k) {
       const double budget = speed[k] * trng.uniform(0.7, 1.0);
       const double share = trng.uniform(0.3, 0.7);
       for (double s : {share, 1 - share}) {
-        const double omega = 2 * kPi * trng.uniform(0.15, 0.45);
+        const double omega = 2 * kPi * trng.uniform(f_lo, f_hi);
         position_[k].push_back({budget * s / omega, omega, trng.uniform(0, 2 * kPi)});
       }
     }

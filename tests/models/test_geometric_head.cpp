@@ -331,3 +331,43 @@ TEST(GeometricHead, BadInputIsInvalidInput) {
 
 }  // namespace
 }  // namespace inertialnet
+
+namespace inertialnet {
+namespace {
+
+// A rolling shutter stretches each vector's interval by readout·v/(height − 1): a pure rotation
+// field stretched so is solved right only when the head is told the readout (both solvers).
+TEST(GeometricHead, RollingShutterIntervalIsCorrected) {
+  Queue& queue = testing::test_queue();
+  const CameraIntrinsics k = quarter_euroc();
+  const std::vector<float> map = normalized_coordinate_map(k);
+  Motion m;
+  m.omega = {0.6, -0.8, 0.5};  // fast: a few px of vertical flow at this size
+  m.outliers = 0;
+  m.noise_px = 0;
+  FlowField flow = render(k, map, m);
+  const double readout = 0.03, per_row = readout / (k.height - 1);
+  for (std::size_t i = 0; i < flow.u.size(); ++i) {
+    // The stretched vector f' satisfies f' = f·(dt + per_row·f'_v)/dt; solved for f'.
+    const double scale = m.dt / (m.dt - per_row * flow.v[i]);
+    flow.u[i] = static_cast<float>(flow.u[i] * scale);
+    flow.v[i] = static_cast<float>(flow.v[i] * scale);
+  }
+  for (const GeometricSolver solver : {GeometricSolver::MotionField, GeometricSolver::OpenGV}) {
+    GeometricHeadOptions o = quarter_options();
+    o.solver = solver;
+    GeometricHead global(testing::test_device(), k, o);
+    o.readout_time_s = readout;
+    GeometricHead rolling(testing::test_device(), k, o);
+    const RotationEstimate uncorrected = global.estimate(queue, flow, m.dt);
+    const RotationEstimate corrected = rolling.estimate(queue, flow, m.dt);
+    EXPECT_TRUE(near_rates(corrected.omega, m.omega, 0.05)) << static_cast<int>(solver);
+    EXPECT_FALSE(near_rates(uncorrected.omega, m.omega, 0.05)) << static_cast<int>(solver);
+  }
+  GeometricHeadOptions bad = quarter_options();
+  bad.readout_time_s = -0.01;
+  EXPECT_THROW(bad.validate(), Error);
+}
+
+}  // namespace
+}  // namespace inertialnet

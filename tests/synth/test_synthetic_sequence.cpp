@@ -570,3 +570,51 @@ TEST(SynthSequence, RejectsBadOptionsAndOccupiedFolders) {
   EXPECT_EQ(parse_synth_motion("general"), SynthOptions::General);
   expect_invalid_input([] { parse_synth_motion("spin"); }, "unknown motion");
 }
+
+// The options that make synthetic sequences look like real recordings: close range, a rolling
+// shutter, motion blur and a camera–IMU offset each change the frames (and nothing else), and
+// are range-checked.
+TEST(SynthSequence, RealCameraOptionsChangeTheFramesAndAreChecked) {
+  TempDir dir("synth_real");
+  const auto frame = [&](const SynthOptions& o, const std::string& name) {
+    const SynthReport r = write_synthetic_sequence(dir.path() / name, o);
+    return cv::imread((r.mav0 / "cam0" / "data" / (std::to_string(r.camera_t_ns[5]) + ".png")).string(),
+                      cv::IMREAD_GRAYSCALE);
+  };
+  const auto differs = [](const cv::Mat& a, const cv::Mat& b) { return cv::norm(a, b, cv::NORM_L1) > 0; };
+  SynthOptions o = small_options(SynthOptions::CloseRange);
+  EXPECT_EQ(parse_synth_motion("close"), SynthOptions::CloseRange);
+  EXPECT_STREQ(to_string(SynthOptions::CloseRange), "close");
+  const cv::Mat global = frame(o, "global");
+  ASSERT_FALSE(global.empty());
+  SynthOptions rolling = o;
+  rolling.readout_time_s = 0.03;
+  EXPECT_TRUE(differs(global, frame(rolling, "rolling")));
+  SynthOptions blurred = o;
+  blurred.exposure_time_s = 0.01;
+  const cv::Mat blur = frame(blurred, "blurred");
+  EXPECT_TRUE(differs(global, blur));
+  // Blur removes detail: the mean gradient magnitude drops.
+  const auto sharpness = [](const cv::Mat& m) {
+    cv::Mat dx;
+    cv::Sobel(m, dx, CV_32F, 1, 0);
+    return cv::mean(cv::abs(dx))[0];
+  };
+  EXPECT_LT(sharpness(blur), sharpness(global));
+  SynthOptions late = o;
+  late.time_offset_s = 0.05;  // one frame later: frame 5 shows what frame 6 shows without it
+  const SynthReport a = write_synthetic_sequence(dir.path() / "late", late);
+  const SynthReport b = write_synthetic_sequence(dir.path() / "ontime", o);
+  const cv::Mat shifted = cv::imread((a.mav0 / "cam0" / "data" / (std::to_string(a.camera_t_ns[5]) + ".png")).string(),
+                                     cv::IMREAD_GRAYSCALE);
+  const cv::Mat next = cv::imread((b.mav0 / "cam0" / "data" / (std::to_string(b.camera_t_ns[6]) + ".png")).string(),
+                                  cv::IMREAD_GRAYSCALE);
+  EXPECT_FALSE(differs(shifted, next));
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(a.interval_rates[4][k], b.interval_rates[5][k], 1e-12);
+
+  for (auto bad : {&SynthOptions::readout_time_s, &SynthOptions::exposure_time_s, &SynthOptions::time_offset_s}) {
+    SynthOptions x = o;
+    x.*bad = 2.0;
+    EXPECT_THROW(x.validate(), Error);
+  }
+}

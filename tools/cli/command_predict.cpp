@@ -101,7 +101,8 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
   app.add_option("--time-offset", o->time_offset,
                  "camera-IMU time offset in seconds (t_imu = t_cam + offset), stated in the CSV for eval");
   app.add_option("--readout-time", o->readout_time,
-                 "rolling-shutter readout time in seconds (rates belong to mid-exposure), stated in the CSV for eval");
+                 "rolling-shutter readout time in seconds: the geometric head corrects each flow vector's interval, "
+                 "and the CSV states it for eval (rates belong to mid-exposure)");
   app.add_option("--lanes", o->lanes, "frame pairs in flight per device")->capture_default_str()->check(CLI::Range(1, 16));
   app.add_option("--decode-threads", o->decode_threads, "image decoding threads")->capture_default_str()->check(CLI::Range(1, 64));
   app.add_option("--max-pairs", o->max_pairs, "stop after this many pairs")
@@ -133,6 +134,9 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
       processor.geometric.solver = GeometricSolver::OpenGV;
     } else if (o->solver != "motion-field") {
       throw invalid_input("unknown solver '" + o->solver + "'; expected motion-field or opengv");
+    }
+    if (!o->readout_time.empty()) {
+      processor.geometric.readout_time_s = parse_seconds(o->readout_time, "--readout-time");
     }
     auto source = open_frame_source(o->sequence, o->rate_hz > 0 ? std::optional<double>(o->rate_hz) : std::nullopt);
     for (const auto& note : source->notes()) std::cerr << "inertialnet: note: " << note << "\n";
@@ -242,7 +246,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
       metadata.push_back({"time_offset_s", format_number(parse_seconds(o->time_offset, "--time-offset"))});
     }
     if (!o->readout_time.empty()) {
-      metadata.push_back({"readout_time_s", format_number(parse_seconds(o->readout_time, "--readout-time"))});
+      metadata.push_back({"readout_time_s", format_number(processor.geometric.readout_time_s)});
     }
     std::unique_ptr<RatesCsvWriter> file_writer;
     if (!o->output.empty()) file_writer = std::make_unique<RatesCsvWriter>(o->output, extra, metadata);

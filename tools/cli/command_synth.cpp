@@ -15,7 +15,7 @@ struct SynthCliOptions {
   std::string out, motion = "rotation", size = "752x480";
   int frames = 40;
   std::uint64_t seed = 1;
-  double max_rate = 60, time_offset = 0;
+  double max_rate = 60, time_offset = 0, readout_time = 0, exposure_time = 0;
   bool no_noise = false, overwrite = false;
 };
 }  // namespace
@@ -24,7 +24,7 @@ Command register_synth(CLI::App& app, const GlobalOptions&) {
   auto o = std::make_shared<SynthCliOptions>();
   app.add_option("out_dir", o->out, "folder to write (mav0/ inside)")->required();
   app.add_option("--frames", o->frames, "number of frames")->capture_default_str()->check(CLI::Range(2, 100000));
-  app.add_option("--motion", o->motion, "rotation (exact homographies) or general (translation, depth)")
+  app.add_option("--motion", o->motion, "rotation (exact homographies), general (translation, depth) or close (hand-held at 0.3-1 m)")
       ->capture_default_str();
   app.add_option("--seed", o->seed, "seed of the motion, texture and noise")->capture_default_str();
   app.add_option("--size", o->size, "image size WxH")->capture_default_str();
@@ -32,6 +32,9 @@ Command register_synth(CLI::App& app, const GlobalOptions&) {
   app.add_option("--time-offset", o->time_offset,
                  "camera-IMU time offset in seconds (t_imu = t_cam + offset): frames show the scene this much later")
       ->capture_default_str();
+  app.add_option("--readout-time", o->readout_time, "rolling shutter: seconds from the first row to the last")
+      ->capture_default_str();
+  app.add_option("--exposure-time", o->exposure_time, "motion blur: seconds each row is exposed")->capture_default_str();
   app.add_flag("--no-noise", o->no_noise, "exact IMU: no white noise, no bias");
   app.add_flag("--overwrite", o->overwrite, "replace an existing sequence in OUT_DIR");
   return [o]() {
@@ -45,6 +48,8 @@ Command register_synth(CLI::App& app, const GlobalOptions&) {
     options.max_rate_deg_s = o->max_rate;
     options.noise = !o->no_noise;
     options.time_offset_s = o->time_offset;
+    options.readout_time_s = o->readout_time;
+    options.exposure_time_s = o->exposure_time;
     options.overwrite = o->overwrite;
     const SynthReport report = write_synthetic_sequence(o->out, options);
     std::printf("wrote %s: %d frames %dx%d (%s motion, %.2f s), %d IMU samples\n", report.mav0.string().c_str(),

@@ -73,6 +73,13 @@ struct GeometricHeadOptions {
   double ransac_threshold_px = 1.0;  // reprojection angle ≈ threshold / focal length
   int ransac_iterations = 200;
 
+  // Rolling shutter (both solvers): rows are read out over this many seconds, top to bottom. A
+  // point that moves v rows between frames was seen dt + readout·v/(height − 1) apart, not dt:
+  // each flow vector is scaled by dt / that interval before solving (first order in the readout;
+  // the rate's change across the rows is not modelled). The rates then belong to mid-exposure,
+  // readout/2 after the frame stamps. 0: a global shutter.
+  double readout_time_s = 0;
+
   void validate() const;  // invalid_input for non-positive strides, scales or counts
 };
 

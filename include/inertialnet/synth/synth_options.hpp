@@ -13,7 +13,10 @@
 namespace inertialnet {
 
 struct SynthOptions {
-  enum Motion { Rotation, General };
+  // Rotation: pure rotation, a wall 6 m away. General: translation up to ≈0.3 m/s, panels at
+  // 1.5–4.5 m. CloseRange: hand-held at close range, translation up to ≈0.5 m/s (0.8–1.6 Hz,
+  // a few cm of travel), panels at 0.3–0.9 m in front of a wall at 1 m.
+  enum Motion { Rotation, General, CloseRange };
 
   int frames = 40;                 // at least 2 (one frame pair)
   int width = 752, height = 480;   // 16..4096 pixels
@@ -29,6 +32,12 @@ struct SynthOptions {
   // shows the scene at t + offset on the IMU's clock, as with a camera whose stamps run early.
   // |offset| ≤ 0.5 s.
   double time_offset_s = 0;
+  // Rolling shutter: row y is exposed at stamp + readout·y/(height − 1), so mid-exposure is
+  // readout/2 after the stamp (eval --readout-time). 0: global shutter. At most 0.1 s.
+  double readout_time_s = 0;
+  // Motion blur: each row averages 5 renders spread evenly over an exposure this long, centred on
+  // the row's time. 0: instantaneous. At most 0.05 s.
+  double exposure_time_s = 0;
   // An existing, non-empty output folder is an error unless this is set; then only its mav0/
   // folder is replaced, whatever else it holds is left alone.
   bool overwrite = false;
