@@ -41,8 +41,8 @@ std::string to_string(OpenGVMethod method) {
 
 void GeometricHeadOptions::validate() const {
   if (stride < 1) throw invalid_input("geometric head: the sample stride must be at least 1, got " + std::to_string(stride));
-  if (!(robust_scale_px > 0) || !std::isfinite(robust_scale_px)) {
-    throw invalid_input("geometric head: the robust scale must be a positive number of pixels");
+  if (!(robust_scale_px >= 0) || !std::isfinite(robust_scale_px)) {
+    throw invalid_input("geometric head: the robust scale must be a positive number of pixels (0: from the image size)");
   }
   if (!(inlier_threshold_px > 0) || !std::isfinite(inlier_threshold_px)) {
     throw invalid_input("geometric head: the inlier threshold must be a positive number of pixels");
@@ -65,15 +65,22 @@ GeometricHead::GeometricHead(Device& device, const CameraIntrinsics& camera, Geo
     : device_(device), camera_(camera), options_(std::move(options)) {
   camera_.validate();
   options_.validate();
+  resolve_scale();
   const std::vector<float> map = normalized_coordinate_map(camera_);
   map_ = Tensor::from_host(device_.queue(), {1, 2, camera_.height, camera_.width}, map);
 }
 
 GeometricHead::~GeometricHead() = default;
 
+// The flow's own error grows with the image: 1 px at EuRoC's 752 columns.
+void GeometricHead::resolve_scale() {
+  if (options_.robust_scale_px == 0) options_.robust_scale_px = camera_.width / 752.0;
+}
+
 void GeometricHead::set_options(const GeometricHeadOptions& options) {
   options.validate();
   options_ = options;
+  resolve_scale();
 }
 
 void GeometricHead::check_queue(const Queue& queue) const {

@@ -22,6 +22,8 @@ inline double synth_span_s(const SynthOptions& o) { return (o.frames - 1) / o.ca
 inline double synth_horizon_s(const SynthOptions& o) { return std::max(synth_span_s(o), kHorizonS); }
 
 // Independent random streams, so that e.g. switching the noise off leaves images and motion alone.
-enum SynthStream : std::uint64_t { kRotation = 1, kTranslation = 2, kLayout = 3, kNoise = 4, kTexture = 100 };
+enum SynthStream : std::uint64_t {
+  kRotation = 1, kTranslation = 2, kLayout = 3, kNoise = 4, kBiasWalk = 5, kDrops = 6, kExposure = 7, kTexture = 100
+};
 
 }  // namespace inertialnet::detail

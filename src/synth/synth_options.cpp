@@ -65,6 +65,17 @@ void SynthOptions::validate() const {
     throw invalid_input("synth: the exposure time should be within 0..0.05 s, found " +
                         std::to_string(o.exposure_time_s) + " s.");
   }
+  if (!(std::isfinite(o.drop_fraction) && o.drop_fraction >= 0 && o.drop_fraction <= 0.5)) {
+    throw invalid_input("synth: the frame drop fraction should be within 0..0.5, found " + std::to_string(o.drop_fraction) + ".");
+  }
+  if (!(std::isfinite(o.exposure_variation) && o.exposure_variation >= 0 && o.exposure_variation <= 0.5)) {
+    throw invalid_input("synth: the exposure variation should be within 0..0.5, found " +
+                        std::to_string(o.exposure_variation) + ".");
+  }
+  if (!(std::isfinite(o.texture_contrast) && o.texture_contrast >= 0.02 && o.texture_contrast <= 1)) {
+    throw invalid_input("synth: the texture contrast should be within 0.02..1, found " +
+                        std::to_string(o.texture_contrast) + ".");
+  }
   if (o.motion != SynthOptions::Rotation && o.motion != SynthOptions::General &&
       o.motion != SynthOptions::CloseRange) {
     throw invalid_input("synth: unknown motion kind " + std::to_string(static_cast<int>(o.motion)) + ".");

@@ -89,10 +89,16 @@ SynthReport write_synthetic_sequence(const fs::path& out_dir, const SynthOptions
     }
     const auto rel = [&](std::int64_t t) { return static_cast<double>(t - kSynthStartNs) * 1e-9; };
 
-    report.frames = o.frames;
+    report.frames = 0;  // set once the drops are known
     report.imu_samples = static_cast<int>(n_imu);
     report.intrinsics = synth_intrinsics(o.width, o.height);
-    for (int k = 0; k < o.frames; ++k) report.camera_t_ns.push_back(t_ns[static_cast<std::size_t>(k) * ratio]);
+    SplitMix64 drops(o.seed, detail::kDrops);
+    for (int k = 0; k < o.frames; ++k) {
+      const bool inner = k > 0 && k + 1 < o.frames;
+      if (o.drop_fraction > 0 && inner && drops.uniform(0, 1) < o.drop_fraction) continue;
+      report.camera_t_ns.push_back(t_ns[static_cast<std::size_t>(k) * ratio]);
+    }
+    report.frames = static_cast<int>(report.camera_t_ns.size());
     report.duration_s = rel(report.camera_t_ns.back());
 
     // IMU and ground truth.
@@ -114,6 +120,9 @@ SynthReport write_synthetic_sequence(const fs::path& out_dir, const SynthOptions
         "b_w_RS_S_y [rad s^-1], b_w_RS_S_z [rad s^-1], b_a_RS_S_x [m s^-2], b_a_RS_S_y [m s^-2], "
         "b_a_RS_S_z [m s^-2]\n";
     Vec3 sum2{0, 0, 0};
+    SplitMix64 walk(o.seed, detail::kBiasWalk);
+    const double walk_std = o.noise && o.bias_random_walk ? detail::kGyroRandomWalk / std::sqrt(o.imu_rate_hz) : 0;
+    Vec3 bias = report.gyro_bias;
     constexpr double kDiff = 1e-4;  // s, central difference for the acceleration (error ~1e-9)
     for (long i = 0; i < n_imu; ++i) {
       const std::int64_t tn = t_ns[static_cast<std::size_t>(i)];
@@ -131,7 +140,7 @@ SynthReport write_synthetic_sequence(const fs::path& out_dir, const SynthOptions
       imu += std::to_string(tn);
       for (int k = 0; k < 3; ++k) {
         imu += ',';
-        append_number(imu, gyro[k] + (o.noise ? report.gyro_bias[k] + gyro_std * noise.normal() : 0.0));
+        append_number(imu, gyro[k] + (o.noise ? bias[k] + gyro_std * noise.normal() : 0.0));
       }
       for (int k = 0; k < 3; ++k) {
         imu += ',';
@@ -144,13 +153,16 @@ SynthReport write_synthetic_sequence(const fs::path& out_dir, const SynthOptions
       if (q.w() < 0) q.coeffs() *= -1;
       gt += std::to_string(tn);
       for (double v : {s.position.x(), s.position.y(), s.position.z(), q.w(), q.x(), q.y(), q.z(),
-                       s.velocity.x(), s.velocity.y(), s.velocity.z(), report.gyro_bias[0],
-                       report.gyro_bias[1], report.gyro_bias[2], report.accel_bias[0],
+                       s.velocity.x(), s.velocity.y(), s.velocity.z(), bias[0],
+                       bias[1], bias[2], report.accel_bias[0],
                        report.accel_bias[1], report.accel_bias[2]}) {
         gt += ',';
         append_number(gt, v);
       }
       gt += '\n';
+      if (walk_std > 0) {
+        for (int k = 0; k < 3; ++k) bias[k] += walk_std * walk.normal();
+      }
     }
     for (int k = 0; k < 3; ++k) report.rms_rate_deg_s[k] = std::sqrt(sum2[k] / static_cast<double>(n_imu));
     write_text(imu_dir / "data.csv", imu);
@@ -160,7 +172,7 @@ SynthReport write_synthetic_sequence(const fs::path& out_dir, const SynthOptions
 
     // Rates the images encode: a frame stamped t shows the scene at t + offset.
     const auto shown = [&](std::int64_t tn) { return rel(tn) + o.time_offset_s; };
-    for (int k = 0; k < o.frames; ++k) {
+    for (int k = 0; k < report.frames; ++k) {
       const double t = shown(report.camera_t_ns[static_cast<std::size_t>(k)]);
       report.camera_rates.push_back(traj.camera_rate(t));
       if (k > 0) report.interval_rates.push_back(traj.mean_camera_rate(shown(report.camera_t_ns[static_cast<std::size_t>(k) - 1]), t));
@@ -176,9 +188,10 @@ SynthReport write_synthetic_sequence(const fs::path& out_dir, const SynthOptions
     const std::vector<Plane> scene = build_scene(o, traj, cam);
     std::string listing = "#timestamp [ns],filename\n";
     const std::vector<int> png{cv::IMWRITE_PNG_COMPRESSION, 3};
+    SplitMix64 exposure(o.seed, detail::kExposure);
     for (std::int64_t tn : report.camera_t_ns) {
       const double t = shown(tn);
-      const cv::Mat frame =
+      cv::Mat frame =
           o.readout_time_s > 0 || o.exposure_time_s > 0
               ? detail::render_exposed(scene, cam,
                                        [&](double ts) {
@@ -186,6 +199,19 @@ SynthReport write_synthetic_sequence(const fs::path& out_dir, const SynthOptions
                                        },
                                        t, o.readout_time_s, o.exposure_time_s, tn)
               : render(scene, cam, to_eigen(traj.rotation(t)), to_eigen(traj.position(t)), tn);
+      if (o.exposure_variation > 0 || o.texture_contrast < 1) {
+        // Low contrast about mid-grey, then this frame's exposure: the sensor's rounding stays.
+        const double gain = 1 + (o.exposure_variation > 0 ? exposure.uniform(-o.exposure_variation, o.exposure_variation) : 0.0);
+        cv::Mat adjusted(frame.size(), CV_8U);
+        for (int y = 0; y < frame.rows; ++y) {
+          const auto* in = frame.ptr<std::uint8_t>(y);
+          auto* out = adjusted.ptr<std::uint8_t>(y);
+          for (int x = 0; x < frame.cols; ++x) {
+            out[x] = cv::saturate_cast<std::uint8_t>(std::lround((128 + o.texture_contrast * (in[x] - 128)) * gain));
+          }
+        }
+        frame = adjusted;
+      }
       const std::string name = std::to_string(tn) + ".png";
       bool ok = false;
       try {

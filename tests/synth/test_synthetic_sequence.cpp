@@ -612,7 +612,36 @@ TEST(SynthSequence, RealCameraOptionsChangeTheFramesAndAreChecked) {
   EXPECT_FALSE(differs(shifted, next));
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(a.interval_rates[4][k], b.interval_rates[5][k], 1e-12);
 
-  for (auto bad : {&SynthOptions::readout_time_s, &SynthOptions::exposure_time_s, &SynthOptions::time_offset_s}) {
+  SynthOptions dimmer = o;
+  dimmer.texture_contrast = 0.1;
+  dimmer.exposure_variation = 0.3;
+  EXPECT_LT(sharpness(frame(dimmer, "dim")), 0.5 * sharpness(global));
+
+  SynthOptions dropping = o;
+  dropping.frames = 30;
+  dropping.drop_fraction = 0.3;
+  const SynthReport d = write_synthetic_sequence(dir.path() / "drops", dropping);
+  EXPECT_LT(d.frames, 30);
+  EXPECT_GT(d.frames, 10);
+  EXPECT_EQ(d.camera_t_ns.size(), static_cast<std::size_t>(d.frames));
+  EXPECT_EQ(d.interval_rates.size(), static_cast<std::size_t>(d.frames - 1));
+  const EurocSequence read = read_euroc(dir.path() / "drops");
+  EXPECT_EQ(read.frames.size(), static_cast<std::size_t>(d.frames));
+
+  SynthOptions walking = o;
+  walking.frames = 40;
+  walking.bias_random_walk = true;
+  write_synthetic_sequence(dir.path() / "walk", walking);
+  const EurocSequence w = read_euroc(dir.path() / "walk");
+  ASSERT_TRUE(w.ground_truth.has_value());
+  const Vec3 first = w.ground_truth->front().gyro_bias, last = w.ground_truth->back().gyro_bias;
+  double moved = 0;
+  for (int k = 0; k < 3; ++k) moved = std::max(moved, std::abs(last[k] - first[k]));
+  EXPECT_GT(moved, 0);
+  EXPECT_LT(moved, 1e-3);  // ≈ 2e-5 rad/s per √s over 2 s
+
+  for (auto bad : {&SynthOptions::readout_time_s, &SynthOptions::exposure_time_s, &SynthOptions::time_offset_s,
+                   &SynthOptions::drop_fraction, &SynthOptions::exposure_variation, &SynthOptions::texture_contrast}) {
     SynthOptions x = o;
     x.*bad = 2.0;
     EXPECT_THROW(x.validate(), Error);

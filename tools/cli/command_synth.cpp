@@ -16,7 +16,8 @@ struct SynthCliOptions {
   int frames = 40;
   std::uint64_t seed = 1;
   double max_rate = 60, time_offset = 0, readout_time = 0, exposure_time = 0;
-  bool no_noise = false, overwrite = false;
+  double drop_fraction = 0, exposure_variation = 0, texture_contrast = 1;
+  bool no_noise = false, overwrite = false, bias_walk = false;
 };
 }  // namespace
 
@@ -35,6 +36,13 @@ Command register_synth(CLI::App& app, const GlobalOptions&) {
   app.add_option("--readout-time", o->readout_time, "rolling shutter: seconds from the first row to the last")
       ->capture_default_str();
   app.add_option("--exposure-time", o->exposure_time, "motion blur: seconds each row is exposed")->capture_default_str();
+  app.add_option("--drop-frames", o->drop_fraction, "leave out each inner frame with this probability")
+      ->capture_default_str();
+  app.add_option("--exposure-variation", o->exposure_variation, "scale each frame's brightness by 1 +- up to this")
+      ->capture_default_str();
+  app.add_option("--texture-contrast", o->texture_contrast, "scale the image contrast (low texture below 1)")
+      ->capture_default_str();
+  app.add_flag("--bias-walk", o->bias_walk, "the gyro bias drifts as a random walk (EuRoC's random walk density)");
   app.add_flag("--no-noise", o->no_noise, "exact IMU: no white noise, no bias");
   app.add_flag("--overwrite", o->overwrite, "replace an existing sequence in OUT_DIR");
   return [o]() {
@@ -50,6 +58,10 @@ Command register_synth(CLI::App& app, const GlobalOptions&) {
     options.time_offset_s = o->time_offset;
     options.readout_time_s = o->readout_time;
     options.exposure_time_s = o->exposure_time;
+    options.drop_fraction = o->drop_fraction;
+    options.exposure_variation = o->exposure_variation;
+    options.texture_contrast = o->texture_contrast;
+    options.bias_random_walk = o->bias_walk;
     options.overwrite = o->overwrite;
     const SynthReport report = write_synthetic_sequence(o->out, options);
     std::printf("wrote %s: %d frames %dx%d (%s motion, %.2f s), %d IMU samples\n", report.mav0.string().c_str(),

@@ -62,8 +62,8 @@ struct GeometricHeadOptions {
   MotionModel model = MotionModel::General;
   RobustLoss loss = RobustLoss::Tukey;
   // σ of the loss in pixels of flow: about the flow's own error. 1 px suits DIS or FlowNet
-  // flow at 752×480; scale it with the image size.
-  double robust_scale_px = 1.0;
+  // flow at 752×480; 0 (the default) scales that with the image: width / 752 px.
+  double robust_scale_px = 0;
   double inlier_threshold_px = 3.0;  // residuals below it count as inliers (diagnostics only)
   int max_iterations = 80;           // reduction passes, all stages (general: typically 20–50)
 
@@ -118,6 +118,7 @@ class GeometricHead {
   RotationEstimate estimate(Queue& queue, const FlowField& flow, double dt);
 
  private:
+  void resolve_scale();
   void check_queue(const Queue& queue) const;
   void check_flow(const Tensor& flow) const;
 

@@ -38,6 +38,16 @@ struct SynthOptions {
   // Motion blur: each row averages 5 renders spread evenly over an exposure this long, centred on
   // the row's time. 0: instantaneous. At most 0.05 s.
   double exposure_time_s = 0;
+  // With noise: the gyro bias also drifts as a random walk with EuRoC's gyroscope_random_walk
+  // (1.9393e-5 rad/s²/√Hz), written to the ground truth's bias columns as it goes.
+  bool bias_random_walk = false;
+  // Frame drops: each frame but the first and the last is left out with this probability (its
+  // stamp and image never written), so intervals vary. 0..0.5.
+  double drop_fraction = 0;
+  // Exposure changes: each frame's brightness is scaled by 1 + u, u uniform in ±this. 0..0.5.
+  double exposure_variation = 0;
+  // Low texture: image contrast about mid-grey is scaled by this (1: the full texture). 0.02..1.
+  double texture_contrast = 1;
   // An existing, non-empty output folder is an error unless this is set; then only its mav0/
   // folder is replaced, whatever else it holds is left alone.
   bool overwrite = false;
