@@ -21,6 +21,7 @@
 #include "inertialnet/runtime/program_cache.hpp"
 #include "inertialnet/runtime/queue.hpp"
 #include "inertialnet/runtime/tensor.hpp"
+#include "inertialnet/runtime/version.hpp"
 
 // ops
 #include "inertialnet/ops/activation.hpp"
