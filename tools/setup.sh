@@ -13,6 +13,7 @@ packages=(
   libopencv-dev libeigen3-dev libopengv-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev
+  python3
 )
 
 missing=()

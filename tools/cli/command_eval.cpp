@@ -5,6 +5,8 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "common.hpp"
+#include "console.hpp"
 #include "inertialnet/eval/evaluate.hpp"
 #include "inertialnet/io/rates_csv.hpp"
 
@@ -21,14 +23,17 @@ Command register_eval(CLI::App& app, const GlobalOptions&) {
   auto o = std::make_shared<EvalCliOptions>();
   app.add_option("rates", o->rates, "rates CSV written by predict")->required()->check(CLI::ExistingFile);
   app.add_option("sequence", o->sequence, "EuRoC sequence with mav0/imu0")->required()->check(CLI::ExistingDirectory);
-  app.add_option("--plot", o->plot, "write time-series plots to this PNG (and histograms beside it, *_hist.png)");
+  app.add_option("--plot", o->plot,
+                 "write time-series plots to this PNG (and histograms beside it, *_hist.png; folders created as "
+                 "needed)");
   app.add_option("--target", o->target, "ground truth at each frame: spline (the paper) or mean (interval mean)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->transform(choice("target", {"spline", "mean"}));
   app.add_option("--gyro-bias", o->gyro_bias, "gyro bias x,y,z in rad/s (IMU frame); default: ground truth or static start");
   app.add_flag("--camera-frame", o->camera_frame, "rotate the gyro into the camera frame with cam0's T_BS");
   app.add_option("--head", o->head, "compare columns wx<_HEAD>…, e.g. --head geometric");
-  app.add_flag("--json", o->json, "machine-readable report");
-  app.add_flag("--series", o->series, "with --json: include the per-frame values");
+  auto* json = app.add_flag("--json", o->json, "machine-readable report (schema inertialnet.eval/1, docs/cli.md)");
+  app.add_flag("--series", o->series, "include the per-frame values in the --json report")->needs(json);
   return [o]() {
     EvalOptions options;
     options.sync.target = parse_sync_target(o->target);
@@ -38,6 +43,7 @@ Command register_eval(CLI::App& app, const GlobalOptions&) {
       options.sync.gyro_bias = parse_vec3(o->gyro_bias, "--gyro-bias");
     }
     options.plot = o->plot;
+    if (!o->plot.empty()) prepare_output_file(o->plot, "--plot");
     // A CSV from `predict --head both` holds two estimators: without --head, report both.
     std::vector<std::string> suffixes;
     if (!o->head.empty()) {
@@ -49,7 +55,7 @@ Command register_eval(CLI::App& app, const GlobalOptions&) {
         if (name.rfind("wx_", 0) == 0) suffixes.push_back(name.substr(2));
       }
     }
-    std::string json = suffixes.size() > 1 ? "[\n" : "";
+    std::vector<EvalReport> reports;
     for (std::size_t i = 0; i < suffixes.size(); ++i) {
       options.head_suffix = suffixes[i];
       if (i > 0 && !o->plot.empty()) {
@@ -58,14 +64,11 @@ Command register_eval(CLI::App& app, const GlobalOptions&) {
         options.plot = plot.parent_path() / (plot.stem().string() + suffixes[i] + plot.extension().string());
       }
       const EvalReport report = evaluate(o->rates, o->sequence, options);
-      if (o->json) {
-        json += report.json(o->series) + (i + 1 < suffixes.size() ? ",\n" : "");
-      } else {
-        std::cout << (i ? "\n" : "") << report.table();
-      }
-      for (const auto& w : report.warnings) std::cerr << "inertialnet: warning: " << w << "\n";
+      if (!o->json) std::cout << (i ? "\n" : "") << report.table();
+      for (const auto& w : report.warnings) warning(w);
+      reports.push_back(report);
     }
-    if (o->json) std::cout << json << (suffixes.size() > 1 ? "]\n" : "");
+    if (o->json) std::cout << format_eval_json(reports, o->series);
     return 0;
   };
 }
