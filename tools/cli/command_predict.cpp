@@ -69,8 +69,9 @@ void warm_up(const std::string& sequence, double rate_hz, const std::vector<Devi
     PairResult discarded;
     factory(*device, 0)->process(first, second, discarded, keep_going);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    info("warm-up pair on " + device->info().name + ": " + std::to_string(seconds) +
-         " s (kernel compile and planning; not counted below)");
+    char text[32];
+    std::snprintf(text, sizeof text, "%.2f", seconds);
+    info("warm-up pair on " + device->info().name + ": " + text + " s (kernel compile and planning; not counted below)");
   }
 }
 
