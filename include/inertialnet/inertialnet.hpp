@@ -16,10 +16,12 @@
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/runtime/kernel_defines.hpp"
 #include "inertialnet/runtime/layer_profiler.hpp"
+#include "inertialnet/runtime/log.hpp"
 #include "inertialnet/runtime/opencl.hpp"
 #include "inertialnet/runtime/program_cache.hpp"
 #include "inertialnet/runtime/queue.hpp"
 #include "inertialnet/runtime/tensor.hpp"
+#include "inertialnet/runtime/version.hpp"
 
 // ops
 #include "inertialnet/ops/activation.hpp"

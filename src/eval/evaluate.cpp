@@ -20,7 +20,8 @@ std::string fmt3(const Vec3& v, const char* format = "%.2f") {
   return std::string("(") + a + ", " + b + ", " + c + ")";
 }
 
-nlohmann::json vec_json(const Vec3& v) { return nlohmann::json::array({v[0], v[1], v[2]}); }
+// Named axes, never positions or joined strings: the schema stays readable and extensible.
+nlohmann::json vec_json(const Vec3& v) { return {{"x", v[0]}, {"y", v[1]}, {"z", v[2]}}; }
 
 nlohmann::json stats_json(const ErrorStats& s) {
   return {{"frames", s.frames},
@@ -47,7 +48,8 @@ EvalReport evaluate(const RatesTable& rates, const EurocSequence& seq, const Eva
   r.imu_samples = seq.imu.size();
   r.warnings = seq.warnings;
   std::vector<Vec3> predicted = rates.rates(options.head_suffix);
-  r.head = "wx" + options.head_suffix + ",wy" + options.head_suffix + ",wz" + options.head_suffix;
+  r.estimator = options.head_suffix.empty() ? std::string() : options.head_suffix.substr(1);
+  r.columns = {"wx" + options.head_suffix, "wy" + options.head_suffix, "wz" + options.head_suffix};
   SyncOptions sync = options.sync;
   std::vector<std::string> notes;
 
@@ -217,13 +219,20 @@ EvalReport evaluate(const RatesTable& rates, const EurocSequence& seq, const Eva
     for (std::size_t i = 0; i < t_s.size(); ++i) t_s[i] = static_cast<double>(r.t_ns[i] - r.t_ns.front()) * 1e-9;
     PlotStyle style = options.style;
     if (has_bias && style.truth_label == PlotStyle{}.truth_label) style.truth_label += " - bias";
+    // One figure per estimator (eval writes out.png, out_geometric.png, …): each names its own.
+    const std::string which = r.estimator.empty() ? std::string() : ", " + r.estimator + " head";
+    if (!r.estimator.empty() && style.predicted_label == PlotStyle{}.predicted_label) {
+      style.predicted_label += " (" + r.estimator + ")";
+    }
     const std::string frame = r.camera_frame ? "camera frame" : "IMU frame";
     plot_rates(options.plot, t_s, r.predicted, r.truth_corrected,
-               seq.name + ": angular rate (" + frame + ", target: " + to_string(r.target) + ")", style);
+               seq.name + ": angular rate (" + frame + ", target: " + to_string(r.target) + which + ")", style);
     r.plots.push_back(options.plot.string());
     const auto hist = histogram_path(options.plot);
     plot_error_histograms(hist, r.histograms,
-                          seq.name + ": prediction error" + (has_bias ? " (against gyro - bias)" : ""), style);
+                          seq.name + ": prediction error" + (has_bias ? " (against gyro - bias" + which + ")" :
+                                                              (which.empty() ? "" : " (" + which.substr(2) + ")")),
+                          style);
     r.plots.push_back(hist.string());
   }
   return r;
@@ -242,7 +251,7 @@ EvalReport evaluate(const std::filesystem::path& rates_csv, const std::filesyste
 
 std::string EvalReport::table() const {
   std::string s = "Evaluation of " + (rates_file.empty() ? std::string("predicted rates") : rates_file) +
-                  " (" + head + ") on " + sequence + "\n";
+                  " (" + columns[0] + "," + columns[1] + "," + columns[2] + ") on " + sequence + "\n";
   s += "  frames evaluated: " + std::to_string(frames_evaluated()) + " of " +
        std::to_string(rate_rows) + " rates rows (" + std::to_string(frames_in_sequence) +
        " frames in the sequence)\n";
@@ -278,9 +287,10 @@ std::string EvalReport::table() const {
 
 std::string EvalReport::json(bool include_series) const {
   nlohmann::json j;
+  j["estimator"] = estimator;
+  j["columns"] = {{"x", columns[0]}, {"y", columns[1]}, {"z", columns[2]}};
   j["sequence"] = sequence;
   j["rates_file"] = rates_file;
-  j["head"] = head;
   j["rate_rows"] = rate_rows;
   j["frames_in_sequence"] = frames_in_sequence;
   j["frames_evaluated"] = frames_evaluated();
@@ -304,7 +314,7 @@ std::string EvalReport::json(bool include_series) const {
   j["raw"] = stats_json(raw);
   j["bias_corrected"] = corrected ? stats_json(*corrected) : nlohmann::json(nullptr);
   nlohmann::json hist = nlohmann::json::object();
-  static const char* axes[3] = {"wx", "wy", "wz"};
+  static const char* axes[3] = {"x", "y", "z"};
   hist["lo_deg_s"] = histograms[0].lo;
   hist["hi_deg_s"] = histograms[0].hi;
   hist["bins"] = histograms[0].bins();
@@ -327,6 +337,16 @@ std::string EvalReport::json(bool include_series) const {
     j["series"] = series;
   }
   return j.dump(2);
+}
+
+std::string format_eval_json(const std::vector<EvalReport>& reports, bool include_series) {
+  nlohmann::json doc;
+  doc["schema"] = kEvalJsonSchema;
+  doc["rates_file"] = reports.empty() ? std::string() : reports.front().rates_file;
+  doc["sequence"] = reports.empty() ? std::string() : reports.front().sequence;
+  doc["estimators"] = nlohmann::json::array();
+  for (const auto& r : reports) doc["estimators"].push_back(nlohmann::json::parse(r.json(include_series)));
+  return doc.dump(2) + "\n";
 }
 
 }  // namespace inertialnet

@@ -23,10 +23,12 @@ const cv::Scalar kBar(190, 130, 60);
 constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
 constexpr double kTickScale = 0.5, kLabelScale = 0.6, kTitleScale = 0.8;
 constexpr int kShift = 4;                   // sub-pixel bits for anti-aliased polylines
+constexpr int kTruthThickness = 4;          // pixels; the prediction is drawn 1 px wide on top
 
-// A "nice" tick step (1, 2 or 5 × 10^k) giving about `target` ticks over `range`.
-double tick_step(double range, int target) {
-  const double raw = range / target;
+// A "nice" tick step (1, 2 or 5 × 10^k) giving about `target` ticks over `range`. On a count axis
+// (`integer`) the step is a whole number: no tick for half a frame.
+double tick_step(double range, int target, bool integer = false) {
+  const double raw = integer ? std::max(1.0, range / target) : range / target;
   const double p = std::pow(10.0, std::floor(std::log10(raw)));
   for (double m : {1.0, 2.0, 5.0}) {
     if (m * p >= raw) return m * p;
@@ -81,9 +83,9 @@ struct Panel {
 
 // Grid, ticks, tick labels, frame and labels of a panel.
 void draw_axes(cv::Mat& img, const Panel& p, const std::string& xlabel, const std::string& ylabel,
-               const std::string& title, bool zero_line) {
+               const std::string& title, bool zero_line, bool integer_y = false) {
   const double xs = tick_step(p.x1 - p.x0, std::max(2, p.area.width / 90));
-  const double ys = tick_step(p.y1 - p.y0, std::max(2, p.area.height / 45));
+  const double ys = tick_step(p.y1 - p.y0, std::max(2, p.area.height / 45), integer_y);
   const int bottom = p.area.y + p.area.height, right = p.area.x + p.area.width;
   for (double x = std::ceil(p.x0 / xs - 1e-9) * xs; x <= p.x1 + xs * 1e-9; x += xs) {
     const int X = p.px(x);
@@ -121,28 +123,34 @@ void draw_title(cv::Mat& img, const std::string& title) {
   put(img, title, {img.cols / 2 - ts.width / 2, 12 + ts.height}, kTitleScale, kBlack, 2);
 }
 
-void draw_legend(cv::Mat& img, const cv::Rect& area, const std::vector<std::pair<std::string, cv::Scalar>>& items) {
+struct LegendItem {
+  std::string label;
+  cv::Scalar colour;
+  int thickness;
+};
+
+void draw_legend(cv::Mat& img, const cv::Rect& area, const std::vector<LegendItem>& items) {
   int w = 0;
-  for (const auto& it : items) w = std::max(w, text_size(it.first, kTickScale).width);
+  for (const auto& it : items) w = std::max(w, text_size(it.label, kTickScale).width);
   const int row = 22, box_w = w + 60, box_h = row * static_cast<int>(items.size()) + 10;
   const cv::Rect box(area.x + area.width - box_w - 10, area.y + 10, box_w, box_h);
   cv::rectangle(img, box, kWhite, cv::FILLED);
   cv::rectangle(img, box, kAxisGrey, 1);
   for (std::size_t i = 0; i < items.size(); ++i) {
     const int y = box.y + 5 + row * static_cast<int>(i) + row / 2;
-    cv::line(img, {box.x + 8, y}, {box.x + 40, y}, items[i].second, 2, cv::LINE_AA);
-    put(img, items[i].first, {box.x + 48, y + 5}, kTickScale, kBlack);
+    cv::line(img, {box.x + 8, y}, {box.x + 40, y}, items[i].colour, items[i].thickness, cv::LINE_AA);
+    put(img, items[i].label, {box.x + 48, y + 5}, kTickScale, kBlack);
   }
 }
 
 void polyline(cv::Mat& img, const Panel& p, const std::vector<double>& t, const std::vector<Vec3>& v,
-              int axis, const cv::Scalar& colour) {
+              int axis, const cv::Scalar& colour, int thickness) {
   std::vector<cv::Point> pts(t.size());
   for (std::size_t i = 0; i < t.size(); ++i) pts[i] = p.map(t[i], v[i][axis] * kDegreesPerRadian);
   cv::Mat clip = img(p.area);  // drawing into the panel's view keeps lines inside its frame
   const cv::Point offset(p.area.x << kShift, p.area.y << kShift);
   for (auto& q : pts) q -= offset;
-  cv::polylines(clip, pts, false, colour, 1, cv::LINE_AA, kShift);
+  cv::polylines(clip, pts, false, colour, thickness, cv::LINE_AA, kShift);
 }
 
 // Encoded in memory and written by the one atomic writer: OpenCV's own writer truncates the target
@@ -198,10 +206,13 @@ void plot_rates(const std::filesystem::path& png, const std::vector<double>& t_s
     const double pad = std::max(0.05 * (hi - lo), 1e-3);
     Panel p{cv::Rect(left, top + k * (panel_h + gap), style.width - left - right, panel_h), t0, t1, lo - pad, hi + pad};
     draw_axes(img, p, k == 2 ? "time [s]" : "", std::string(names[k]) + " [deg/s]", "", true);
-    polyline(img, p, t_s, truth, k, kTruth);
-    polyline(img, p, t_s, predicted, k, kPredicted);
+    // The truth wider and underneath: where the prediction agrees with it, it shows on both sides.
+    polyline(img, p, t_s, truth, k, kTruth, kTruthThickness);
+    polyline(img, p, t_s, predicted, k, kPredicted, 1);
     cv::rectangle(img, p.area, kAxisGrey, 1);
-    if (k == 0) draw_legend(img, p.area, {{style.predicted_label, kPredicted}, {style.truth_label, kTruth}});
+    if (k == 0) {
+      draw_legend(img, p.area, {{style.predicted_label, kPredicted, 2}, {style.truth_label, kTruth, kTruthThickness}});
+    }
   }
   write_png(png, img);
 }
@@ -223,7 +234,7 @@ void plot_error_histograms(const std::filesystem::path& png, const std::array<Hi
     Panel p{cv::Rect(left + k * (panel_w + gap), top, panel_w, style.height - top - bottom), h.lo, h.hi, 0,
             static_cast<double>(peak) * 1.08};
     draw_axes(img, p, std::string("error ") + names[k] + " [deg/s]", k == 0 ? "frames" : "",
-              std::string(names[k]), false);
+              std::string(names[k]), false, true);
     for (std::size_t b = 0; b < h.bins(); ++b) {
       if (h.counts[b] == 0) continue;
       const int x0 = p.px(h.edge(b)), x1 = p.px(h.edge(b + 1));

@@ -11,6 +11,7 @@
 #include <unordered_map>
 
 #include "inertialnet/runtime/error.hpp"
+#include "inertialnet/runtime/log.hpp"
 
 namespace inertialnet::detail {
 
@@ -68,8 +69,9 @@ std::string apply_clblast_tuning(const DeviceInfo& device) {
     const auto status = clblast::OverrideParameters(device.device_id, entry->kernel, clblast::Precision::kSingle,
                                                     parameters);
     if (status != clblast::StatusCode::kSuccess) {
-      std::fprintf(stderr, "inertialnet: warning: CLBlast refused the %s parameters for '%s' (%s); using its defaults\n",
-                   entry->kernel, device.name.c_str(), clblast_status_name(static_cast<int>(status)).c_str());
+      log_message(LogLevel::Warning, std::string("CLBlast refused the ") + entry->kernel + " parameters for '" +
+                                         device.name + "' (" + clblast_status_name(static_cast<int>(status)) +
+                                         "); using its defaults");
     }
   }
   return description;

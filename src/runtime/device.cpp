@@ -2,6 +2,7 @@
 
 #include <cstdlib>
 
+#include "inertialnet/runtime/log.hpp"
 #include "inertialnet/runtime/queue.hpp"
 #include "runtime/clblast_tuning.hpp"
 
@@ -11,8 +12,8 @@ namespace {
 
 void CL_CALLBACK report_context_error(const char* message, const void*, std::size_t, void*) {
   // Drivers report asynchronous failures (e.g. a kernel fault) here; the failing call also
-  // returns an error, which is what the user sees. Keep the driver's words on stderr.
-  std::fprintf(stderr, "inertialnet: OpenCL driver: %s\n", message);
+  // returns an error, which is what the user sees. Keep the driver's words for the user too.
+  log_message(LogLevel::Warning, std::string("OpenCL driver: ") + message);
 }
 
 DiskCacheMode effective_cache_mode(DiskCacheMode requested) {

@@ -151,8 +151,7 @@ std::string format_device_json(const std::vector<DeviceInfo>& devices) {
   nlohmann::json list = nlohmann::json::array();
   for (const auto& d : devices) {
     list.push_back({{"index", d.index},
-                    {"platform_index", d.platform_index},
-                    {"device_index", d.device_index},
+                    {"address", d.address()},
                     {"platform", d.platform_name},
                     {"platform_version", d.platform_version},
                     {"platform_vendor", d.platform_vendor},
@@ -169,7 +168,7 @@ std::string format_device_json(const std::vector<DeviceInfo>& devices) {
                     {"max_work_group_size", d.max_work_group_size},
                     {"fp16", d.fp16}});
   }
-  return list.dump(2) + "\n";
+  return nlohmann::json{{"schema", kDevicesJsonSchema}, {"devices", list}}.dump(2) + "\n";
 }
 
 }  // namespace inertialnet

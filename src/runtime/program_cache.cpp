@@ -1,6 +1,7 @@
 #include "inertialnet/runtime/program_cache.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -8,6 +9,7 @@
 #include <sstream>
 
 #include "inertialnet/runtime/error.hpp"
+#include "inertialnet/runtime/log.hpp"
 #include "runtime/atomic_file.hpp"
 #include "runtime/embedded_kernels.hpp"
 #include "runtime/hash.hpp"
@@ -116,9 +118,26 @@ cl_program ProgramCache::program_from_source(const std::string& name, const std:
   if (disk_enabled_) program = load_binary(file, key, options);
   if (program) {
     ++stats_.disk_hits;
+    if (log_enabled(LogLevel::Debug)) {
+      log_message(LogLevel::Debug, "loaded kernel family '" + name + "' (" + options + ") for " + device_.name +
+                                       " from " + file.string());
+    }
   } else {
+    // A first run compiles for tens of seconds: say so once per device, before the silence.
+    if (!announced_compile_) {
+      announced_compile_ = true;
+      log_message(LogLevel::Info, "compiling OpenCL kernels for " + device_.name +
+                                      (disk_enabled_ ? " (first run; cached in " + directory_.string() + ")"
+                                                     : std::string(" (program cache off)")));
+    }
+    const auto start = std::chrono::steady_clock::now();
     program = build(name, source, options);
     ++stats_.source_builds;
+    if (log_enabled(LogLevel::Debug)) {
+      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      log_message(LogLevel::Debug, "compiled kernel family '" + name + "' (" + options + ") for " + device_.name +
+                                       " in " + std::to_string(seconds) + " s");
+    }
     if (disk_enabled_) store_binary(program.get(), file, key);
   }
   return programs_.emplace(key, std::move(program)).first->second.get();

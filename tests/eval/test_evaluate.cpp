@@ -96,19 +96,27 @@ TEST_F(Evaluate, TableAndJson) {
   EXPECT_EQ(j["target"], "spline");
   EXPECT_EQ(j["frame"], "camera");
   EXPECT_EQ(j["bias"]["source"], "ground_truth");
-  EXPECT_NEAR(j["bias"]["imu_frame_rad_s"][2].get<double>(), 0.0789, 1e-12);
-  EXPECT_NEAR(j["bias_corrected"]["rmse_deg_s"][1].get<double>(), 0.05 * kDegreesPerRadian, 1e-6);
+  EXPECT_NEAR(j["bias"]["imu_frame_rad_s"]["z"].get<double>(), 0.0789, 1e-12);
+  EXPECT_NEAR(j["bias_corrected"]["rmse_deg_s"]["y"].get<double>(), 0.05 * kDegreesPerRadian, 1e-6);
   EXPECT_EQ(j["series"].size(), 100u);
   EXPECT_EQ(j["series"][0]["timestamp_ns"].get<std::int64_t>(), seq.frames[1].t_ns);
-  EXPECT_EQ(j["error_histogram"]["wx"]["counts"].size(), 41u);
+  EXPECT_EQ(j["error_histogram"]["x"]["counts"].size(), 41u);
   EXPECT_FALSE(nlohmann::json::parse(r.json()).contains("series"));
+
+  // The document: one object whatever the number of estimators, with the schema's name.
+  const auto doc = nlohmann::json::parse(format_eval_json({r, r}, false));
+  EXPECT_EQ(doc["schema"], "inertialnet.eval/1");
+  ASSERT_EQ(doc["estimators"].size(), 2u);
+  EXPECT_EQ(doc["estimators"][1]["columns"]["z"], "wz");
+  EXPECT_TRUE(nlohmann::json::parse(format_eval_json({r}, false))["estimators"].is_array());
 }
 
 TEST_F(Evaluate, SecondHeadAndNoBias) {
   options.head_suffix = "_zero";
   options.sync.bias = BiasSource::None;
   const EvalReport r = evaluate(predictions(seq, SyncTarget::Spline), seq, options);
-  EXPECT_EQ(r.head, "wx_zero,wy_zero,wz_zero");
+  EXPECT_EQ(r.estimator, "zero");
+  EXPECT_EQ(r.columns, (std::array<std::string, 3>{"wx_zero", "wy_zero", "wz_zero"}));
   EXPECT_FALSE(r.corrected.has_value());
   EXPECT_GT(r.raw.rmse[0], 1.0);  // zero prediction against a moving signal
 }

@@ -144,3 +144,46 @@ TEST(Plots, AFailedWriteKeepsThePreviousPlotAndNamesIt) {
   }
   EXPECT_TRUE(std::filesystem::is_fifo(std::filesystem::symlink_status(fifo)));
 }
+
+// Where the prediction equals the truth, the truth (drawn wider, underneath) still shows.
+TEST(Plots, TruthStaysVisibleUnderAnEqualPrediction) {
+  te::TempDir dir("plots_equal");
+  std::vector<double> t;
+  std::vector<Vec3> g;
+  for (int i = 0; i < 400; ++i) {
+    t.push_back(0.05 * i);
+    g.push_back({0.5 * std::sin(0.09 * i), 0.3 * std::cos(0.05 * i), 0.2 * std::sin(0.02 * i)});
+  }
+  const auto png = dir.path() / "equal.png";
+  plot_rates(png, t, g, g, "equal");
+  const cv::Mat img = cv::imread(png.string(), cv::IMREAD_COLOR);
+  ASSERT_FALSE(img.empty());
+  const int truth = count_colour(img, {160, 90, 20});
+  const int predicted = count_colour(img, {40, 40, 215});
+  EXPECT_GT(predicted, 500);
+  EXPECT_GT(truth, predicted) << "the truth is hidden under the prediction";
+}
+
+// A count axis has whole-number ticks: with at most 2 frames in a bin, the ticks are 0, 1, 2.
+TEST(Plots, HistogramCountAxisHasIntegerTicks) {
+  te::TempDir dir("plots_ticks");
+  std::array<Histogram, 3> hists;
+  for (auto& h : hists) {
+    h.lo = -5;
+    h.hi = 5;
+    h.counts.assign(10, 0);
+    h.counts[4] = 2;
+    h.counts[6] = 1;
+  }
+  const auto png = dir.path() / "hist.png";
+  plot_error_histograms(png, hists, "ticks");
+  const cv::Mat img = cv::imread(png.string(), cv::IMREAD_COLOR);
+  ASSERT_FALSE(img.empty());
+  // The y tick marks of the first panel: 5-pixel grey dashes left of its frame (left margin 100).
+  int ticks = 0;
+  for (int y = 0; y < img.rows; ++y) {
+    const cv::Vec3b p = img.at<cv::Vec3b>(y, 97);
+    if (p[0] == 90 && p[1] == 90 && p[2] == 90) ++ticks;
+  }
+  EXPECT_EQ(ticks, 3);
+}

@@ -2,6 +2,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "inertialnet/runtime/log.hpp"
 #include "support/testing.hpp"
 
 namespace inertialnet {
@@ -59,6 +60,30 @@ TEST_F(ProgramCacheTest, SecondBuildIsADiskHit) {
   EXPECT_EQ(stats.disk_hits, 1u);
   EXPECT_EQ(stats.source_builds, 0u);
   EXPECT_EQ(stats.disk_rejected, 0u);
+}
+
+// A first run says once per device that it compiles (its tens of seconds are otherwise silent);
+// a run served from the cache says nothing. Seen through the library's log sink.
+TEST_F(ProgramCacheTest, CompilingIsAnnouncedOnceAndACacheHitIsSilent) {
+  std::vector<std::pair<LogLevel, std::string>> messages;
+  set_log_sink([&messages](LogLevel level, const std::string& message) { messages.emplace_back(level, message); });
+  {
+    auto device = open_with_cache(directory_);
+    device->programs().program("elementwise", "-DVARIANT=1");
+    device->programs().program("elementwise", "-DVARIANT=2");
+    ASSERT_EQ(messages.size(), 1u);
+    EXPECT_EQ(messages[0].first, LogLevel::Info);
+    EXPECT_EQ(messages[0].second, "compiling OpenCL kernels for " + device->info().name + " (first run; cached in " +
+                                      directory_.string() + ")");
+  }
+  messages.clear();
+  {
+    auto device = open_with_cache(directory_);
+    device->programs().program("elementwise", "-DVARIANT=1");
+    EXPECT_EQ(device->programs().stats().disk_hits, 1u);
+  }
+  EXPECT_TRUE(messages.empty()) << messages.front().second;
+  set_log_sink({});
 }
 
 TEST_F(ProgramCacheTest, OptionsAreKeyedSeparately) {

@@ -9,6 +9,7 @@
 #include "bench_report.hpp"
 #include "commands.hpp"
 #include "common.hpp"
+#include "console.hpp"
 #include "inertialnet/models/flownet.hpp"
 #include "inertialnet/models/inertialnet_head.hpp"
 #include "inertialnet/runtime/device_selection.hpp"
@@ -102,6 +103,7 @@ BenchResult run_bench(const DeviceInfo& info, const GlobalOptions& global, const
     pair(queue, true);
     progress.update(static_cast<std::size_t>(i + 1));
   }
+  progress.finish();
   for (double* stage : {&r.upload, &r.flow, &r.head_seconds, &r.download}) *stage /= o.pairs;
 
   // One more pair on a profiling queue, layer by layer.
@@ -125,7 +127,7 @@ BenchResult run_bench(const DeviceInfo& info, const GlobalOptions& global, const
 
 Command register_bench(CLI::App& app, const GlobalOptions& global) {
   auto o = std::make_shared<BenchOptions>();
-  app.add_option("--model", o->model, "FlowNet2, FlowNet2-C, -S, -SD, -CS or -CSS")->capture_default_str();
+  app.add_option("--model", o->model, "flow network")->capture_default_str()->transform(choice("model", flow_model_names()));
   app.add_option("--size", o->size, "frame size WIDTHxHEIGHT")->capture_default_str();
   app.add_option("--pairs", o->pairs, "timed frame pairs (after one warm-up pair)")
       ->capture_default_str()
@@ -136,8 +138,7 @@ Command register_bench(CLI::App& app, const GlobalOptions& global) {
     const auto infos = select_devices(device_spec_or_environment(global.device), discover_devices());
     model_kind_from_string(o->model);  // a bad model or size is a usage error before any device work
     parse_size(o->size);
-    std::cerr << "inertialnet: note: bench runs synthetic weights: the timing is that of trained weights, the flow "
-                 "is not a measurement\n";
+    info("note: bench runs synthetic weights: the timing is that of trained weights, the flow is not a measurement");
     std::vector<BenchResult> results;
     for (const auto& info : infos) {
       results.push_back(run_bench(info, global, *o));

@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "console.hpp"
 #include "inertialnet/eval/evaluate.hpp"
 #include "inertialnet/io/frame_source.hpp"
 #include "inertialnet/pipeline/pipeline.hpp"
@@ -37,8 +38,8 @@ RatesTable predict_weight_free(const std::string& sequence, const GlobalOptions&
   Device device(select_device(device_spec_or_environment(global.device), discover_devices()), device_options);
   RatesTable table;
   table.metadata = {{"frame", "body"}, {"estimator", "inter_frame"}};
-  std::cerr << "inertialnet: no rates file given: predicting " << source->size() - 1
-            << " pairs with DIS flow + the geometric head\n";
+  info("no rates file given: predicting " + std::to_string(source->size() - 1) +
+       " pairs with DIS flow + the geometric head");
   run_pipeline(*source, {&device}, rates_processor({}, processor), [&](const PairResult& r) {
     const auto& w = r.rates.front().second;
     table.t_ns.push_back(r.t1_ns);
@@ -70,7 +71,7 @@ Command register_calibrate_time(CLI::App& app, const GlobalOptions& global) {
     std::cout << e.summary() << "\n";
     std::printf("time_offset_s %.6f\nstd_error_s %.6f\nconfidence %s\n", e.offset_s, e.std_error_s, e.confidence().c_str());
     std::cout << "apply it with: inertialnet eval RATES.csv " << o->sequence << " --time-offset " << e.offset_s << "\n";
-    for (const auto& w : report.warnings) std::cerr << "inertialnet: warning: " << w << "\n";
+    for (const auto& w : report.warnings) warning(w);
     return 0;
   };
 }

@@ -6,18 +6,19 @@
 #include "commands.hpp"
 #include "inertialnet/runtime/device_info.hpp"
 #include "inertialnet/runtime/device_selection.hpp"
+#include "inertialnet/runtime/log.hpp"
 
 namespace inertialnet::cli {
 
 Command register_devices(CLI::App& app, const GlobalOptions& global) {
   auto json = std::make_shared<bool>(false);
-  app.add_flag("--json", *json, "machine-readable output");
+  app.add_flag("--json", *json, "machine-readable output (schema inertialnet.devices/1, docs/cli.md)");
   return [json, &global]() {
     const auto devices = discover_devices();
     if (devices.empty()) {
-      if (*json) std::cout << "[]\n";
-      std::cerr << "inertialnet: no OpenCL device found; install a driver, e.g. `apt-get install pocl-opencl-icd` "
-                   "for the CPU\n";
+      if (*json) std::cout << format_device_json(devices);
+      log_message(LogLevel::Error, "no OpenCL device found; install a driver, e.g. `apt-get install pocl-opencl-icd` "
+                                   "for the CPU");
       return 1;
     }
     const std::string spec = device_spec_or_environment(global.device);

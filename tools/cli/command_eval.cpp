@@ -5,6 +5,8 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "common.hpp"
+#include "console.hpp"
 #include "inertialnet/eval/evaluate.hpp"
 #include "inertialnet/io/rates_csv.hpp"
 
@@ -22,10 +24,13 @@ Command register_eval(CLI::App& app, const GlobalOptions&) {
   auto o = std::make_shared<EvalCliOptions>();
   app.add_option("rates", o->rates, "rates CSV written by predict")->required()->check(CLI::ExistingFile);
   app.add_option("sequence", o->sequence, "EuRoC sequence with mav0/imu0")->required()->check(CLI::ExistingDirectory);
-  app.add_option("--plot", o->plot, "write time-series plots to this PNG (and histograms beside it, *_hist.png)");
+  app.add_option("--plot", o->plot,
+                 "write time-series plots to this PNG (and histograms beside it, *_hist.png; folders created as "
+                 "needed)");
   app.add_option("--target", o->target,
                  "ground truth at each frame: spline (the paper) or mean (interval mean); default: the one that fits "
-                 "the estimator the rates file states (mean for an inter-frame rotation), else spline");
+                 "the estimator the rates file states (mean for an inter-frame rotation), else spline")
+      ->transform(choice("target", {"spline", "mean"}));
   app.add_option("--time-offset", o->time_offset,
                  "camera-IMU time offset in seconds (t_imu = t_cam + offset), or auto to estimate it from the data; "
                  "default: what the rates file states, else 0");
@@ -37,8 +42,8 @@ Command register_eval(CLI::App& app, const GlobalOptions&) {
                  "default: ground truth, else a static start (vibration allowed when the images show no rotation)");
   app.add_flag("--camera-frame", o->camera_frame, "rotate the gyro into the camera frame with cam0's T_BS");
   app.add_option("--head", o->head, "compare columns wx<_HEAD>…, e.g. --head geometric");
-  app.add_flag("--json", o->json, "machine-readable report");
-  app.add_flag("--series", o->series, "with --json: include the per-frame values");
+  auto* json = app.add_flag("--json", o->json, "machine-readable report (schema inertialnet.eval/1, docs/cli.md)");
+  app.add_flag("--series", o->series, "include the per-frame values in the --json report")->needs(json);
   return [o]() {
     EvalOptions options;
     options.choose_target = o->target.empty();
@@ -58,6 +63,7 @@ Command register_eval(CLI::App& app, const GlobalOptions&) {
       options.sync.gyro_bias = parse_vec3(o->gyro_bias, "--gyro-bias");
     }
     options.plot = o->plot;
+    if (!o->plot.empty()) prepare_output_file(o->plot, "--plot");
     // A CSV from `predict --head both` holds two estimators: without --head, report both.
     std::vector<std::string> suffixes;
     if (!o->head.empty()) {
@@ -69,7 +75,7 @@ Command register_eval(CLI::App& app, const GlobalOptions&) {
         if (name.rfind("wx_", 0) == 0) suffixes.push_back(name.substr(2));
       }
     }
-    std::string json = suffixes.size() > 1 ? "[\n" : "";
+    std::vector<EvalReport> reports;
     for (std::size_t i = 0; i < suffixes.size(); ++i) {
       options.head_suffix = suffixes[i];
       if (i > 0 && !o->plot.empty()) {
@@ -79,17 +85,14 @@ Command register_eval(CLI::App& app, const GlobalOptions&) {
       }
       const EvalReport report = evaluate(o->rates, o->sequence, options);
       if (!o->json) {
-        std::cerr << "inertialnet: target " << to_string(report.target)
-                  << (o->target.empty() ? " (chosen for the estimator; --target spline|mean to change it)" : "") << "\n";
-      }
-      if (o->json) {
-        json += report.json(o->series) + (i + 1 < suffixes.size() ? ",\n" : "");
-      } else {
+        info("target " + to_string(report.target) +
+             (o->target.empty() ? " (chosen for the estimator; --target spline|mean to change it)" : ""));
         std::cout << (i ? "\n" : "") << report.table();
       }
-      for (const auto& w : report.warnings) std::cerr << "inertialnet: warning: " << w << "\n";
+      for (const auto& w : report.warnings) warning(w);
+      reports.push_back(report);
     }
-    if (o->json) std::cout << json << (suffixes.size() > 1 ? "]\n" : "");
+    if (o->json) std::cout << format_eval_json(reports, o->series);
     return 0;
   };
 }

@@ -1,5 +1,6 @@
 // `inertialnet predict SEQ`: angular rates for every frame pair of a sequence, through the
 // pipelined scheduler, as a rates CSV (timestamp_ns,wx,wy,wz; rad/s; stamped with t_k).
+#include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -9,6 +10,7 @@
 
 #include "commands.hpp"
 #include "common.hpp"
+#include "console.hpp"
 #include "inertialnet/runtime/device_selection.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/runtime/layer_profiler.hpp"
@@ -55,6 +57,26 @@ ModelKind flow_model_of(const WeightSet& weights, const std::string& requested) 
   return ModelKind::FlowNet2;
 }
 
+// One pair (the first) through a processor of each device, untimed: kernels compile and the
+// networks plan their memory here, so the timed run measures pairs only. The sequence is opened
+// again because a video source decodes in order from its start.
+void warm_up(const std::string& sequence, double rate_hz, const std::vector<Device*>& devices,
+             const ProcessorFactory& factory) {
+  auto source = open_frame_source(sequence, rate_hz > 0 ? std::optional<double>(rate_hz) : std::nullopt);
+  const Frame first{0, source->timestamp_ns(0), source->decode(0)};
+  const Frame second{1, source->timestamp_ns(1), source->decode(1)};
+  const std::atomic<bool> keep_going{false};
+  for (Device* device : devices) {
+    const auto start = std::chrono::steady_clock::now();
+    PairResult discarded;
+    factory(*device, 0)->process(first, second, discarded, keep_going);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    char text[32];
+    std::snprintf(text, sizeof text, "%.2f", seconds);
+    info("warm-up pair on " + device->info().name + ": " + text + " s (kernel compile and planning; not counted below)");
+  }
+}
+
 const char* kNoWeightsHelp =
     "Convert a flownet2-pytorch checkpoint with `python3 tools/convert_checkpoint.py FlowNet2_checkpoint.pth.tar "
     "flownet2.safetensors` (and the head the same way), or write synthetic weights for a trial run with "
@@ -85,17 +107,20 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
   app.add_option("sequence", o->sequence, "EuRoC folder, image folder or video")->required();
   app.add_option("-w,--weights", o->weights,
                  "weights (safetensors) holding FlowNet2 and/or the InertialNet head; repeat for several files");
-  app.add_option("--model", o->model, "flow network: FlowNet2 (default), FlowNet2-C, -S, -SD, -CS, -CSS");
-  app.add_option("--flow", o->flow, "flownet2 (default with weights) or dis (OpenCV DIS; default without weights)");
-  app.add_option("--head", o->head,
-                 "inertialnet (default with weights), geometric (default without), or both");
-  app.add_option("--solver", o->solver, "geometric head: motion-field (default) or opengv")->capture_default_str();
+  app.add_option("--model", o->model, "flow network (default FlowNet2)")->transform(choice("model", flow_model_names()));
+  app.add_option("--flow", o->flow, "flownet2 (default with weights) or dis (OpenCV DIS; default without weights)")
+      ->transform(choice("flow method", {"flownet2", "dis"}));
+  app.add_option("--head", o->head, "inertialnet (default with weights), geometric (default without), or both")
+      ->transform(choice("head", {"inertialnet", "geometric", "both"}));
+  app.add_option("--solver", o->solver, "geometric head's solver")
+      ->capture_default_str()
+      ->transform(choice("solver", {"motion-field", "opengv"}));
   app.add_option("--fx", o->fx, "focal length x (px), when the sequence has no sensor.yaml")->check(finite_positive);
   app.add_option("--fy", o->fy, "focal length y (px)")->check(finite_positive);
   app.add_option("--cx", o->cx, "principal point x (px)")->check(finite);
   app.add_option("--cy", o->cy, "principal point y (px)")->check(finite);
-  app.add_option("-o,--output", o->output, "rates CSV to write (default: standard output)");
-  app.add_option("--save-flow", o->save_flow, "write each pair's flow as <timestamp>.flo into this folder");
+  app.add_option("-o,--output", o->output, "rates CSV to write, folders created as needed (default: standard output)");
+  app.add_option("--save-flow", o->save_flow, "write each pair's flow as <timestamp>.flo into this folder (created as needed)");
   app.add_option("--rate", o->rate_hz, "frame rate for image folders and videos without timestamps (Hz)")
       ->check(finite_positive);
   app.add_option("--time-offset", o->time_offset,
@@ -113,16 +138,14 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
                        : "must be a count of pairs (0 for all), got " + text;
           },
           "COUNT"));
-  app.add_flag("--stats", o->stats, "print time per stage and pairs per second");
+  app.add_flag("--stats", o->stats,
+               "print time per stage and pairs per second (after one untimed warm-up pair that compiles the kernels)");
   app.add_flag("--profile", o->profile, "print the device time of every network layer per pair (profiling queues)");
   return [o, &global]() {
     const bool have_weights = !o->weights.empty();
     RatesProcessorOptions processor;
     processor.flow = parse_flow_method(o->flow.empty() ? (have_weights ? "flownet2" : "dis") : o->flow);
     const std::string head = o->head.empty() ? (have_weights ? "inertialnet" : "geometric") : o->head;
-    if (head != "inertialnet" && head != "geometric" && head != "both") {
-      throw invalid_input("unknown head '" + head + "'; expected inertialnet, geometric or both");
-    }
     processor.inertialnet_head = head != "geometric";
     processor.geometric_head = head != "inertialnet";
     if (!have_weights && (processor.flow == FlowMethod::FlowNet || processor.inertialnet_head)) {
@@ -130,16 +153,12 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
                                       "FlowNet2 and InertialNet head tensors (safetensors). ") + kNoWeightsHelp +
                           ". Without weights, predict runs DIS flow + the geometric head.");
     }
-    if (o->solver == "opengv") {
-      processor.geometric.solver = GeometricSolver::OpenGV;
-    } else if (o->solver != "motion-field") {
-      throw invalid_input("unknown solver '" + o->solver + "'; expected motion-field or opengv");
-    }
+    if (o->solver == "opengv") processor.geometric.solver = GeometricSolver::OpenGV;
     if (!o->readout_time.empty()) {
       processor.geometric.readout_time_s = parse_seconds(o->readout_time, "--readout-time");
     }
     auto source = open_frame_source(o->sequence, o->rate_hz > 0 ? std::optional<double>(o->rate_hz) : std::nullopt);
-    for (const auto& note : source->notes()) std::cerr << "inertialnet: note: " << note << "\n";
+    for (const auto& note : source->notes()) info("note: " + note);
     if (processor.geometric_head) {
       const bool given = o->fx > 0 || o->fy > 0;
       if (given) {
@@ -195,31 +214,28 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
       processor.flow_model = flow_model_of(*weight_sets.front(), o->model);
     }
     const auto factory = rates_processor(weights_of, processor);
-    if (!o->save_flow.empty()) {
-      // Checked here, so that a file in the way is a message, not a raw filesystem_error.
-      std::error_code error;
-      std::filesystem::create_directories(o->save_flow, error);
-      if (error || !std::filesystem::is_directory(o->save_flow)) {
-        throw invalid_input("--save-flow " + o->save_flow + ": cannot use it as a folder (" +
-                            (error ? error.message() : std::string("it exists and is not a folder")) + ").");
-      }
-    }
+    if (!o->save_flow.empty()) prepare_output_folder(o->save_flow, "--save-flow");
+    if (!o->output.empty()) prepare_output_file(o->output, "-o");
 
     std::string method = (processor.flow == FlowMethod::DIS ? std::string("DIS flow") : to_string(processor.flow_model));
     method += processor.inertialnet_head && processor.geometric_head ? " + InertialNet and geometric heads"
               : processor.inertialnet_head                           ? " + InertialNet head"
                                                                      : " + geometric head";
     const std::size_t pairs = o->max_pairs ? std::min(o->max_pairs, source->size() - 1) : source->size() - 1;
-    if (!have_weights) {
-      std::cerr << "inertialnet: no weights given: weight-free DIS optical flow + geometric head\n";
-    }
-    std::cerr << "inertialnet: " << source->description() << ", " << pairs << " pairs, " << method << " on "
-              << device_list.size() << " device" << (device_list.size() > 1 ? "s" : "") << " (" << infos.front().name
-              << (infos.size() > 1 ? ", …" : "") << ")";
+    if (!have_weights) info("no weights given: weight-free DIS optical flow + geometric head");
+    std::string summary = source->description() + ", " + std::to_string(pairs) + " pairs, " + method + " on " +
+                          std::to_string(device_list.size()) + " device" + (device_list.size() > 1 ? "s" : "") + " (" +
+                          infos.front().name + (infos.size() > 1 ? ", …" : "") + ")";
     if (processor.geometric_head) {
-      std::cerr << "; geometric rates in the " << (processor.camera_to_body ? "body (IMU) frame" : "camera frame");
+      summary += std::string("; geometric rates in the ") +
+                 (processor.camera_to_body ? "body (IMU) frame" : "camera frame");
     }
-    std::cerr << "\n";
+    info(summary);
+    // Timing keeps the first run's kernel compile (and each network's planning) out of its figures.
+    if (o->stats || o->profile) {
+      warm_up(o->sequence, o->rate_hz, device_list, factory);
+      if (o->profile) profiler.collect();  // the warm-up pair is not one of the profiled ones
+    }
 
     // Columns: the first estimator is wx,wy,wz; a second one adds wx_<name>,wy_<name>,wz_<name>.
     std::vector<std::string> extra;
@@ -287,6 +303,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
     const PipelineStats stats = run_pipeline(*source, device_list, factory, sink, options);
     std::signal(SIGINT, SIG_DFL);
     std::signal(SIGTERM, SIG_DFL);
+    progress.finish();  // the summary below starts on a line of its own
 
     if (o->stats) {
       std::cerr << "pairs: " << stats.pairs << " in " << stats.seconds << " s = " << stats.pairs_per_second()
@@ -299,15 +316,14 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
       for (const auto& [device, count] : stats.pairs_per_device) std::cerr << device << ": " << count << " pairs\n";
     }
     if (o->profile && stats.pairs > 0) {
-      // Lanes run side by side, so a layer's time includes the other lanes' load on the device;
-      // the first pair of each lane also waits for its kernels to compile.
+      // Lanes run side by side, so a layer's time includes the other lanes' load on the device.
       std::vector<LayerTime> per_pair = total_by_layer(profiler.collect());
       for (auto& l : per_pair) {
         l.seconds /= static_cast<double>(stats.pairs);
         l.layer.flops /= static_cast<double>(stats.pairs);
       }
       print_profile("per pair, mean over " + std::to_string(stats.pairs) + " pairs and " + std::to_string(o->lanes) +
-                        " lanes in flight per device; the first pairs include compiling",
+                        " lanes in flight per device, after a warm-up pair",
                     per_pair);
     }
     if (stats.cancelled) {

@@ -26,7 +26,8 @@ Command register_synth(CLI::App& app, const GlobalOptions&) {
   app.add_option("out_dir", o->out, "folder to write (mav0/ inside)")->required();
   app.add_option("--frames", o->frames, "number of frames")->capture_default_str()->check(CLI::Range(2, 100000));
   app.add_option("--motion", o->motion, "rotation (exact homographies), general (translation, depth) or close (hand-held at 0.3-1 m)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->transform(choice("motion", {"rotation", "general", "close"}));
   app.add_option("--seed", o->seed, "seed of the motion, texture and noise")->capture_default_str();
   app.add_option("--size", o->size, "image size WxH")->capture_default_str();
   app.add_option("--max-rate", o->max_rate, "peak angular rate per axis, deg/s")->capture_default_str();

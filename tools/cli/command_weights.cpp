@@ -23,11 +23,10 @@ struct WeightsOptions {
 
 Command register_weights(CLI::App& app, const GlobalOptions&) {
   auto o = std::make_shared<WeightsOptions>();
-  auto* synthetic = app.add_option("--synthetic", o->synthetic,
-                                   "write synthetic weights of MODEL: FlowNet2, FlowNet2-C, FlowNet2-S, FlowNet2-SD, "
-                                   "FlowNet2-CS, FlowNet2-CSS or InertialNetHead");
+  auto* synthetic = app.add_option("--synthetic", o->synthetic, "write synthetic weights of this model")
+                        ->transform(choice("model", model_names()));
   app.add_option("--seed", o->seed, "seed of the synthetic weights")->capture_default_str();
-  app.add_option("-o,--output", o->output, "file to write (safetensors)");
+  app.add_option("-o,--output", o->output, "file to write (safetensors; folders created as needed)");
   app.add_option("--size", o->size, "flow size WxH the InertialNet head is made for (default 752x480)");
   auto* info = app.add_option("--info", o->info, "describe a weight file")->check(CLI::ExistingFile);
   synthetic->excludes(info);
@@ -45,6 +44,7 @@ Command register_weights(CLI::App& app, const GlobalOptions&) {
     }
     if (o->output.empty()) throw invalid_input("--synthetic needs -o FILE");
     const ModelKind kind = model_kind_from_string(o->synthetic);
+    prepare_output_file(o->output, "-o");
     HeadConfig head;
     if (!o->size.empty()) {
       if (kind != ModelKind::InertialNetHead) throw invalid_input("--size applies to InertialNetHead only");

@@ -8,10 +8,13 @@
 
 namespace inertialnet::cli {
 
-// Options every subcommand shares.
+// Options every subcommand shares (global_options.hpp registers them on the app and on each
+// subcommand, so they may come before or after the subcommand and show in its --help).
 struct GlobalOptions {
   std::string device;  // --device SPEC (else $INERTIALNET_DEVICE, else the default device)
   bool no_cache = false;
+  bool quiet = false;    // -q: warnings and errors only, no progress line
+  bool verbose = false;  // -v: debug messages too (each kernel program compiled or loaded)
 };
 
 using Command = std::function<int()>;

@@ -4,10 +4,14 @@
 #include <cstdio>
 #include <cstring>
 #include <iostream>
+#include <filesystem>
 #include <regex>
 
 #include "inertialnet/runtime/device_selection.hpp"
+#include "inertialnet/models/parameters.hpp"
 #include "inertialnet/runtime/error.hpp"
+#include "console.hpp"
+#include "suggest.hpp"
 
 namespace inertialnet::cli {
 
@@ -31,8 +35,57 @@ void warn_if_synthetic(const WeightSet& weights) {
   if (!weights.synthetic()) return;
   std::string sources;
   for (const auto& s : weights.synthetic_sources()) sources += (sources.empty() ? "" : ", ") + s;
-  std::cerr << "inertialnet: note: synthetic weights (" << sources
-            << "): the output exercises the network but is not a measurement\n";
+  info("note: synthetic weights (" + sources + "): the output exercises the network but is not a measurement");
+}
+
+CLI::Validator choice(const std::string& what, const std::vector<std::string>& values) {
+  const CLI::Validator member = CLI::IsMember(values, CLI::ignore_case);
+  return CLI::Validator(
+      [member, what, values](std::string& text) {
+        const std::string given = text;
+        if (member(text).empty()) return std::string();  // text is now the canonical spelling
+        std::string list;
+        for (const auto& v : values) list += (list.empty() ? "" : ", ") + v;
+        const std::string near = nearest(given, values);
+        return "unknown " + what + " '" + given + "'; expected one of " + list +
+               (near.empty() ? std::string() : " (did you mean '" + near + "'?)");
+      },
+      member.get_description());
+}
+
+std::vector<std::string> model_names() {
+  std::vector<std::string> names;
+  for (const ModelKind kind : all_model_kinds()) names.emplace_back(to_string(kind));
+  return names;
+}
+
+std::vector<std::string> flow_model_names() {
+  std::vector<std::string> names;
+  for (const ModelKind kind : all_model_kinds()) {
+    if (kind != ModelKind::InertialNetHead) names.emplace_back(to_string(kind));
+  }
+  return names;
+}
+
+void prepare_output_folder(const std::string& path, const std::string& option) {
+  std::error_code error;
+  std::filesystem::create_directories(path, error);
+  // Checked here, so that a file in the way is a message, not a raw filesystem_error.
+  if (error || !std::filesystem::is_directory(path)) {
+    throw invalid_input(option + " " + path + ": cannot use it as a folder (" +
+                        (error ? error.message() : std::string("it exists and is not a folder")) + ").");
+  }
+}
+
+void prepare_output_file(const std::string& path, const std::string& option) {
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  if (parent.empty()) return;
+  std::error_code error;
+  std::filesystem::create_directories(parent, error);
+  if (error || !std::filesystem::is_directory(parent)) {
+    throw invalid_input(option + " " + path + ": cannot create the folder " + parent.string() + " (" +
+                        (error ? error.message() : std::string("it exists and is not a folder")) + ").");
+  }
 }
 
 void flush_standard_output() {

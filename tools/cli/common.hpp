@@ -6,6 +6,9 @@
 #include <memory>
 #include <string>
 #include <utility>
+#include <vector>
+
+#include <CLI/CLI.hpp>
 
 #include "commands.hpp"
 #include "inertialnet/runtime/device.hpp"
@@ -21,6 +24,22 @@ std::pair<std::int64_t, std::int64_t> parse_size(const std::string& text);
 
 // One line on stderr when any weights are synthetic: their output is not a measurement.
 void warn_if_synthetic(const WeightSet& weights);
+
+// The validator of an option that takes one of `values`: any case is accepted and turned into
+// the canonical spelling given here (`--flow DIS` → "dis", `--model flownet2-c` → "FlowNet2-C"),
+// the choices show in --help and in the generated completion, and anything else is answered with
+// "unknown <what> 'X'; expected one of …" and its nearest choice. Register it with ->transform().
+CLI::Validator choice(const std::string& what, const std::vector<std::string>& values);
+// The names of the FlowNet2 family ("FlowNet2", "FlowNet2-C", …), and of every model kind
+// (those and "InertialNetHead"), as the library spells them.
+std::vector<std::string> flow_model_names();
+std::vector<std::string> model_names();
+
+// One rule for every output path (-o, --png, --plot, --save-flow): missing parent folders are
+// created. A parent that exists as something other than a folder is invalid_input naming
+// `option`. output_folder() does the same for a folder that is itself the output.
+void prepare_output_file(const std::string& path, const std::string& option);
+void prepare_output_folder(const std::string& path, const std::string& option);
 
 // Pushes what is buffered for standard output to it; runtime_error when it cannot be written
 // (a full disk, a closed pipe, /dev/full), so that no command reports success with its output lost.

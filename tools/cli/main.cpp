@@ -6,8 +6,25 @@
 
 #include "commands.hpp"
 #include "common.hpp"
+#include "console.hpp"
+#include "docgen.hpp"
+#include "global_options.hpp"
+#include "help_text.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/runtime/program_cache.hpp"
+#include "inertialnet/runtime/version.hpp"
+#include "suggest.hpp"
+#include "version_report.hpp"
+
+namespace {
+
+// Help ends with the examples, then the exit codes.
+std::string footer(const std::string& subcommand) {
+  const std::string examples = inertialnet::cli::help_examples(subcommand);
+  return (examples.empty() ? std::string() : "\n" + examples + "\n") + inertialnet::cli::kExitCodes;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace inertialnet;
@@ -16,11 +33,15 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.fallthrough();  // global options may follow the subcommand: `inertialnet devices --device 1`
   cli::GlobalOptions global;
-  app.add_option("-d,--device", global.device,
-                 "device: N, P:D, cpu, gpu, accelerator, a name substring, or all (env INERTIALNET_DEVICE)");
-  app.add_flag("--no-cache", global.no_cache, "do not read or write the on-disk program cache");
-  app.set_version_flag("--version", "inertialnet 0.1.0");
-  app.footer("Exit codes: 0 ok, 1 runtime failure, 2 bad usage or bad input.");
+  cli::add_global_options(app, global);
+  app.add_flag_callback(
+      "--version",
+      [] {
+        std::cout << cli::version_report();
+        throw CLI::Success();
+      },
+      "library, CLBlast and OpenCV versions, and every OpenCL platform and driver");
+  app.footer(footer(""));
 
   // The subcommands, in the order --help lists them.
   struct Subcommand {
@@ -44,20 +65,40 @@ int main(int argc, char** argv) {
     CLI::App* sub = app.add_subcommand(s.name, s.description);
     commands[sub] = s.register_options(*sub, global);
   }
+  // Generated from the definitions above: shell completion and the man page.
+  std::string shell;
+  CLI::App* completion = app.add_subcommand("completion", "print the bash or zsh completion script");
+  completion->add_option("shell", shell, "the shell")->required()->transform(CLI::IsMember({"bash", "zsh"}, CLI::ignore_case));
+  commands[completion] = [&app, &shell] {
+    std::cout << (shell == "zsh" ? cli::zsh_completion(app) : cli::bash_completion(app));
+    return 0;
+  };
+  CLI::App* man = app.add_subcommand("man", "print the man page (roff)");
+  commands[man] = [&app] {
+    std::cout << cli::man_page(app, build_versions().inertialnet);
+    return 0;
+  };
+  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
+    cli::add_global_options(*sub, global);
+    sub->footer(footer(sub->get_name()));
+  }
 
   try {
     app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForAllHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForVersion& e) {
+  } catch (const CLI::Success& e) {  // --help, --help-all, --version
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    app.exit(e);
+    // A typo gets its nearest spelling; other errors keep CLI11's words.
+    const std::string unknown = cli::explain_unknown_word(app, std::vector<std::string>(argv + 1, argv + argc));
+    if (!unknown.empty()) {
+      std::cerr << "inertialnet: error: " << unknown << "\n";
+    } else {
+      app.exit(e);
+    }
     return 2;
   }
 
+  cli::configure_logging(global);
   if (global.no_cache) ::setenv(kNoCacheEnvironmentVariable, "1", 1);
   try {
     for (auto& [sub, run] : commands) {
@@ -69,12 +110,15 @@ int main(int argc, char** argv) {
     }
     return 2;
   } catch (const Error& e) {
+    cli::end_progress_line();
     std::cerr << "inertialnet: error: " << e.what() << "\n";
     return e.exit_code();
   } catch (const std::bad_alloc&) {
+    cli::end_progress_line();
     std::cerr << "inertialnet: error: out of host memory\n";
     return 1;
   } catch (const std::exception& e) {
+    cli::end_progress_line();
     std::cerr << "inertialnet: error: " << e.what() << "\n";
     return 1;
   }

@@ -4,14 +4,19 @@
 
 #include <cstdio>
 
+#include "console.hpp"
+
 namespace inertialnet::cli {
 
 Progress::Progress(std::string what, std::size_t total)
-    : what_(std::move(what)), total_(total), enabled_(::isatty(STDERR_FILENO) != 0),
+    : what_(std::move(what)), total_(total),
+      enabled_(::isatty(STDERR_FILENO) != 0 && log_enabled(LogLevel::Info)),
       start_(std::chrono::steady_clock::now()), last_(start_) {}
 
-Progress::~Progress() {
-  if (enabled_) std::fprintf(stderr, "\n");
+Progress::~Progress() { finish(); }
+
+void Progress::finish() {
+  if (enabled_) end_progress_line();
 }
 
 void Progress::update(std::size_t done) {
@@ -26,8 +31,10 @@ void Progress::update(std::size_t done) {
   std::string bar(static_cast<std::size_t>(filled), '#');
   bar.resize(width, '.');
   const double eta = rate > 0 ? static_cast<double>(total_ - done) / rate : 0;
-  std::fprintf(stderr, "\r%s [%s] %zu/%zu  %.2f/s  eta %.0fs ", what_.c_str(), bar.c_str(), done, total_, rate, eta);
-  std::fflush(stderr);
+  char text[512];
+  std::snprintf(text, sizeof text, "\r%s [%s] %zu/%zu  %.2f/s  eta %.0fs ", what_.c_str(), bar.c_str(), done, total_,
+                rate, eta);
+  write_progress_line(text);
 }
 
 }  // namespace inertialnet::cli

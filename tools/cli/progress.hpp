@@ -1,4 +1,6 @@
-// A one-line progress bar on stderr, shown only when stderr is a terminal.
+// A one-line progress bar on stderr, shown only when stderr is a terminal and -q is not given.
+// finish() ends the line (the destructor does it when finish() was not called), so a summary
+// printed after finish() starts on a line of its own.
 #pragma once
 
 #include <chrono>
@@ -10,8 +12,9 @@ namespace inertialnet::cli {
 class Progress {
  public:
   Progress(std::string what, std::size_t total);
-  ~Progress();  // ends the line
+  ~Progress();
   void update(std::size_t done);
+  void finish();
 
  private:
   std::string what_;

@@ -56,7 +56,8 @@ struct EvalOptions {
 struct EvalReport {
   std::string sequence;
   std::string rates_file;
-  std::string head;                  // "wx,wy,wz" or "wx_geometric,wy_geometric,wz_geometric"
+  std::string estimator;             // the column suffix without "_": "" (wx,wy,wz), "geometric", …
+  std::array<std::string, 3> columns;  // {"wx", "wy", "wz"} or {"wx_geometric", …}
   std::size_t rate_rows = 0;
   std::size_t frames_in_sequence = 0;
   std::size_t imu_samples = 0;       // in the whole sequence
@@ -87,8 +88,36 @@ struct EvalReport {
 
   std::size_t frames_evaluated() const { return t_ns.size(); }
   std::string table() const;                 // human-readable report, Table 1 layout
-  std::string json(bool include_series = false) const;  // pretty JSON (series: per-frame values)
+  // This estimator's object of the "inertialnet.eval/1" document (below); series: per-frame values.
+  std::string json(bool include_series = false) const;
 };
+
+// The JSON of `inertialnet eval --json`, one document whatever the number of estimators
+// (docs/cli.md). Fields are only ever added under this schema name; a change of meaning gets a
+// new number. Every three-vector is an object {"x", "y", "z"}.
+//   { "schema": "inertialnet.eval/1", "rates_file": string, "sequence": string,
+//     "estimators": [ {
+//       "estimator": "" | "geometric" | …     the column suffix ("" for wx,wy,wz)
+//       "columns": {"x": "wx", "y": "wy", "z": "wz"}
+//       "sequence", "rates_file": string
+//       "rate_rows", "frames_in_sequence", "frames_evaluated", "imu_samples",
+//       "imu_samples_in_span", "rows_not_frames", "rows_without_truth": int
+//       "target": "spline" | "mean",  "frame": "imu" | "camera"
+//       "rates_frame": "body" | "camera" | "unstated"   (the frame the rates file states)
+//       "time_offset_s": number   (shift applied, t_imu = t_cam + offset, readout/2 included)
+//       "time_offset_estimate" (with --time-offset auto): {"offset_s", "std_error_s", "contrast",
+//            "confidence", "at_range_edge", "pairs", "rmse_deg_s", "rmse_at_zero_deg_s"}
+//       "bias": {"source": string, "imu_frame_rad_s": xyz (when a bias is known)}
+//       "raw", "bias_corrected" (null without a bias): {"frames": int, "rmse_deg_s": xyz,
+//            "mean_error_deg_s": xyz, "max_abs_error_deg_s": xyz,
+//            "rms_t_deg_s": {"mean", "median", "max"}}
+//       "error_histogram": {"lo_deg_s", "hi_deg_s", "bins", "x"|"y"|"z": {"counts": [int], "below", "above"}}
+//       "plots", "notes", "warnings": [string]
+//       "series" (with include_series): [ {"timestamp_ns", "predicted_rad_s": xyz,
+//            "truth_raw_rad_s": xyz, "truth_corrected_rad_s": xyz, "rms_t_deg_s"} ]
+//     } ] }
+inline constexpr const char* kEvalJsonSchema = "inertialnet.eval/1";
+std::string format_eval_json(const std::vector<EvalReport>& reports, bool include_series = false);
 
 // Throws invalid_input when no rates row matches a frame with ground truth.
 EvalReport evaluate(const RatesTable& rates, const EurocSequence& sequence, const EvalOptions& options = {});

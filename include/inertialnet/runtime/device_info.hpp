@@ -51,6 +51,15 @@ std::vector<DeviceInfo> discover_devices();
 
 // The device table that `inertialnet devices` prints and that device-selection errors include.
 std::string format_device_table(const std::vector<DeviceInfo>& devices);
+// `inertialnet devices --json` (docs/cli.md); fields are only ever added under this schema name:
+//   { "schema": "inertialnet.devices/1",
+//     "devices": [ { "index": int (the N of --device N), "address": "P:D" (the --device P:D),
+//                    "platform", "platform_version", "platform_vendor", "name", "vendor",
+//                    "type": "cpu" | "gpu" | "accelerator" | …, "driver_version",
+//                    "device_version", "opencl_c_version": string, "compute_units",
+//                    "global_memory_bytes", "max_alloc_bytes", "local_memory_bytes",
+//                    "max_work_group_size": int, "fp16": bool } ] }
+inline constexpr const char* kDevicesJsonSchema = "inertialnet.devices/1";
 std::string format_device_json(const std::vector<DeviceInfo>& devices);
 
 }  // namespace inertialnet

@@ -9,6 +9,10 @@
 // ~/.cache/inertialnet, keyed by platform, device, driver version, source hash and options, so
 // a second start skips compilation. Files are written to a temporary name and renamed (safe
 // with concurrent processes); a corrupt or foreign file is ignored and rebuilt.
+//
+// The first compile from source on a device logs one Info message (inertialnet/runtime/log.hpp)
+// naming the device and the cache folder, so that a first run's wait is explained; a run served
+// from the cache logs nothing at Info. Each build and each load logs at Debug.
 #pragma once
 
 #include <cstddef>
@@ -86,6 +90,7 @@ class ProgramCache {
   mutable std::mutex mutex_;
   std::map<std::string, ProgramHandle> programs_;  // by cache key
   ProgramCacheStats stats_;
+  bool announced_compile_ = false;  // the one "compiling OpenCL kernels" message per device
 };
 
 }  // namespace inertialnet

@@ -1,0 +1,18 @@
+#include "global_options.hpp"
+
+namespace inertialnet::cli {
+
+void add_global_options(CLI::App& app, GlobalOptions& global) {
+  app.add_option("-d,--device", global.device,
+                 "device: N, P:D, cpu, gpu, accelerator, a name substring, or all (env INERTIALNET_DEVICE)")
+      ->group(kGlobalGroup);
+  app.add_flag("--no-cache", global.no_cache, "do not read or write the on-disk program cache")->group(kGlobalGroup);
+  auto* quiet = app.add_flag("-q,--quiet", global.quiet, "only warnings and errors on stderr; no progress line")
+                    ->group(kGlobalGroup);
+  auto* verbose =
+      app.add_flag("-v,--verbose", global.verbose, "also debug messages (each kernel program compiled or loaded)")
+          ->group(kGlobalGroup);
+  quiet->excludes(verbose);
+}
+
+}  // namespace inertialnet::cli

@@ -1,0 +1,55 @@
+#include "help_text.hpp"
+
+#include <map>
+
+namespace inertialnet::cli {
+
+std::string help_examples(const std::string& subcommand) {
+  static const std::map<std::string, std::string> examples = {
+      {"",
+       "  inertialnet devices                                  # which OpenCL devices there are\n"
+       "  inertialnet synth data/seq --frames 40               # a synthetic EuRoC sequence\n"
+       "  inertialnet predict data/seq -o rates.csv            # weight-free: DIS flow + geometric head\n"
+       "  inertialnet eval rates.csv data/seq --plot rates.png # the paper's metrics and plots\n"
+       "  inertialnet predict --help                           # the options of one subcommand\n"},
+      {"devices",
+       "  inertialnet devices\n"
+       "  inertialnet devices --json\n"
+       "  inertialnet devices --device gpu                     # what a spec selects\n"},
+      {"flow",
+       "  inertialnet flow a.png b.png -w flownet2.safetensors -o ab.flo --png ab.png\n"
+       "  inertialnet flow a.png b.png -w flownet2-c.safetensors --model flownet2-c --profile\n"},
+      {"predict",
+       "  inertialnet predict data/seq -o out/rates.csv                        # DIS + geometric head\n"
+       "  inertialnet predict data/seq -w flownet2.safetensors -w head.safetensors --head both -o rates.csv\n"
+       "  inertialnet predict video.mp4 --fx 458 --rate 20 --stats\n"
+       "  inertialnet predict data/seq --flow DIS --save-flow out/flows -q\n"},
+      {"eval",
+       "  inertialnet eval rates.csv data/seq\n"
+       "  inertialnet eval rates.csv data/seq --plot out/rates.png --target mean\n"
+       "  inertialnet eval rates.csv data/seq --json --series > report.json\n"
+       "  inertialnet eval rates.csv data/seq --time-offset auto --gyro-bias auto\n"},
+      {"calibrate-time",
+       "  inertialnet calibrate-time data/seq                  # predicts weight-free, then estimates\n"
+       "  inertialnet calibrate-time data/seq rates.csv --range 0.3\n"},
+      {"synth",
+       "  inertialnet synth data/seq --frames 40 --seed 1\n"
+       "  inertialnet synth data/general --motion general --size 376x240 --no-noise --overwrite\n"},
+      {"bench",
+       "  inertialnet bench --model FlowNet2-C --size 256x192 --pairs 3\n"
+       "  inertialnet bench --device all --json > bench.json\n"},
+      {"weights",
+       "  inertialnet weights --synthetic FlowNet2 -o flownet2.safetensors\n"
+       "  inertialnet weights --synthetic InertialNetHead --size 752x480 -o head.safetensors\n"
+       "  inertialnet weights --info flownet2.safetensors\n"},
+      {"completion",
+       "  inertialnet completion bash > /etc/bash_completion.d/inertialnet\n"
+       "  inertialnet completion zsh > ~/.zfunc/_inertialnet\n"},
+      {"man",
+       "  inertialnet man > inertialnet.1 && man ./inertialnet.1\n"},
+  };
+  const auto found = examples.find(subcommand);
+  return found == examples.end() ? std::string() : "Examples:\n" + found->second;
+}
+
+}  // namespace inertialnet::cli
