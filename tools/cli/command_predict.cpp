@@ -9,13 +9,11 @@
 
 #include "commands.hpp"
 #include "common.hpp"
-#include "inertialnet/runtime/device_selection.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/runtime/layer_profiler.hpp"
 #include "inertialnet/io/flow_io.hpp"
-#include "inertialnet/io/frame_source.hpp"
 #include "inertialnet/pipeline/pipeline.hpp"
-#include "inertialnet/pipeline/rates_processor.hpp"
+#include "inertialnet/pipeline/predict.hpp"
 #include "inertialnet/io/rates_csv.hpp"
 #include "profile.hpp"
 #include "progress.hpp"
@@ -37,6 +35,7 @@ struct PredictOptions {
   double fx = 0, fy = 0, cx = 0, cy = 0;
   std::string output;
   std::string save_flow;
+  std::string flow_format = "flo";
   double rate_hz = 0;
   int lanes = 2;
   int decode_threads = 2;
@@ -45,19 +44,17 @@ struct PredictOptions {
   bool profile = false;
 };
 
-ModelKind flow_model_of(const WeightSet& weights, const std::string& requested) {
-  if (!requested.empty()) return model_kind_from_string(requested);
-  for (const ModelKind kind : weights.models()) {
-    if (kind != ModelKind::InertialNetHead) return kind;
+// One pair's flow under --save-flow, named by the pair's second frame like the rates row.
+void save_flow(const std::filesystem::path& folder, const std::string& format, std::int64_t t_ns, const FlowField& flow) {
+  const std::string stem = std::to_string(t_ns);
+  if (format == "flo") {
+    write_flo(folder / (stem + ".flo"), flow);
+  } else if (format == "png") {
+    write_flow_png(folder / (stem + ".png"), flow);
+  } else {
+    write_kitti_flow_png(folder / (stem + ".png"), flow);
   }
-  return ModelKind::FlowNet2;
 }
-
-const char* kNoWeightsHelp =
-    "Convert a flownet2-pytorch checkpoint with `python3 tools/convert_checkpoint.py FlowNet2_checkpoint.pth.tar "
-    "flownet2.safetensors` (and the head the same way), or write synthetic weights for a trial run with "
-    "`inertialnet weights --synthetic FlowNet2 -o flownet2.safetensors` and `inertialnet weights --synthetic "
-    "InertialNetHead --size WxH -o head.safetensors`";
 
 }  // namespace
 
@@ -93,7 +90,11 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
   app.add_option("--cx", o->cx, "principal point x (px)")->check(finite);
   app.add_option("--cy", o->cy, "principal point y (px)")->check(finite);
   app.add_option("-o,--output", o->output, "rates CSV to write (default: standard output)");
-  app.add_option("--save-flow", o->save_flow, "write each pair's flow as <timestamp>.flo into this folder");
+  app.add_option("--save-flow", o->save_flow, "write each pair's flow as <timestamp>.flo (or .png) into this folder");
+  app.add_option("--flow-format", o->flow_format,
+                 "--save-flow format: flo (Middlebury), png (colour wheel) or kitti (KITTI 16-bit flow PNG)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"flo", "png", "kitti"}));
   app.add_option("--rate", o->rate_hz, "frame rate for image folders and videos without timestamps (Hz)")
       ->check(finite_positive);
   app.add_option("--lanes", o->lanes, "frame pairs in flight per device")->capture_default_str()->check(CLI::Range(1, 16));
@@ -110,80 +111,26 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
   app.add_flag("--profile", o->profile, "print the device time of every network layer per pair (profiling queues)");
   return [o, &global]() {
     const bool have_weights = !o->weights.empty();
-    RatesProcessorOptions processor;
-    processor.flow = parse_flow_method(o->flow.empty() ? (have_weights ? "flownet2" : "dis") : o->flow);
-    const std::string head = o->head.empty() ? (have_weights ? "inertialnet" : "geometric") : o->head;
-    if (head != "inertialnet" && head != "geometric" && head != "both") {
-      throw invalid_input("unknown head '" + head + "'; expected inertialnet, geometric or both");
-    }
-    processor.inertialnet_head = head != "geometric";
-    processor.geometric_head = head != "inertialnet";
-    if (!have_weights && (processor.flow == FlowMethod::FlowNet || processor.inertialnet_head)) {
-      throw invalid_input(std::string("--flow flownet2 and --head inertialnet need weights: --weights FILE with the "
-                                      "FlowNet2 and InertialNet head tensors (safetensors). ") + kNoWeightsHelp +
-                          ". Without weights, predict runs DIS flow + the geometric head.");
-    }
-    if (o->solver == "opengv") {
-      processor.geometric.solver = GeometricSolver::OpenGV;
-    } else if (o->solver != "motion-field") {
-      throw invalid_input("unknown solver '" + o->solver + "'; expected motion-field or opengv");
-    }
-    auto source = open_frame_source(o->sequence, o->rate_hz > 0 ? std::optional<double>(o->rate_hz) : std::nullopt);
-    if (processor.geometric_head) {
-      const bool given = o->fx > 0 || o->fy > 0;
-      if (given) {
-        CameraIntrinsics camera;
-        const HostImage first = source->decode(0);
-        camera.width = first.width;
-        camera.height = first.height;
-        camera.fx = o->fx;
-        camera.fy = o->fy > 0 ? o->fy : o->fx;
-        camera.cx = o->cx > 0 ? o->cx : (first.width - 1) / 2.0;
-        camera.cy = o->cy > 0 ? o->cy : (first.height - 1) / 2.0;
-        camera.validate();
-        processor.camera = camera;
-      } else if (const auto calibration = source->calibration()) {
-        processor.camera = CameraIntrinsics::from_calibration(*calibration);
-        // The geometric head allocates per pixel of the calibrated size: compare it with the
-        // images before, so that a wrong resolution is a clear message, not gigabytes asked for.
-        const HostImage first = source->decode(0);
-        if (first.width != processor.camera->width || first.height != processor.camera->height) {
-          throw invalid_input(source->description() + ": cam0/sensor.yaml gives the resolution " +
-                              std::to_string(processor.camera->width) + "x" + std::to_string(processor.camera->height) +
-                              ", which does not match the images (" + std::to_string(first.width) + "x" +
-                              std::to_string(first.height) + ").");
-        }
-        processor.camera_to_body = calibration->rotation_BS();
-      } else {
-        throw invalid_input("the geometric head needs the camera: " + source->description() +
-                            " has no cam0/sensor.yaml; give --fx (and --fy --cx --cy)");
-      }
-    }
-    processor.keep_flow = !o->save_flow.empty();
-
-    // Devices and their weights (one set per device).
-    const auto infos = select_devices(device_spec_or_environment(global.device), discover_devices());
     LayerProfiler profiler;  // declared before the devices, whose queues report to it
-    std::vector<std::unique_ptr<Device>> devices;
-    std::vector<std::unique_ptr<WeightSet>> weight_sets;
-    std::map<const Device*, const WeightSet*> weights_of;
-    std::vector<Device*> device_list;
-    for (const auto& info : infos) {
-      DeviceOptions options;
-      if (global.no_cache) options.program_cache = DiskCacheMode::Off;
-      if (o->profile) options.profiler = &profiler;
-      devices.push_back(std::make_unique<Device>(info, options));
-      if (have_weights) {
-        weight_sets.push_back(std::make_unique<WeightSet>(WeightSet::load(*devices.back(), o->weights)));
-        weights_of[devices.back().get()] = weight_sets.back().get();
-      }
-      device_list.push_back(devices.back().get());
-    }
-    if (have_weights) {
-      warn_if_synthetic(*weight_sets.front());
-      processor.flow_model = flow_model_of(*weight_sets.front(), o->model);
-    }
-    const auto factory = rates_processor(weights_of, processor);
+    PredictSettings settings;
+    settings.sequence = o->sequence;
+    settings.weights = o->weights;
+    settings.model = o->model;
+    settings.flow = o->flow;
+    settings.head = o->head;
+    settings.solver = o->solver;
+    settings.fx = o->fx;
+    settings.fy = o->fy;
+    settings.cx = o->cx;
+    settings.cy = o->cy;
+    settings.rate_hz = o->rate_hz;
+    settings.device = global.device;
+    settings.no_cache = global.no_cache;
+    settings.keep_flow = !o->save_flow.empty();
+    if (o->profile) settings.profiler = &profiler;
+    Prediction prediction(settings);
+    if (const WeightSet* weights = prediction.weights()) warn_if_synthetic(*weights);
+    const RatesProcessorOptions& processor = prediction.processor();
     if (!o->save_flow.empty()) {
       // Checked here, so that a file in the way is a message, not a raw filesystem_error.
       std::error_code error;
@@ -194,25 +141,22 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
       }
     }
 
-    std::string method = (processor.flow == FlowMethod::DIS ? std::string("DIS flow") : to_string(processor.flow_model));
-    method += processor.inertialnet_head && processor.geometric_head ? " + InertialNet and geometric heads"
-              : processor.inertialnet_head                           ? " + InertialNet head"
-                                                                     : " + geometric head";
-    const std::size_t pairs = o->max_pairs ? std::min(o->max_pairs, source->size() - 1) : source->size() - 1;
+    const std::size_t pairs = prediction.pairs(o->max_pairs);
+    const auto& infos = prediction.device_infos();
     if (!have_weights) {
       std::cerr << "inertialnet: no weights given: weight-free DIS optical flow + geometric head\n";
     }
-    std::cerr << "inertialnet: " << source->description() << ", " << pairs << " pairs, " << method << " on "
-              << device_list.size() << " device" << (device_list.size() > 1 ? "s" : "") << " (" << infos.front().name
-              << (infos.size() > 1 ? ", …" : "") << ")";
+    std::cerr << "inertialnet: " << prediction.source().description() << ", " << pairs << " pairs, "
+              << prediction.method() << " on " << infos.size() << " device" << (infos.size() > 1 ? "s" : "") << " ("
+              << infos.front().name << (infos.size() > 1 ? ", …" : "") << ")";
     if (processor.geometric_head) {
       std::cerr << "; geometric rates in the " << (processor.camera_to_body ? "body (IMU) frame" : "camera frame");
     }
     std::cerr << "\n";
 
     // Columns: the first estimator is wx,wy,wz; a second one adds wx_<name>,wy_<name>,wz_<name>.
-    std::vector<std::string> extra;
-    if (processor.inertialnet_head && processor.geometric_head) extra = {"wx_geometric", "wy_geometric", "wz_geometric"};
+    const std::vector<std::string> columns = prediction.columns();
+    const std::vector<std::string> extra(columns.begin() + 3, columns.end());
     std::unique_ptr<RatesCsvWriter> file_writer;
     if (!o->output.empty()) file_writer = std::make_unique<RatesCsvWriter>(o->output, extra);
     if (!file_writer) {
@@ -227,13 +171,6 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
       const auto& w = r.rates.front().second;
       std::vector<double> more;
       for (std::size_t i = 1; i < r.rates.size(); ++i) more.insert(more.end(), r.rates[i].second.begin(), r.rates[i].second.end());
-      // Inputs are checked where they enter; a NaN here is a failure of the computation, never a rate.
-      bool finite = std::isfinite(w[0]) && std::isfinite(w[1]) && std::isfinite(w[2]);
-      for (const double v : more) finite = finite && std::isfinite(v);
-      if (!finite) {
-        throw runtime_error("the rates computed for the frame at timestamp " + std::to_string(r.t1_ns) +
-                            " are not finite (NaN or infinity); stopping rather than writing them.");
-      }
       if (file_writer) {
         file_writer->write(r.t1_ns, {w[0], w[1], w[2]}, more);
       } else {
@@ -242,7 +179,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
         std::printf("\n");
         flush_standard_output();  // a row at a time, so a closed pipe stops the run at once
       }
-      if (r.flow) write_flo(std::filesystem::path(o->save_flow) / (std::to_string(r.t1_ns) + ".flo"), *r.flow);
+      if (r.flow) save_flow(o->save_flow, o->flow_format, r.t1_ns, *r.flow);
       progress.update(++done);
     };
 
@@ -253,7 +190,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
     options.cancel = &interrupted;
     std::signal(SIGINT, on_interrupt);
     std::signal(SIGTERM, on_interrupt);
-    const PipelineStats stats = run_pipeline(*source, device_list, factory, sink, options);
+    const PipelineStats stats = prediction.run(sink, options);
     std::signal(SIGINT, SIG_DFL);
     std::signal(SIGTERM, SIG_DFL);
 
