@@ -2,7 +2,8 @@
 # Installs the Debian packages that building, testing and running InertialNet-CL need
 # (OpenCL headers and ICD loader, PoCL for the CPU, CLBlast, OpenCV, Eigen, GoogleTest,
 # Google Benchmark, CLI11, nlohmann-json, CMake and a C++17 compiler; OpenBLAS only as the
-# benchmarks' reference, never linked into the library).
+# benchmarks' reference, never linked into the library; python3-venv and python3-dev for the Python
+# package, whose own build and test tools come from PyPI through tools/python_env.sh).
 # Does nothing when everything is present. Works as root (no sudo needed) or through sudo.
 set -euo pipefail
 
@@ -13,6 +14,7 @@ packages=(
   libopencv-dev libeigen3-dev libopengv-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev
+  python3-venv python3-dev
 )
 
 missing=()
