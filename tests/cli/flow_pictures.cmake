@@ -42,6 +42,8 @@ foreach(format flo png kitti)
 endforeach()
 run(2 ${CLI} predict seq --save-flow flows_x --flow-format jpeg)
 expect_match("flow-format")
+run(2 ${CLI} predict seq --flow-format png)  # not silently ignored without --save-flow
+expect_match("--flow-format requires --save-flow")
 
 # 3. viz: .flo and KITTI inputs, beside the inputs or into a new folder, scales and legend.
 file(GLOB kitti RELATIVE "${WORK}" "${WORK}/flows_kitti/*.png")
