@@ -3,7 +3,8 @@
 # (OpenCL headers and ICD loader, PoCL for the CPU, CLBlast, OpenCV, Eigen, GoogleTest,
 # Google Benchmark, CLI11, nlohmann-json, CMake and a C++17 compiler; OpenBLAS only as the
 # benchmarks' reference, never linked into the library; python3 and zsh for the CLI's terminal
-# and completion tests).
+# and completion tests; python3-venv and python3-dev for the Python package, whose own build and
+# test tools come from PyPI through tools/python_env.sh).
 # Does nothing when everything is present. Works as root (no sudo needed) or through sudo.
 set -euo pipefail
 
@@ -14,7 +15,7 @@ packages=(
   libopencv-dev libeigen3-dev libopengv-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev
-  python3 zsh
+  python3 zsh python3-venv python3-dev
 )
 
 missing=()

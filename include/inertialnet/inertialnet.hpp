@@ -45,6 +45,7 @@
 #include "inertialnet/ops/warp.hpp"
 
 // models
+#include "inertialnet/models/dis_flow.hpp"
 #include "inertialnet/models/flownet.hpp"
 #include "inertialnet/models/geometric_head.hpp"
 #include "inertialnet/models/inertialnet_head.hpp"
@@ -76,4 +77,5 @@
 
 // pipeline
 #include "inertialnet/pipeline/pipeline.hpp"
+#include "inertialnet/pipeline/predict.hpp"
 #include "inertialnet/pipeline/rates_processor.hpp"

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <system_error>
 
@@ -250,8 +251,59 @@ ColorImage flow_to_color(const FlowField& flow, float max_magnitude) {
   return image;
 }
 
-void write_flow_png(const fs::path& path, const FlowField& flow, float max_magnitude) {
-  const ColorImage image = flow_to_color(flow, max_magnitude);
+ColorImage color_wheel_legend(int size) {
+  if (size < 8) throw invalid_input("The colour-wheel legend needs at least 8 pixels, not " + std::to_string(size) + ".");
+  // A radial field: each pixel's vector points from the centre to it, its length normalised so
+  // that the inscribed circle is the radius; outside the circle the square stays white.
+  FlowField field(size, size);
+  const float centre = 0.5f * static_cast<float>(size - 1);
+  const float radius = 0.5f * static_cast<float>(size);
+  std::vector<bool> inside(field.pixel_count());
+  for (int y = 0; y < size; ++y) {
+    for (int x = 0; x < size; ++x) {
+      const float u = (static_cast<float>(x) - centre) / radius, v = (static_cast<float>(y) - centre) / radius;
+      field.u_at(x, y) = u;
+      field.v_at(x, y) = v;
+      inside[field.index(x, y)] = u * u + v * v <= 1.0f;
+    }
+  }
+  ColorImage legend = flow_to_color(field, 1.0f);
+  for (std::size_t i = 0; i < field.pixel_count(); ++i) {
+    if (!inside[i]) std::fill_n(legend.rgb.begin() + static_cast<std::ptrdiff_t>(3 * i), 3, std::uint8_t{255});
+  }
+  return legend;
+}
+
+void paste_legend(ColorImage& image, const ColorImage& legend, int margin) {
+  const int x0 = image.width - margin - legend.width, y0 = image.height - margin - legend.height;
+  for (int y = std::max(0, -y0); y < legend.height && y0 + y < image.height; ++y) {
+    for (int x = std::max(0, -x0); x < legend.width && x0 + x < image.width; ++x) {
+      const std::uint8_t* from = legend.pixel(x, y);
+      std::uint8_t* to = image.rgb.data() + 3 * (static_cast<std::size_t>(y0 + y) * static_cast<std::size_t>(image.width) +
+                                                 static_cast<std::size_t>(x0 + x));
+      std::copy(from, from + 3, to);
+    }
+  }
+}
+
+namespace {
+
+std::vector<unsigned char> encode_png(const fs::path& path, const cv::Mat& image, const char* what) {
+  std::vector<unsigned char> png;
+  try {
+    if (!cv::imencode(".png", image, png)) throw runtime_error(std::string("OpenCV could not encode the ") + what + " as PNG.");
+  } catch (const cv::Exception& e) {
+    throw runtime_error(std::string("OpenCV could not encode the ") + what + " for " + quoted(path) + " as PNG: " + e.what());
+  }
+  return png;
+}
+
+constexpr int kKittiOffset = 1 << 15;
+constexpr float kKittiScale = 64.0f;
+
+}  // namespace
+
+void write_color_png(const fs::path& path, const ColorImage& image) {
   cv::Mat bgr(image.height, image.width, CV_8UC3);
   for (int y = 0; y < image.height; ++y) {
     auto* row = bgr.ptr<cv::Vec3b>(y);
@@ -260,13 +312,88 @@ void write_flow_png(const fs::path& path, const FlowField& flow, float max_magni
       row[x] = cv::Vec3b(p[2], p[1], p[0]);  // OpenCV's encoders take BGR
     }
   }
-  std::vector<unsigned char> png;
-  try {
-    if (!cv::imencode(".png", bgr, png)) throw runtime_error("OpenCV could not encode the flow image as PNG.");
-  } catch (const cv::Exception& e) {
-    throw runtime_error("OpenCV could not encode the flow image for " + quoted(path) + " as PNG: " + e.what());
-  }
+  const std::vector<unsigned char> png = encode_png(path, bgr, "flow image");
   write_file_atomically(path, png.data(), png.size());
+}
+
+void write_flow_png(const fs::path& path, const FlowField& flow, float max_magnitude) {
+  write_color_png(path, flow_to_color(flow, max_magnitude));
+}
+
+std::uint16_t kitti_flow_value(float component) {
+  const double scaled = std::nearbyint(static_cast<double>(component) * kKittiScale) + kKittiOffset;
+  return static_cast<std::uint16_t>(std::clamp(scaled, 0.0, 65535.0));
+}
+
+void write_kitti_flow_png(const fs::path& path, const FlowField& flow) {
+  flow.validate();
+  cv::Mat bgr(flow.height, flow.width, CV_16UC3);
+  for (int y = 0; y < flow.height; ++y) {
+    auto* row = bgr.ptr<cv::Vec<std::uint16_t, 3>>(y);
+    for (int x = 0; x < flow.width; ++x) {
+      const float u = flow.u_at(x, y), v = flow.v_at(x, y);
+      // OpenCV's channel order is B, G, R: valid, v, u.
+      row[x] = is_unknown_flow(u, v) ? cv::Vec<std::uint16_t, 3>(0, 0, 0)
+                                     : cv::Vec<std::uint16_t, 3>(1, kitti_flow_value(v), kitti_flow_value(u));
+    }
+  }
+  const std::vector<unsigned char> png = encode_png(path, bgr, "KITTI flow");
+  write_file_atomically(path, png.data(), png.size());
+}
+
+namespace {
+
+std::vector<unsigned char> read_flow_bytes(const fs::path& path) {
+  std::ifstream in = io_detail::open_input_file(path, "The flow file");
+  std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw invalid_input("The flow file " + quoted(path) + " could not be read to its end.");
+  return bytes;
+}
+
+FlowField decode_kitti_flow_png(const fs::path& path, const std::vector<unsigned char>& bytes) {
+  cv::Mat image;
+  try {
+    if (!bytes.empty()) {
+      image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U, const_cast<unsigned char*>(bytes.data())),
+                           cv::IMREAD_UNCHANGED);
+    }
+  } catch (const cv::Exception& e) {
+    throw invalid_input("The KITTI flow file " + quoted(path) + " cannot be decoded: " + e.what());
+  }
+  if (image.empty()) throw invalid_input("The KITTI flow file " + quoted(path) + " is not a decodable PNG.");
+  if (image.depth() != CV_16U || image.channels() != 3) {
+    throw invalid_input("The file " + quoted(path) + " is not a KITTI flow PNG: it has " +
+                        std::to_string(image.channels()) + " channel(s) of " +
+                        (image.depth() == CV_16U ? "16" : image.depth() == CV_8U ? "8" : "other") +
+                        "-bit samples; KITTI flow has 3 channels of 16 bits (u, v, valid).");
+  }
+  FlowField flow(image.cols, image.rows);
+  for (int y = 0; y < image.rows; ++y) {
+    const auto* row = image.ptr<cv::Vec<std::uint16_t, 3>>(y);
+    for (int x = 0; x < image.cols; ++x) {
+      const bool valid = row[x][0] != 0;
+      flow.u_at(x, y) = valid ? (static_cast<float>(row[x][2]) - kKittiOffset) / kKittiScale : kUnknownFlowValue;
+      flow.v_at(x, y) = valid ? (static_cast<float>(row[x][1]) - kKittiOffset) / kKittiScale : kUnknownFlowValue;
+    }
+  }
+  return flow;
+}
+
+bool is_png(const std::vector<unsigned char>& bytes) {
+  static const unsigned char signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+  return bytes.size() >= 8 && std::equal(signature, signature + 8, bytes.begin());
+}
+
+}  // namespace
+
+FlowField read_kitti_flow_png(const fs::path& path) { return decode_kitti_flow_png(path, read_flow_bytes(path)); }
+
+FlowField read_flow_file(const fs::path& path) {
+  const std::vector<unsigned char> bytes = read_flow_bytes(path);
+  if (bytes.size() >= 4 && std::memcmp(bytes.data(), kFloMagic, 4) == 0) return read_flo(path);
+  if (is_png(bytes)) return decode_kitti_flow_png(path, bytes);
+  throw invalid_input("The file " + quoted(path) +
+                      " is neither a Middlebury .flo file (magic \"PIEH\") nor a KITTI flow PNG.");
 }
 
 }  // namespace inertialnet

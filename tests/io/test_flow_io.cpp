@@ -17,6 +17,9 @@
 #include "inertialnet/io/image_io.hpp"
 #include "support/testing.hpp"
 
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
 using namespace inertialnet;
 namespace fs = std::filesystem;
 namespace it = inertialnet::testing;
@@ -359,4 +362,100 @@ TEST(FlowColor, PngRoundTripKeepsTheColoursAndChannelOrder) {
   EXPECT_GT(png.at(1, 0, 48), png.at(2, 0, 48));
   EXPECT_LT(png.at(1, 0, 48), 100.0f);
   for (int c = 0; c < 3; ++c) EXPECT_EQ(png.at(c, 63, 95), 0.0f);
+}
+
+// --- KITTI flow PNG ---------------------------------------------------------------------------
+
+TEST(KittiFlow, WriterFollowsTheFormatDefinition) {
+  // Read back with OpenCV, not with the library: 16-bit, 3 channels, R = u, G = v as
+  // 64·c + 2^15, B = valid.
+  const auto dir = fs::path(it::temporary_directory("kitti_layout"));
+  FlowField flow(3, 2);
+  flow.u = {0.0f, 1.5f, -2.25f, 511.0f, -512.0f, kUnknownFlowValue};
+  flow.v = {0.0f, -0.015625f, 100.0f, 3.0f, 0.5f, 0.0f};
+  write_kitti_flow_png(dir / "f.png", flow);
+  const cv::Mat png = cv::imread((dir / "f.png").string(), cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(png.type(), CV_16UC3);
+  ASSERT_EQ(png.cols, 3);
+  ASSERT_EQ(png.rows, 2);
+  const auto px = [&](int x, int y) { return png.at<cv::Vec<std::uint16_t, 3>>(y, x); };  // B, G, R
+  EXPECT_EQ(px(0, 0), (cv::Vec<std::uint16_t, 3>(1, 32768, 32768)));
+  EXPECT_EQ(px(1, 0), (cv::Vec<std::uint16_t, 3>(1, 32767, 32768 + 96)));
+  EXPECT_EQ(px(2, 0), (cv::Vec<std::uint16_t, 3>(1, 32768 + 6400, 32768 - 144)));
+  EXPECT_EQ(px(0, 1), (cv::Vec<std::uint16_t, 3>(1, 32768 + 192, 32768 + 511 * 64)));
+  EXPECT_EQ(px(1, 1), (cv::Vec<std::uint16_t, 3>(1, 32768 + 32, 0)));
+  EXPECT_EQ(px(2, 1), (cv::Vec<std::uint16_t, 3>(0, 0, 0)));  // unknown: invalid
+  EXPECT_EQ(kitti_flow_value(1000.0f), 65535);                 // clamped to the range
+  EXPECT_EQ(kitti_flow_value(-1000.0f), 0);
+}
+
+TEST(KittiFlow, RoundTripIsExactToTheQuantisation) {
+  const auto dir = fs::path(it::temporary_directory("kitti_rt"));
+  FlowField flow = rotating_field(97, 61);
+  // Values on the 1/64 grid come back exactly; any value within half a step.
+  FlowField on_grid = flow;
+  for (std::size_t i = 0; i < flow.pixel_count(); ++i) {
+    if (is_unknown_flow(flow.u[i], flow.v[i])) continue;
+    on_grid.u[i] = std::round(flow.u[i] * 64.0f) / 64.0f;
+    on_grid.v[i] = std::round(flow.v[i] * 64.0f) / 64.0f;
+  }
+  write_kitti_flow_png(dir / "grid.png", on_grid);
+  write_kitti_flow_png(dir / "any.png", flow);
+  const FlowField grid_back = read_kitti_flow_png(dir / "grid.png");
+  const FlowField any_back = read_flow_file(dir / "any.png");
+  ASSERT_EQ(grid_back.width, 97);
+  ASSERT_EQ(grid_back.height, 61);
+  for (std::size_t i = 0; i < flow.pixel_count(); ++i) {
+    if (is_unknown_flow(flow.u[i], flow.v[i])) {
+      ASSERT_TRUE(is_unknown_flow(grid_back.u[i], grid_back.v[i])) << i;
+      ASSERT_TRUE(is_unknown_flow(any_back.u[i], any_back.v[i])) << i;
+      continue;
+    }
+    ASSERT_EQ(grid_back.u[i], on_grid.u[i]) << i;
+    ASSERT_EQ(grid_back.v[i], on_grid.v[i]) << i;
+    ASSERT_LE(std::fabs(any_back.u[i] - flow.u[i]), 1.0f / 128.0f + 1e-6f) << i;
+    ASSERT_LE(std::fabs(any_back.v[i] - flow.v[i]), 1.0f / 128.0f + 1e-6f) << i;
+  }
+}
+
+TEST(KittiFlow, ReaderRefusesOtherImagesAndReadFlowFileKnowsBothFormats) {
+  const auto dir = fs::path(it::temporary_directory("kitti_errors"));
+  cv::imwrite((dir / "rgb8.png").string(), cv::Mat(4, 4, CV_8UC3, cv::Scalar(1, 2, 3)));
+  EXPECT_TRUE(contains(invalid_input_message([&] { read_kitti_flow_png(dir / "rgb8.png"); }), "not a KITTI flow PNG"));
+  EXPECT_TRUE(contains(invalid_input_message([&] { read_flow_file(dir / "rgb8.png"); }), "8-bit"));
+  write_bytes(dir / "text.flo", {'h', 'e', 'l', 'l', 'o'});
+  EXPECT_TRUE(contains(invalid_input_message([&] { read_flow_file(dir / "text.flo"); }), "neither a Middlebury"));
+  EXPECT_TRUE(contains(invalid_input_message([&] { read_flow_file(dir / "missing.flo"); }), "does not exist"));
+  const FlowField flow = rotating_field(10, 9);
+  write_flo(dir / "f.flo", flow);
+  const FlowField back = read_flow_file(dir / "f.flo");
+  EXPECT_EQ(back.u, flow.u);
+}
+
+// --- legend -------------------------------------------------------------------------------------
+
+TEST(FlowColor, LegendWheelShowsEachDirectionsColourAtTheRim) {
+  const int size = 65;
+  const ColorImage legend = color_wheel_legend(size);
+  ASSERT_EQ(legend.width, size);
+  ASSERT_EQ(legend.height, size);
+  const auto at = [&](int x, int y) {
+    const std::uint8_t* p = legend.pixel(x, y);
+    return Rgb{p[0], p[1], p[2]};
+  };
+  EXPECT_TRUE(near_rgb(at(32, 32), {255, 255, 255}, 0));  // centre: zero flow, white
+  EXPECT_TRUE(near_rgb(at(0, 0), {255, 255, 255}, 0));    // outside the circle: white
+  // Each pixel is the colour of the vector from the centre to it, the rim (radius 32.5 px)
+  // being the normalising radius: right red, left cyan-blue, down yellow-orange.
+  const float r = 32.5f;
+  EXPECT_TRUE(near_rgb(at(63, 32), color_of(31 / r, 0, 1), 0));
+  EXPECT_TRUE(near_rgb(at(1, 32), color_of(-31 / r, 0, 1), 0));
+  EXPECT_TRUE(near_rgb(at(32, 63), color_of(0, 31 / r, 1), 0));
+  EXPECT_TRUE(near_rgb(at(63, 32), {255, 11, 11}, 0));
+  EXPECT_TRUE(contains(invalid_input_message([] { color_wheel_legend(4); }), "8 pixels"));
+
+  ColorImage image = flow_to_color(FlowField(100, 80));
+  paste_legend(image, legend, 4);
+  EXPECT_TRUE(near_rgb(Rgb{image.pixel(95 - 1, 75 - 32)[0], image.pixel(95 - 1, 75 - 32)[1], image.pixel(95 - 1, 75 - 32)[2]},
+                       at(63, 32), 0));
 }

@@ -1,5 +1,5 @@
-// `inertialnet flow IMG1 IMG2 --weights W`: one optical-flow field, as Middlebury .flo and/or a
-// colour-wheel PNG.
+// `inertialnet flow IMG1 IMG2 [--weights W]`: one optical-flow field (FlowNet2 family with weights,
+// OpenCV DIS without), as Middlebury .flo, a KITTI flow PNG and/or a colour-wheel PNG.
 #include <chrono>
 #include <cmath>
 #include <iostream>
@@ -10,7 +10,9 @@
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/io/flow_io.hpp"
 #include "inertialnet/io/image_io.hpp"
+#include "inertialnet/models/dis_flow.hpp"
 #include "inertialnet/models/flownet.hpp"
+#include "inertialnet/pipeline/rates_processor.hpp"
 #include "inertialnet/runtime/layer_profiler.hpp"
 #include "profile.hpp"
 
@@ -21,7 +23,8 @@ struct FlowOptions {
   std::string image1, image2;
   std::vector<std::string> weights;
   std::string model;
-  std::string flo, png;
+  std::string flow;  // "" = flownet2 with weights, dis without
+  std::string flo, png, kitti;
   bool profile = false;
 };
 
@@ -33,17 +36,46 @@ ModelKind flow_model(const WeightSet& weights, const std::string& requested) {
   throw invalid_input("weights " + weights.sources() +
                       " do not say which FlowNet model they hold (metadata inertialnet.model); pass --model");
 }
+
+void report(const FlowField& flow, const std::string& method, const HostImage& frame, double seconds,
+            const std::string& timing_note = "") {
+  double sum = 0;
+  for (std::size_t i = 0; i < flow.pixel_count(); ++i) sum += std::hypot(flow.u[i], flow.v[i]);
+  std::cout << method << ": " << frame.width << "x" << frame.height << " flow in " << seconds << " s" << timing_note << ", mean |flow| "
+            << sum / static_cast<double>(flow.pixel_count()) << " px, max " << max_flow_magnitude(flow) << " px\n";
+}
+
+void write_outputs(const FlowOptions& o, const FlowField& flow) {
+  if (!o.flo.empty()) {
+    prepare_output_file(o.flo, "-o");
+    write_flo(o.flo, flow);
+  }
+  if (!o.png.empty()) {
+    prepare_output_file(o.png, "--png");
+    write_flow_png(o.png, flow);
+  }
+  if (!o.kitti.empty()) {
+    prepare_output_file(o.kitti, "--kitti");
+    write_kitti_flow_png(o.kitti, flow);
+  }
+  if (o.flo.empty() && o.png.empty() && o.kitti.empty()) {
+    std::cout << "(no output file: add -o out.flo, --png out.png and/or --kitti out_kitti.png)\n";
+  }
+}
 }  // namespace
 
 Command register_flow(CLI::App& app, const GlobalOptions& global) {
   auto o = std::make_shared<FlowOptions>();
   app.add_option("image1", o->image1, "first frame")->required()->check(CLI::ExistingFile);
   app.add_option("image2", o->image2, "second frame (same size)")->required()->check(CLI::ExistingFile);
-  app.add_option("-w,--weights", o->weights, "FlowNet2-family weights (safetensors); repeatable")->required();
+  app.add_option("-w,--weights", o->weights, "FlowNet2-family weights (safetensors); repeatable");
+  app.add_option("--flow", o->flow, "flownet2 (default with weights) or dis (OpenCV DIS; default without weights)")
+      ->transform(choice("flow method", {"flownet2", "dis"}));
   app.add_option("--model", o->model, "flow network (default: from the weights)")
       ->transform(choice("model", flow_model_names()));
   app.add_option("-o,--output", o->flo, "write the flow as Middlebury .flo (folders created as needed)");
   app.add_option("--png", o->png, "write the flow as a colour-wheel PNG (folders created as needed)");
+  app.add_option("--kitti", o->kitti, "write the flow as a KITTI 16-bit flow PNG (folders created as needed)");
   app.add_flag("--profile", o->profile, "print the device time of every layer (after one warm-up run)");
   return [o, &global]() {
     const HostImage first = load_rgb_image(o->image1);
@@ -52,6 +84,21 @@ Command register_flow(CLI::App& app, const GlobalOptions& global) {
       throw invalid_input("the frames differ in size: " + o->image1 + " is " + std::to_string(first.width) + "x" +
                           std::to_string(first.height) + ", " + o->image2 + " is " + std::to_string(second.width) +
                           "x" + std::to_string(second.height));
+    }
+    const FlowMethod method = parse_flow_method(o->flow.empty() ? (o->weights.empty() ? "dis" : "flownet2") : o->flow);
+    if (method == FlowMethod::DIS && (!o->weights.empty() || o->profile || !o->model.empty())) {
+      throw invalid_input("--flow dis takes no --weights, --model or --profile: DIS runs on the host without weights");
+    }
+    if (method == FlowMethod::DIS) {
+      const auto start = std::chrono::steady_clock::now();
+      const FlowField flow = DisFlow().compute(first, second);
+      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      report(flow, "DIS (OpenCV, no weights)", first, seconds);
+      write_outputs(*o, flow);
+      return 0;
+    }
+    if (o->weights.empty()) {
+      throw invalid_input("--flow flownet2 needs --weights FILE (safetensors); without weights use --flow dis");
     }
     auto device = open_device(global);
     const WeightSet weights = WeightSet::load(*device, o->weights);
@@ -68,13 +115,8 @@ Command register_flow(CLI::App& app, const GlobalOptions& global) {
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     // One pair is all there is to time: say when its time includes compiling rather than hide it.
     const bool compiled = device->programs().stats().source_builds > builds_before;
-
-    double sum = 0;
-    for (std::size_t i = 0; i < flow.pixel_count(); ++i) sum += std::hypot(flow.u[i], flow.v[i]);
-    std::cout << to_string(net.kind()) << " on " << device->info().name << ": " << first.width << "x" << first.height
-              << " flow in " << seconds << " s" << (compiled ? " (including the first run's kernel compile)" : "")
-              << ", mean |flow| " << sum / static_cast<double>(flow.pixel_count())
-              << " px, max " << max_flow_magnitude(flow) << " px\n";
+    report(flow, std::string(to_string(net.kind())) + " on " + device->info().name, first, seconds,
+           compiled ? " (including the first run's kernel compile)" : "");
     if (o->profile) {
       // A second run on a profiling queue: the first one compiled the kernels, whose time is not the layers'.
       const auto profiling_queue = device->create_queue(true);
@@ -84,15 +126,7 @@ Command register_flow(CLI::App& app, const GlobalOptions& global) {
       profiling_queue->finish();
       print_profile(std::string(to_string(net.kind())) + " on " + device->info().name, profiler.collect());
     }
-    if (!o->flo.empty()) {
-      prepare_output_file(o->flo, "-o");
-      write_flo(o->flo, flow);
-    }
-    if (!o->png.empty()) {
-      prepare_output_file(o->png, "--png");
-      write_flow_png(o->png, flow);
-    }
-    if (o->flo.empty() && o->png.empty()) std::cout << "(no output file: add -o out.flo and/or --png out.png)\n";
+    write_outputs(*o, flow);
     return 0;
   };
 }

@@ -1,6 +1,5 @@
 // `inertialnet predict SEQ`: angular rates for every frame pair of a sequence, through the
 // pipelined scheduler, as a rates CSV (timestamp_ns,wx,wy,wz; rad/s; stamped with t_k).
-#include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -11,13 +10,11 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "console.hpp"
-#include "inertialnet/runtime/device_selection.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/runtime/layer_profiler.hpp"
 #include "inertialnet/io/flow_io.hpp"
-#include "inertialnet/io/frame_source.hpp"
 #include "inertialnet/pipeline/pipeline.hpp"
-#include "inertialnet/pipeline/rates_processor.hpp"
+#include "inertialnet/pipeline/predict.hpp"
 #include "inertialnet/io/rates_csv.hpp"
 #include "inertialnet/eval/time_offset.hpp"
 #include "profile.hpp"
@@ -40,6 +37,7 @@ struct PredictOptions {
   double fx = 0, fy = 0, cx = 0, cy = 0;
   std::string output;
   std::string save_flow;
+  std::string flow_format = "flo";
   double rate_hz = 0;
   std::string time_offset, readout_time;
   int lanes = 2;
@@ -49,39 +47,17 @@ struct PredictOptions {
   bool profile = false;
 };
 
-ModelKind flow_model_of(const WeightSet& weights, const std::string& requested) {
-  if (!requested.empty()) return model_kind_from_string(requested);
-  for (const ModelKind kind : weights.models()) {
-    if (kind != ModelKind::InertialNetHead) return kind;
-  }
-  return ModelKind::FlowNet2;
-}
-
-// One pair (the first) through a processor of each device, untimed: kernels compile and the
-// networks plan their memory here, so the timed run measures pairs only. The sequence is opened
-// again because a video source decodes in order from its start.
-void warm_up(const std::string& sequence, double rate_hz, const std::vector<Device*>& devices,
-             const ProcessorFactory& factory) {
-  auto source = open_frame_source(sequence, rate_hz > 0 ? std::optional<double>(rate_hz) : std::nullopt);
-  const Frame first{0, source->timestamp_ns(0), source->decode(0)};
-  const Frame second{1, source->timestamp_ns(1), source->decode(1)};
-  const std::atomic<bool> keep_going{false};
-  for (Device* device : devices) {
-    const auto start = std::chrono::steady_clock::now();
-    PairResult discarded;
-    factory(*device, 0)->process(first, second, discarded, keep_going);
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    char text[32];
-    std::snprintf(text, sizeof text, "%.2f", seconds);
-    info("warm-up pair on " + device->info().name + ": " + text + " s (kernel compile and planning; not counted below)");
+// One pair's flow under --save-flow, named by the pair's second frame like the rates row.
+void save_flow(const std::filesystem::path& folder, const std::string& format, std::int64_t t_ns, const FlowField& flow) {
+  const std::string stem = std::to_string(t_ns);
+  if (format == "flo") {
+    write_flo(folder / (stem + ".flo"), flow);
+  } else if (format == "png") {
+    write_flow_png(folder / (stem + ".png"), flow);
+  } else {
+    write_kitti_flow_png(folder / (stem + ".png"), flow);
   }
 }
-
-const char* kNoWeightsHelp =
-    "Convert a flownet2-pytorch checkpoint with `python3 tools/convert_checkpoint.py FlowNet2_checkpoint.pth.tar "
-    "flownet2.safetensors` (and the head the same way), or write synthetic weights for a trial run with "
-    "`inertialnet weights --synthetic FlowNet2 -o flownet2.safetensors` and `inertialnet weights --synthetic "
-    "InertialNetHead --size WxH -o head.safetensors`";
 
 }  // namespace
 
@@ -119,8 +95,25 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
   app.add_option("--fy", o->fy, "focal length y (px)")->check(finite_positive);
   app.add_option("--cx", o->cx, "principal point x (px)")->check(finite);
   app.add_option("--cy", o->cy, "principal point y (px)")->check(finite);
+<<<<<<< HEAD
   app.add_option("-o,--output", o->output, "rates CSV to write, folders created as needed (default: standard output)");
-  app.add_option("--save-flow", o->save_flow, "write each pair's flow as <timestamp>.flo into this folder (created as needed)");
+  auto* save_flow_option = app.add_option(
+      "--save-flow", o->save_flow, "write each pair's flow as <timestamp>.flo (or .png) into this folder (created as needed)");
+  app.add_option("--flow-format", o->flow_format,
+                 "--save-flow format: flo (Middlebury), png (colour wheel) or kitti (KITTI 16-bit flow PNG)")
+      ->capture_default_str()
+      ->transform(choice("flow format", {"flo", "png", "kitti"}))
+      ->needs(save_flow_option);
+=======
+  app.add_option("-o,--output", o->output, "rates CSV to write (default: standard output)");
+  auto* save_flow_option =
+      app.add_option("--save-flow", o->save_flow, "write each pair's flow as <timestamp>.flo (or .png) into this folder");
+  app.add_option("--flow-format", o->flow_format,
+                 "--save-flow format: flo (Middlebury), png (colour wheel) or kitti (KITTI 16-bit flow PNG)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"flo", "png", "kitti"}))
+      ->needs(save_flow_option);
+>>>>>>> python
   app.add_option("--rate", o->rate_hz, "frame rate for image folders and videos without timestamps (Hz)")
       ->check(finite_positive);
   app.add_option("--time-offset", o->time_offset,
@@ -143,89 +136,38 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
   app.add_flag("--profile", o->profile, "print the device time of every network layer per pair (profiling queues)");
   return [o, &global]() {
     const bool have_weights = !o->weights.empty();
-    RatesProcessorOptions processor;
-    processor.flow = parse_flow_method(o->flow.empty() ? (have_weights ? "flownet2" : "dis") : o->flow);
-    const std::string head = o->head.empty() ? (have_weights ? "inertialnet" : "geometric") : o->head;
-    processor.inertialnet_head = head != "geometric";
-    processor.geometric_head = head != "inertialnet";
-    if (!have_weights && (processor.flow == FlowMethod::FlowNet || processor.inertialnet_head)) {
-      throw invalid_input(std::string("--flow flownet2 and --head inertialnet need weights: --weights FILE with the "
-                                      "FlowNet2 and InertialNet head tensors (safetensors). ") + kNoWeightsHelp +
-                          ". Without weights, predict runs DIS flow + the geometric head.");
-    }
-    if (o->solver == "opengv") processor.geometric.solver = GeometricSolver::OpenGV;
-    if (!o->readout_time.empty()) {
-      processor.geometric.readout_time_s = parse_seconds(o->readout_time, "--readout-time");
-    }
-    auto source = open_frame_source(o->sequence, o->rate_hz > 0 ? std::optional<double>(o->rate_hz) : std::nullopt);
-    for (const auto& note : source->notes()) info("note: " + note);
-    if (processor.geometric_head) {
-      const bool given = o->fx > 0 || o->fy > 0;
-      if (given) {
-        CameraIntrinsics camera;
-        const HostImage first = source->decode(0);
-        camera.width = first.width;
-        camera.height = first.height;
-        camera.fx = o->fx;
-        camera.fy = o->fy > 0 ? o->fy : o->fx;
-        camera.cx = o->cx > 0 ? o->cx : (first.width - 1) / 2.0;
-        camera.cy = o->cy > 0 ? o->cy : (first.height - 1) / 2.0;
-        camera.validate();
-        processor.camera = camera;
-      } else if (const auto calibration = source->calibration()) {
-        processor.camera = CameraIntrinsics::from_calibration(*calibration);
-        // The geometric head allocates per pixel of the calibrated size: compare it with the
-        // images before, so that a wrong resolution is a clear message, not gigabytes asked for.
-        const HostImage first = source->decode(0);
-        if (first.width != processor.camera->width || first.height != processor.camera->height) {
-          throw invalid_input(source->description() + ": cam0/sensor.yaml gives the resolution " +
-                              std::to_string(processor.camera->width) + "x" + std::to_string(processor.camera->height) +
-                              ", which does not match the images (" + std::to_string(first.width) + "x" +
-                              std::to_string(first.height) + ").");
-        }
-        processor.camera_to_body = calibration->rotation_BS();
-      } else {
-        throw invalid_input("the geometric head needs the camera: " + source->description() +
-                            " has no cam0/sensor.yaml; give --fx (and --fy --cx --cy)");
-      }
-    }
-    processor.keep_flow = !o->save_flow.empty();
-
-    // Devices and their weights (one set per device).
-    const auto infos = select_devices(device_spec_or_environment(global.device), discover_devices());
     LayerProfiler profiler;  // declared before the devices, whose queues report to it
-    std::vector<std::unique_ptr<Device>> devices;
-    std::vector<std::unique_ptr<WeightSet>> weight_sets;
-    std::map<const Device*, const WeightSet*> weights_of;
-    std::vector<Device*> device_list;
-    for (const auto& info : infos) {
-      DeviceOptions options;
-      if (global.no_cache) options.program_cache = DiskCacheMode::Off;
-      if (o->profile) options.profiler = &profiler;
-      devices.push_back(std::make_unique<Device>(info, options));
-      if (have_weights) {
-        weight_sets.push_back(std::make_unique<WeightSet>(WeightSet::load(*devices.back(), o->weights)));
-        weights_of[devices.back().get()] = weight_sets.back().get();
-      }
-      device_list.push_back(devices.back().get());
-    }
-    if (have_weights) {
-      warn_if_synthetic(*weight_sets.front());
-      processor.flow_model = flow_model_of(*weight_sets.front(), o->model);
-    }
-    const auto factory = rates_processor(weights_of, processor);
+    PredictSettings settings;
+    settings.sequence = o->sequence;
+    settings.weights = o->weights;
+    settings.model = o->model;
+    settings.flow = o->flow;
+    settings.head = o->head;
+    settings.solver = o->solver;
+    settings.fx = o->fx;
+    settings.fy = o->fy;
+    settings.cx = o->cx;
+    settings.cy = o->cy;
+    settings.rate_hz = o->rate_hz;
+    if (!o->readout_time.empty()) settings.readout_time_s = parse_seconds(o->readout_time, "--readout-time");
+    if (!o->time_offset.empty()) settings.time_offset_s = parse_seconds(o->time_offset, "--time-offset");
+    settings.device = global.device;
+    settings.no_cache = global.no_cache;
+    settings.keep_flow = !o->save_flow.empty();
+    if (o->profile) settings.profiler = &profiler;
+    Prediction prediction(settings);
+    for (const auto& note : prediction.notes()) info("note: " + note);
+    if (const WeightSet* weights = prediction.weights()) warn_if_synthetic(*weights);
+    const RatesProcessorOptions& processor = prediction.processor();
     if (!o->save_flow.empty()) prepare_output_folder(o->save_flow, "--save-flow");
     if (!o->output.empty()) prepare_output_file(o->output, "-o");
 
-    std::string method = (processor.flow == FlowMethod::DIS ? std::string("DIS flow") : to_string(processor.flow_model));
-    method += processor.inertialnet_head && processor.geometric_head ? " + InertialNet and geometric heads"
-              : processor.inertialnet_head                           ? " + InertialNet head"
-                                                                     : " + geometric head";
-    const std::size_t pairs = o->max_pairs ? std::min(o->max_pairs, source->size() - 1) : source->size() - 1;
+    const std::size_t pairs = prediction.pairs(o->max_pairs);
+    const auto& infos = prediction.device_infos();
     if (!have_weights) info("no weights given: weight-free DIS optical flow + geometric head");
-    std::string summary = source->description() + ", " + std::to_string(pairs) + " pairs, " + method + " on " +
-                          std::to_string(device_list.size()) + " device" + (device_list.size() > 1 ? "s" : "") + " (" +
-                          infos.front().name + (infos.size() > 1 ? ", …" : "") + ")";
+    std::string summary = prediction.source().description() + ", " + std::to_string(pairs) + " pairs, " +
+                          prediction.method() + " on " + std::to_string(infos.size()) + " device" +
+                          (infos.size() > 1 ? "s" : "") + " (" + infos.front().name + (infos.size() > 1 ? ", …" : "") + ")";
     if (processor.geometric_head) {
       summary += std::string("; geometric rates in the ") +
                  (processor.camera_to_body ? "body (IMU) frame" : "camera frame");
@@ -233,38 +175,19 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
     info(summary);
     // Timing keeps the first run's kernel compile (and each network's planning) out of its figures.
     if (o->stats || o->profile) {
-      warm_up(o->sequence, o->rate_hz, device_list, factory);
+      prediction.warm_up([](const DeviceInfo& device, double seconds) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%.2f", seconds);
+        info("warm-up pair on " + device.name + ": " + text + " s (kernel compile and planning; not counted below)");
+      });
       if (o->profile) profiler.collect();  // the warm-up pair is not one of the profiled ones
     }
 
     // Columns: the first estimator is wx,wy,wz; a second one adds wx_<name>,wy_<name>,wz_<name>.
-    std::vector<std::string> extra;
-    if (processor.inertialnet_head && processor.geometric_head) extra = {"wx_geometric", "wy_geometric", "wz_geometric"};
-    // What the columns are, stated in the file (docs/data_conventions.md, "Rates CSV").
-    std::vector<std::pair<std::string, std::string>> metadata;
-    const auto format_number = [](double v) {
-      char buf[32];
-      std::snprintf(buf, sizeof buf, "%.9g", v);
-      return std::string(buf);
-    };
-    const char* geometric_frame = processor.camera_to_body ? "body" : "camera";
-    if (processor.inertialnet_head) {
-      // InertialNet is trained against the gyro, so it answers in the body (IMU) frame.
-      metadata = {{"frame", "body"}, {"estimator", "network"}};
-      if (processor.geometric_head) {
-        metadata.push_back({"frame_geometric", geometric_frame});
-        metadata.push_back({"estimator_geometric", "inter_frame"});
-      }
-    } else {
-      metadata = {{"frame", geometric_frame}, {"estimator", "inter_frame"}};
-    }
-    if (!o->time_offset.empty()) {
-      metadata.push_back({"time_offset_s", format_number(parse_seconds(o->time_offset, "--time-offset"))});
-    }
-    if (!o->readout_time.empty()) {
-      metadata.push_back({"readout_time_s", format_number(processor.geometric.readout_time_s)});
-    }
+    const std::vector<std::string> columns = prediction.columns();
+    const std::vector<std::string> extra(columns.begin() + 3, columns.end());
     std::unique_ptr<RatesCsvWriter> file_writer;
+    const auto metadata = prediction.csv_metadata();
     if (!o->output.empty()) file_writer = std::make_unique<RatesCsvWriter>(o->output, extra, metadata);
     if (!file_writer) std::cout << rates_csv_header(extra, metadata);
 
@@ -274,13 +197,6 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
       const auto& w = r.rates.front().second;
       std::vector<double> more;
       for (std::size_t i = 1; i < r.rates.size(); ++i) more.insert(more.end(), r.rates[i].second.begin(), r.rates[i].second.end());
-      // Inputs are checked where they enter; a NaN here is a failure of the computation, never a rate.
-      bool finite = std::isfinite(w[0]) && std::isfinite(w[1]) && std::isfinite(w[2]);
-      for (const double v : more) finite = finite && std::isfinite(v);
-      if (!finite) {
-        throw runtime_error("the rates computed for the frame at timestamp " + std::to_string(r.t1_ns) +
-                            " are not finite (NaN or infinity); stopping rather than writing them.");
-      }
       if (file_writer) {
         file_writer->write(r.t1_ns, {w[0], w[1], w[2]}, more);
       } else {
@@ -289,7 +205,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
         std::printf("\n");
         flush_standard_output();  // a row at a time, so a closed pipe stops the run at once
       }
-      if (r.flow) write_flo(std::filesystem::path(o->save_flow) / (std::to_string(r.t1_ns) + ".flo"), *r.flow);
+      if (r.flow) save_flow(o->save_flow, o->flow_format, r.t1_ns, *r.flow);
       progress.update(++done);
     };
 
@@ -300,7 +216,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
     options.cancel = &interrupted;
     std::signal(SIGINT, on_interrupt);
     std::signal(SIGTERM, on_interrupt);
-    const PipelineStats stats = run_pipeline(*source, device_list, factory, sink, options);
+    const PipelineStats stats = prediction.run(sink, options);
     std::signal(SIGINT, SIG_DFL);
     std::signal(SIGTERM, SIG_DFL);
     progress.finish();  // the summary below starts on a line of its own

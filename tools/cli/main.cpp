@@ -51,11 +51,12 @@ int main(int argc, char** argv) {
   };
   static constexpr Subcommand kSubcommands[] = {
       {"devices", "list the OpenCL platforms and devices", cli::register_devices},
-      {"flow", "optical flow between two images (FlowNet2 family)", cli::register_flow},
+      {"flow", "optical flow between two images (FlowNet2 family, or DIS without weights)", cli::register_flow},
       {"predict", "angular rates for every frame pair of a sequence", cli::register_predict},
       {"eval", "the paper's metrics for a rates CSV against a EuRoC sequence", cli::register_eval},
       {"calibrate-time", "estimate the camera-IMU time offset of a sequence from its images and gyro",
        cli::register_calibrate_time},
+      {"viz", "flow files (.flo, KITTI PNG) as colour-wheel pictures", cli::register_viz},
       {"synth", "render a EuRoC-layout sequence from a known camera motion", cli::register_synth},
       {"bench", "pairs per second, stage split and per-layer profile (synthetic weights)", cli::register_bench},
       {"weights", "write synthetic weights, or describe a weight file", cli::register_weights},

@@ -9,6 +9,10 @@
 // motion to the right; the hue turns through yellow, green, cyan, blue and magenta), the
 // magnitude divided by a normalising radius the saturation: zero flow is white, flow at the
 // radius is the fully saturated wheel colour, flow beyond it the wheel colour dimmed to 75 %.
+//
+// KITTI flow PNG (Geiger et al., KITTI 2012/2015 devkit): a 16-bit, 3-channel PNG whose red
+// channel holds u and green v as (value − 2^15) / 64 pixels, and whose blue channel is 1 where
+// the flow is valid and 0 where it is not; the precision is 1/64 px and the range ±512 px.
 #pragma once
 
 #include <cstddef>
@@ -58,6 +62,21 @@ FlowField read_flo(const std::filesystem::path& path);
 // half-written file. A missing folder or a read-only location is invalid_input.
 void write_flo(const std::filesystem::path& path, const FlowField& flow);
 
+// KITTI flow PNG. Invalid pixels read back as unknown flow (kUnknownFlowValue). Throws
+// invalid_input naming the file unless it is a 16-bit PNG with 3 channels.
+FlowField read_kitti_flow_png(const std::filesystem::path& path);
+// Each component rounded to the nearest 1/64 px and clamped to the format's range
+// [−512, 512 − 1/64]; unknown flow is written as invalid (blue 0, red and green 0). Atomic, like
+// write_flo().
+void write_kitti_flow_png(const std::filesystem::path& path, const FlowField& flow);
+// The KITTI quantisation of one component, as write_kitti_flow_png stores it: round(64·c) + 2^15,
+// clamped to 0..65535.
+std::uint16_t kitti_flow_value(float component);
+
+// A flow file by its content: Middlebury .flo (magic "PIEH") or a KITTI flow PNG. Anything else
+// is invalid_input naming the file and both formats.
+FlowField read_flow_file(const std::filesystem::path& path);
+
 // An 8-bit colour image, interleaved R, G, B, row-major.
 struct ColorImage {
   int width = 0;
@@ -77,7 +96,20 @@ float max_flow_magnitude(const FlowField& flow);
 // sequence of fields on one scale. Throws invalid_input for a negative or non-finite radius.
 ColorImage flow_to_color(const FlowField& flow, float max_magnitude = 0);
 
-// flow_to_color() saved as a PNG (whatever the extension), through a temporary file and rename.
+// The legend of flow_to_color(): a colour wheel `size` pixels across on a white square, i.e. the
+// colour of every flow vector up to the normalising radius (the wheel's rim), +u to the right
+// and +v down as in the image. Throws invalid_input unless size >= 8.
+ColorImage color_wheel_legend(int size);
+
+// Copies `legend` into the bottom-right corner of `image`, inside a margin of `margin` pixels
+// (shrinking nothing: a legend larger than the image is clipped).
+void paste_legend(ColorImage& image, const ColorImage& legend, int margin = 4);
+
+// An 8-bit colour image saved as a PNG (whatever the extension), through a temporary file and
+// rename.
+void write_color_png(const std::filesystem::path& path, const ColorImage& image);
+
+// flow_to_color() saved as a PNG, as write_color_png().
 void write_flow_png(const std::filesystem::path& path, const FlowField& flow, float max_magnitude = 0);
 
 }  // namespace inertialnet

@@ -1,0 +1,36 @@
+// The weight-free flow estimator: OpenCV's DIS optical flow (Kroeger et al., "Fast Optical Flow
+// using Dense Inverse Search", 2016) at its MEDIUM preset, on the frames' BT.601 luminance.
+//
+// It runs through OpenCV's T-API (UMat), so on OpenCL where OpenCV can. `predict --flow dis`,
+// `flow --flow dis` and the Python package's dis_flow() all go through this one class, so they
+// give the same field for the same frames.
+#pragma once
+
+#include <memory>
+
+#include "inertialnet/io/flow_io.hpp"
+#include "inertialnet/io/image_io.hpp"
+
+namespace inertialnet {
+
+// DIS matches 8×8 patches and builds its pyramid above them: smaller frames end in an OpenCV
+// assertion. Twice the patch leaves one pyramid level to refine.
+constexpr int kDisMinimumSide = 16;
+
+class DisFlow {
+ public:
+  DisFlow();
+  ~DisFlow();
+  DisFlow(const DisFlow&) = delete;
+  DisFlow& operator=(const DisFlow&) = delete;
+
+  // The flow from `first` to `second` in pixels. Throws invalid_input when the frames differ in
+  // size or are smaller than kDisMinimumSide on a side. Not thread-safe: one instance per thread.
+  FlowField compute(const HostImage& first, const HostImage& second);
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+}  // namespace inertialnet

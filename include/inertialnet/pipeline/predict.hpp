@@ -1,0 +1,94 @@
+// `predict` as one library call: the settings of `inertialnet predict` resolved into the frame
+// source, the devices with their weights, the camera and the pair processor, then run through
+// the pipeline. The CLI and the Python package both go through it, so they compute the same
+// numbers from the same settings.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <optional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "inertialnet/io/frame_source.hpp"
+#include "inertialnet/models/weights.hpp"
+#include "inertialnet/pipeline/pipeline.hpp"
+#include "inertialnet/pipeline/rates_processor.hpp"
+#include "inertialnet/runtime/device.hpp"
+#include "inertialnet/runtime/layer_profiler.hpp"
+
+namespace inertialnet {
+
+struct PredictSettings {
+  std::filesystem::path sequence;    // EuRoC folder, image folder or video
+  std::vector<std::string> weights;  // safetensors files; empty: the weight-free path
+  std::string model;                 // flow network; "" takes it from the weights (else FlowNet2)
+  std::string flow;                  // "flownet2" or "dis"; "": flownet2 with weights, dis without
+  std::string head;                  // "inertialnet", "geometric" or "both"; "": by the weights
+  std::string solver = "motion-field";  // geometric head: "motion-field" or "opengv"
+  // Intrinsics for sources without sensor.yaml (fx > 0 overrides the calibration); fy, cx, cy
+  // default to fx and the image centre.
+  double fx = 0, fy = 0, cx = 0, cy = 0;
+  double rate_hz = 0;                // frame rate of image folders and videos; 0: from the source
+  // Rolling shutter: seconds from the first row's exposure to the last's (0: global shutter). The
+  // geometric head corrects each flow vector's interval; the CSV states it for eval.
+  double readout_time_s = 0;
+  // Camera-IMU time offset (t_imu = t_cam + offset) stated in the CSV for eval; not applied here.
+  std::optional<double> time_offset_s;
+  std::string device;                // a --device spec; "": $INERTIALNET_DEVICE, else the default
+  bool no_cache = false;             // no on-disk program cache
+  bool keep_flow = false;            // download every pair's flow into PairResult::flow
+  LayerProfiler* profiler = nullptr;  // profiling queues report here (must outlive the Prediction)
+};
+
+// Every check happens in the constructor (invalid_input for contradictory or missing settings,
+// with the messages the CLI prints); run() then only computes.
+class Prediction {
+ public:
+  explicit Prediction(const PredictSettings& settings);
+  ~Prediction();
+  Prediction(const Prediction&) = delete;
+  Prediction& operator=(const Prediction&) = delete;
+
+  FrameSource& source() { return *source_; }
+  // Pairs a run computes: every pair, or at most `max_pairs` (0: all).
+  std::size_t pairs(std::size_t max_pairs = 0) const;
+  const std::vector<DeviceInfo>& device_infos() const { return infos_; }
+  const RatesProcessorOptions& processor() const { return processor_; }
+  // The first device's weights; nullptr on the weight-free path.
+  const WeightSet* weights() const { return weight_sets_.empty() ? nullptr : weight_sets_.front().get(); }
+  // "DIS flow + geometric head", "FlowNet2 + InertialNet and geometric heads", …
+  std::string method() const;
+  // The rates columns after timestamp_ns: wx,wy,wz for the first estimator, then
+  // wx_<name>,wy_<name>,wz_<name> for a second (with both heads: wx_geometric, …).
+  std::vector<std::string> columns() const;
+  // What the columns are, as the rates CSV states it in its `# key: value` lines (frame and
+  // estimator per column, time offset, readout time; docs/data_conventions.md, "Rates CSV").
+  std::vector<std::pair<std::string, std::string>> csv_metadata() const;
+  // What the frame source assumed (a rate for names without stamps, --rate overriding stamps, …).
+  const std::vector<std::string>& notes() const { return notes_; }
+
+  // One pair (the first) through a processor of each device, untimed, so that kernels compile and
+  // the networks plan their memory before anything is timed; `report` gets each device's seconds.
+  // The sequence is opened again because a video source decodes in order from its start.
+  void warm_up(const std::function<void(const DeviceInfo& device, double seconds)>& report = {});
+
+  // Hands each pair's result to `sink` in pair order; a rate that is not finite stops the run
+  // with runtime_error before it reaches the sink.
+  PipelineStats run(const std::function<void(const PairResult&)>& sink, const PipelineOptions& options = {});
+
+ private:
+  PredictSettings settings_;
+  std::unique_ptr<FrameSource> source_;
+  std::vector<std::string> notes_;
+  RatesProcessorOptions processor_;
+  std::vector<DeviceInfo> infos_;
+  std::vector<std::unique_ptr<Device>> devices_;
+  std::vector<std::unique_ptr<WeightSet>> weight_sets_;
+  std::map<const Device*, const WeightSet*> weights_of_;
+};
+
+}  // namespace inertialnet

@@ -1,0 +1,686 @@
+// The Python module `inertialnet._inertialnet`: the library's API for NumPy users. The pure
+// Python package (python/inertialnet/__init__.py) re-exports it and adds the model classes and
+// the structured array of predict().
+//
+// Conventions: images are NumPy uint8 (or uint16) arrays (H, W) gray, (H, W, C) with C = 1, 3 or 4
+// (alpha dropped), or batches (N, H, W, C); flow is float32 (H, W, 2) (u, v in pixels) or
+// (N, H, W, 2); rates are float64 (3,) in rad/s. Device work runs without the GIL. Library errors
+// keep their messages: invalid input becomes ValueError, runtime failures RuntimeError.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "inertialnet/inertialnet.hpp"
+
+namespace py = pybind11;
+using namespace inertialnet;
+
+namespace {
+
+// --- arrays ------------------------------------------------------------------------------------
+
+enum class ChannelOrder { RGB, BGR };
+
+ChannelOrder parse_order(const std::string& order) {
+  if (order == "rgb" || order == "RGB") return ChannelOrder::RGB;
+  if (order == "bgr" || order == "BGR") return ChannelOrder::BGR;
+  throw invalid_input("unknown channel order '" + order + "'; expected rgb or bgr");
+}
+
+// One image of an (H, W), (H, W, C) or, at `index`, (N, H, W, C) array as planar RGB floats in
+// 0..255, exactly as load_rgb_image() makes them from a file.
+template <typename T>
+void to_planar(const py::array_t<T, py::array::c_style | py::array::forcecast>& a, std::size_t index, ChannelOrder order,
+               float divisor, HostImage& out) {
+  const bool batch = a.ndim() == 4;
+  const auto h = static_cast<std::size_t>(a.shape(batch ? 1 : 0));
+  const auto w = static_cast<std::size_t>(a.shape(batch ? 2 : 1));
+  const std::size_t c = a.ndim() == 2 ? 1 : static_cast<std::size_t>(a.shape(a.ndim() - 1));
+  const T* data = a.data() + index * h * w * c;
+  const std::size_t plane = h * w;
+  out.width = static_cast<int>(w);
+  out.height = static_cast<int>(h);
+  out.data.resize(3 * plane);
+  for (std::size_t i = 0; i < plane; ++i) {
+    const T* p = data + i * c;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const std::size_t from = c < 3 ? 0 : (order == ChannelOrder::RGB ? k : 2 - k);
+      out.data[k * plane + i] = static_cast<float>(p[from]) / divisor;
+    }
+  }
+}
+
+// The images of one argument: a single image or a batch.
+std::vector<HostImage> images_of(const py::array& array, const std::string& order_text, const char* what) {
+  const ChannelOrder order = parse_order(order_text);
+  const auto nd = array.ndim();
+  const auto channels = nd == 2 ? 1 : nd >= 3 ? array.shape(nd - 1) : 0;
+  if (nd < 2 || nd > 4 || (nd >= 3 && channels != 1 && channels != 3 && channels != 4)) {
+    throw invalid_input(std::string(what) + " must be an image array (H, W) gray, (H, W, C) with C = 1, 3 or 4, or a "
+                        "batch (N, H, W, C); got " + std::to_string(nd) + " dimensions" +
+                        (nd >= 3 ? " with " + std::to_string(channels) + " channels" : std::string()) + ".");
+  }
+  const std::size_t count = nd == 4 ? static_cast<std::size_t>(array.shape(0)) : 1;
+  std::vector<HostImage> images(count);
+  const bool wide = py::isinstance<py::array_t<std::uint16_t>>(array);
+  if (!wide && !py::isinstance<py::array_t<std::uint8_t>>(array)) {
+    throw invalid_input(std::string(what) + " must hold uint8 (or uint16) samples, not " +
+                        std::string(py::str(array.dtype())) + "; convert with .astype(numpy.uint8).");
+  }
+  for (std::size_t n = 0; n < count; ++n) {
+    if (wide) {
+      // 16-bit samples as the file loader takes them: 65535 / 257 = 255.
+      to_planar<std::uint16_t>(py::array_t<std::uint16_t, py::array::c_style | py::array::forcecast>::ensure(array), n,
+                               order, 257.0f, images[n]);
+    } else {
+      to_planar<std::uint8_t>(py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>::ensure(array), n,
+                              order, 1.0f, images[n]);
+    }
+  }
+  if (count == 0 || images.front().width == 0 || images.front().height == 0) {
+    throw invalid_input(std::string(what) + " is empty.");
+  }
+  return images;
+}
+
+// Planar RGB floats back to an (H, W, 3) uint8 array (values rounded and clamped).
+py::array_t<std::uint8_t> to_uint8_rgb(const HostImage& image) {
+  py::array_t<std::uint8_t> out({image.height, image.width, 3});
+  auto* p = out.mutable_data();
+  const std::size_t plane = image.plane_size();
+  for (std::size_t i = 0; i < plane; ++i) {
+    for (std::size_t k = 0; k < 3; ++k) {
+      p[3 * i + k] = static_cast<std::uint8_t>(std::clamp(image.data[k * plane + i] + 0.5f, 0.0f, 255.0f));
+    }
+  }
+  return out;
+}
+
+py::array_t<float> flow_to_array(const FlowField& flow) {
+  py::array_t<float> out({flow.height, flow.width, 2});
+  float* p = out.mutable_data();
+  for (std::size_t i = 0; i < flow.pixel_count(); ++i) {
+    p[2 * i] = flow.u[i];
+    p[2 * i + 1] = flow.v[i];
+  }
+  return out;
+}
+
+// (H, W, 2) float flow as a FlowField.
+FlowField flow_from_array(const py::array& array) {
+  const auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(array);
+  if (!a || a.ndim() != 3 || a.shape(2) != 2) {
+    throw invalid_input("a flow field must be a float array (H, W, 2) holding (u, v) in pixels; got " +
+                        std::to_string(array.ndim()) + " dimensions.");
+  }
+  FlowField flow(static_cast<int>(a.shape(1)), static_cast<int>(a.shape(0)));
+  const float* p = a.data();
+  for (std::size_t i = 0; i < flow.pixel_count(); ++i) {
+    flow.u[i] = p[2 * i];
+    flow.v[i] = p[2 * i + 1];
+  }
+  return flow;
+}
+
+// --- devices -----------------------------------------------------------------------------------
+
+py::dict device_dict(const DeviceInfo& d) {
+  py::dict out;
+  out["index"] = d.index;
+  out["platform_index"] = d.platform_index;
+  out["device_index"] = d.device_index;
+  out["platform"] = d.platform_name;
+  out["platform_vendor"] = d.platform_vendor;
+  out["name"] = d.name;
+  out["vendor"] = d.vendor;
+  out["type"] = to_string(d.type);
+  out["driver_version"] = d.driver_version;
+  out["device_version"] = d.device_version;
+  out["opencl_c_version"] = d.opencl_c_version;
+  out["compute_units"] = d.compute_units;
+  out["global_memory_bytes"] = d.global_memory_bytes;
+  out["max_alloc_bytes"] = d.max_alloc_bytes;
+  out["fp16"] = d.fp16;
+  return out;
+}
+
+// An opened device, shared by the models made on it.
+struct PyDevice {
+  std::shared_ptr<Device> device;
+  explicit PyDevice(const std::string& spec) {
+    const DeviceInfo info = select_device(device_spec_or_environment(spec), discover_devices());
+    py::gil_scoped_release release;
+    device = std::make_shared<Device>(info);
+  }
+};
+
+// `device=` of every constructor: None (INERTIALNET_DEVICE, else the default), a spec string or
+// a Device.
+std::shared_ptr<Device> device_of(const py::object& device) {
+  if (device.is_none()) return PyDevice("").device;
+  if (py::isinstance<PyDevice>(device)) return device.cast<PyDevice&>().device;
+  if (py::isinstance<py::str>(device) || py::isinstance<py::int_>(device)) {
+    return PyDevice(py::str(device).cast<std::string>()).device;
+  }
+  throw invalid_input("device must be None, a device spec string (\"0\", \"cpu\", \"pocl\", …) or an inertialnet.Device");
+}
+
+std::vector<std::string> paths_of(const py::object& weights) {
+  if (py::isinstance<py::str>(weights) || py::hasattr(weights, "__fspath__")) {
+    return {py::str(py::module_::import("os").attr("fspath")(weights)).cast<std::string>()};
+  }
+  std::vector<std::string> paths;
+  for (const auto& item : weights) paths.push_back(py::str(py::module_::import("os").attr("fspath")(item)).cast<std::string>());
+  if (paths.empty()) throw invalid_input("no weight file given");
+  return paths;
+}
+
+// --- models ------------------------------------------------------------------------------------
+
+class PyFlowNet {
+ public:
+  PyFlowNet(const py::object& weights, const py::object& device, const std::string& model)
+      : device_(device_of(device)) {
+    const auto paths = paths_of(weights);
+    py::gil_scoped_release release;
+    weights_ = std::make_unique<WeightSet>(WeightSet::load(*device_, paths));
+    ModelKind kind = ModelKind::FlowNet2;
+    if (!model.empty()) {
+      kind = model_kind_from_string(model);
+    } else {
+      bool found = false;
+      for (const ModelKind k : weights_->models()) {
+        if (k != ModelKind::InertialNetHead) {
+          kind = k;
+          found = true;
+          break;
+        }
+      }
+      if (!found) {
+        throw invalid_input("weights " + weights_->sources() +
+                            " do not say which FlowNet model they hold (metadata inertialnet.model); pass model=");
+      }
+    }
+    net_ = std::make_unique<FlowNet>(*device_, kind, *weights_);
+  }
+
+  py::array_t<float> flow(const py::array& first, const py::array& second, const std::string& order) {
+    const auto a = images_of(first, order, "img1");
+    const auto b = images_of(second, order, "img2");
+    if (a.size() != b.size() || a.front().width != b.front().width || a.front().height != b.front().height) {
+      throw invalid_input("img1 and img2 differ: " + std::to_string(a.size()) + " image(s) of " +
+                          std::to_string(a.front().width) + "x" + std::to_string(a.front().height) + " against " +
+                          std::to_string(b.size()) + " of " + std::to_string(b.front().width) + "x" +
+                          std::to_string(b.front().height) + ".");
+    }
+    const bool batch = first.ndim() == 4;
+    const auto n = static_cast<std::int64_t>(a.size());
+    const int w = a.front().width, h = a.front().height;
+    std::vector<float> result;
+    {
+      py::gil_scoped_release release;
+      std::vector<float> f1, f2;
+      for (std::size_t i = 0; i < a.size(); ++i) {
+        f1.insert(f1.end(), a[i].data.begin(), a[i].data.end());
+        f2.insert(f2.end(), b[i].data.begin(), b[i].data.end());
+      }
+      Queue& queue = device_->queue();
+      const Shape shape{n, 3, h, w};
+      const Tensor frame1 = Tensor::from_host(queue, shape, f1);
+      const Tensor frame2 = Tensor::from_host(queue, shape, f2);
+      result = net_->compute(queue, frame1, frame2).to_host(queue);
+    }
+    // [N, 2, H, W] planes to (N, H, W, 2).
+    py::array_t<float> out(batch ? std::vector<py::ssize_t>{n, h, w, 2} : std::vector<py::ssize_t>{h, w, 2});
+    float* p = out.mutable_data();
+    const std::size_t plane = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
+    for (std::size_t k = 0; k < static_cast<std::size_t>(n); ++k) {
+      const float* u = result.data() + 2 * k * plane;
+      for (std::size_t i = 0; i < plane; ++i) {
+        p[2 * (k * plane + i)] = u[i];
+        p[2 * (k * plane + i) + 1] = u[plane + i];
+      }
+    }
+    return out;
+  }
+
+  std::string model() const { return to_string(net_->kind()); }
+  std::string device() const { return device_->info().name; }
+  bool synthetic() const { return weights_->synthetic(); }
+
+ private:
+  std::shared_ptr<Device> device_;
+  std::unique_ptr<WeightSet> weights_;
+  std::unique_ptr<FlowNet> net_;
+};
+
+py::array_t<float> dis_flow(const py::array& first, const py::array& second, const std::string& order) {
+  const auto a = images_of(first, order, "img1");
+  const auto b = images_of(second, order, "img2");
+  if (a.size() != b.size()) throw invalid_input("img1 and img2 hold different numbers of images.");
+  std::vector<FlowField> flows;
+  {
+    py::gil_scoped_release release;
+    DisFlow dis;
+    for (std::size_t i = 0; i < a.size(); ++i) flows.push_back(dis.compute(a[i], b[i]));
+  }
+  if (first.ndim() != 4) return flow_to_array(flows.front());
+  const auto n = static_cast<py::ssize_t>(flows.size());
+  py::array_t<float> out({n, static_cast<py::ssize_t>(flows[0].height), static_cast<py::ssize_t>(flows[0].width),
+                          py::ssize_t{2}});
+  float* p = out.mutable_data();
+  for (const auto& f : flows) {
+    for (std::size_t i = 0; i < f.pixel_count(); ++i, p += 2) {
+      p[0] = f.u[i];
+      p[1] = f.v[i];
+    }
+  }
+  return out;
+}
+
+py::array_t<double> vec3_array(const Vec3& w) {
+  py::array_t<double> out(3);
+  std::copy(w.begin(), w.end(), out.mutable_data());
+  return out;
+}
+
+std::optional<Mat3> mat3_of(const py::object& m) {
+  if (m.is_none()) return std::nullopt;
+  const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(m);
+  if (!a || a.size() != 9) throw invalid_input("camera_to_body must be a 3x3 rotation matrix.");
+  Mat3 r;
+  std::copy(a.data(), a.data() + 9, r.begin());
+  return r;
+}
+
+class PyGeometricHead {
+ public:
+  PyGeometricHead(const py::object& device, const std::string& solver, int stride) : device_(device_of(device)) {
+    if (solver == "opengv") {
+      options_.solver = GeometricSolver::OpenGV;
+    } else if (solver != "motion-field") {
+      throw invalid_input("unknown solver '" + solver + "'; expected motion-field or opengv");
+    }
+    options_.stride = stride;
+    options_.validate();
+  }
+
+  // ω in the camera frame, or with camera_to_body in the body frame as predict reports it.
+  py::array_t<double> rates(const py::array& flow_array, const CameraIntrinsics& camera, double dt,
+                            const py::object& camera_to_body) {
+    const FlowField flow = flow_from_array(flow_array);
+    const auto r = mat3_of(camera_to_body);
+    Vec3 w;
+    {
+      py::gil_scoped_release release;
+      if (!head_ || !same_camera(head_->camera(), camera)) head_ = std::make_unique<GeometricHead>(*device_, camera, options_);
+      // The same upload as the pipeline's: the flow as a [1, 2, H, W] tensor.
+      Queue& queue = device_->queue();
+      std::vector<float> planes(flow.u);
+      planes.insert(planes.end(), flow.v.begin(), flow.v.end());
+      const Tensor tensor = Tensor::from_host(queue, {1, 2, flow.height, flow.width}, planes);
+      w = head_->estimate(queue, tensor, dt).omega;
+      if (r) w = mul(*r, w);
+    }
+    return vec3_array(w);
+  }
+
+ private:
+  static bool same_camera(const CameraIntrinsics& a, const CameraIntrinsics& b) {
+    return a.width == b.width && a.height == b.height && a.fx == b.fx && a.fy == b.fy && a.cx == b.cx &&
+           a.cy == b.cy && a.distortion == b.distortion && a.coefficients == b.coefficients;
+  }
+  std::shared_ptr<Device> device_;
+  GeometricHeadOptions options_;
+  std::unique_ptr<GeometricHead> head_;
+};
+
+class PyInertialNetHead {
+ public:
+  PyInertialNetHead(const py::object& weights, const py::object& device) : device_(device_of(device)) {
+    const auto paths = paths_of(weights);
+    py::gil_scoped_release release;
+    weights_ = std::make_unique<WeightSet>(WeightSet::load(*device_, paths));
+    head_ = std::make_unique<InertialNetHead>(*device_, *weights_);
+  }
+
+  // (3,) for one flow (H, W, 2), (N, 3) for a batch (N, H, W, 2). The learned head needs neither
+  // camera nor frame interval: it was trained on one camera and rate.
+  py::array_t<double> rates(const py::array& flow_array) {
+    const auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(flow_array);
+    const bool batch = a && a.ndim() == 4;
+    if (!a || (a.ndim() != 3 && a.ndim() != 4) || a.shape(a.ndim() - 1) != 2) {
+      throw invalid_input("the flow must be a float array (H, W, 2) or a batch (N, H, W, 2).");
+    }
+    const std::int64_t n = batch ? a.shape(0) : 1;
+    const std::int64_t h = a.shape(batch ? 1 : 0), w = a.shape(batch ? 2 : 1);
+    const std::size_t plane = static_cast<std::size_t>(h * w);
+    std::vector<float> planar(2 * plane * static_cast<std::size_t>(n));
+    const float* p = a.data();
+    for (std::size_t k = 0; k < static_cast<std::size_t>(n); ++k) {
+      for (std::size_t i = 0; i < plane; ++i) {
+        planar[2 * k * plane + i] = p[2 * (k * plane + i)];
+        planar[(2 * k + 1) * plane + i] = p[2 * (k * plane + i) + 1];
+      }
+    }
+    std::vector<float> omega;
+    {
+      py::gil_scoped_release release;
+      Queue& queue = device_->queue();
+      const Tensor flow = Tensor::from_host(queue, {n, 2, h, w}, planar);
+      omega = head_->compute(queue, flow).to_host(queue);
+    }
+    py::array_t<double> out(batch ? std::vector<py::ssize_t>{n, 3} : std::vector<py::ssize_t>{3});
+    std::copy(omega.begin(), omega.end(), out.mutable_data());
+    return out;
+  }
+
+  py::dict config() const {
+    const HeadConfig& c = head_->config();
+    py::dict d;
+    d["input_width"] = c.input_width;
+    d["input_height"] = c.input_height;
+    return d;
+  }
+
+ private:
+  std::shared_ptr<Device> device_;
+  std::unique_ptr<WeightSet> weights_;
+  std::unique_ptr<InertialNetHead> head_;
+};
+
+// --- sequences, predict, evaluate ------------------------------------------------------------------
+
+class PySequence {
+ public:
+  PySequence(const std::filesystem::path& path, double rate_hz)
+      : source_(open_frame_source(path, rate_hz > 0 ? std::optional<double>(rate_hz) : std::nullopt)) {}
+  std::size_t size() const { return source_->size(); }
+  py::array_t<std::int64_t> timestamps() const {
+    py::array_t<std::int64_t> out(static_cast<py::ssize_t>(source_->size()));
+    for (std::size_t i = 0; i < source_->size(); ++i) out.mutable_data()[i] = source_->timestamp_ns(i);
+    return out;
+  }
+  py::array_t<std::uint8_t> frame(std::size_t index) {
+    if (index >= source_->size()) throw py::index_error("frame " + std::to_string(index) + " of " + std::to_string(size()));
+    HostImage image;
+    {
+      py::gil_scoped_release release;
+      image = source_->decode(index);
+    }
+    return to_uint8_rgb(image);
+  }
+  std::optional<CameraIntrinsics> camera() const {
+    const auto c = source_->calibration();
+    if (!c) return std::nullopt;
+    return CameraIntrinsics::from_calibration(*c);
+  }
+  py::object camera_to_body() const {
+    const auto c = source_->calibration();
+    if (!c) return py::none();
+    const Mat3 r = c->rotation_BS();
+    py::array_t<double> out({3, 3});
+    std::copy(r.begin(), r.end(), out.mutable_data());
+    return std::move(out);
+  }
+  std::string description() const { return source_->description(); }
+
+ private:
+  std::unique_ptr<FrameSource> source_;
+};
+
+// The rows of predict(): the column names, the timestamps, the values (rows × columns) and, with
+// keep_flow, each pair's flow. The Python side makes the structured array.
+py::tuple predict(const PredictSettings& settings, std::size_t max_pairs, int lanes, int decode_threads) {
+  std::vector<std::int64_t> t_ns;
+  std::vector<double> values;
+  std::vector<FlowField> flows;
+  std::vector<std::string> columns;
+  {
+    py::gil_scoped_release release;
+    Prediction prediction(settings);
+    columns = prediction.columns();
+    PipelineOptions options;
+    options.lanes_per_device = lanes;
+    options.decode_threads = decode_threads;
+    options.max_pairs = max_pairs;
+    prediction.run(
+        [&](const PairResult& r) {
+          t_ns.push_back(r.t1_ns);
+          for (const auto& [name, w] : r.rates) values.insert(values.end(), w.begin(), w.end());
+          if (r.flow) flows.push_back(*r.flow);
+        },
+        options);
+  }
+  py::array_t<std::int64_t> t(static_cast<py::ssize_t>(t_ns.size()));
+  std::copy(t_ns.begin(), t_ns.end(), t.mutable_data());
+  py::array_t<double> v({static_cast<py::ssize_t>(t_ns.size()), static_cast<py::ssize_t>(columns.size())});
+  std::copy(values.begin(), values.end(), v.mutable_data());
+  py::list flow_list;
+  for (const auto& f : flows) flow_list.append(flow_to_array(f));
+  return py::make_tuple(columns, t, v, flow_list);
+}
+
+std::string evaluate_json(const std::filesystem::path& rates, const std::filesystem::path& sequence,
+                          const std::string& target, const std::string& head, const py::object& gyro_bias,
+                          bool camera_frame, const std::string& plot, bool series) {
+  EvalOptions options;
+  options.sync.target = parse_sync_target(target);
+  options.sync.camera_frame = camera_frame;
+  if (!gyro_bias.is_none()) {
+    const auto b = gyro_bias.cast<std::vector<double>>();
+    if (b.size() != 3) throw invalid_input("gyro_bias must hold three values (x, y, z) in rad/s.");
+    options.sync.bias = BiasSource::Given;
+    options.sync.gyro_bias = {b[0], b[1], b[2]};
+  }
+  options.head_suffix = head.empty() ? "" : "_" + head;
+  options.plot = plot;
+  py::gil_scoped_release release;
+  return evaluate(rates, sequence, options).json(series);
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_inertialnet, m) {
+  m.doc() = "InertialNet-CL: FlowNet2 optical flow and angular-rate heads on OpenCL (native module)";
+
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const Error& e) {
+      PyErr_SetString(e.kind() == ErrorKind::InvalidInput ? PyExc_ValueError : PyExc_RuntimeError, e.what());
+    }
+  });
+
+  m.def("devices", [] {
+    py::list out;
+    for (const auto& d : discover_devices()) out.append(device_dict(d));
+    return out;
+  }, "Every OpenCL device: a list of dicts (index, platform, name, type, driver_version, …).");
+  m.def("select_devices", [](const std::string& spec) {
+    py::list out;
+    for (const auto& d : select_devices(device_spec_or_environment(spec), discover_devices())) out.append(device_dict(d));
+    return out;
+  }, py::arg("spec") = "", "The devices a --device spec selects (\"\": $INERTIALNET_DEVICE, else the default).");
+
+  py::class_<PyDevice>(m, "Device", "An opened OpenCL device, chosen by a --device spec string.")
+      .def(py::init<const std::string&>(), py::arg("spec") = "")
+      .def_property_readonly("name", [](const PyDevice& d) { return d.device->info().name; })
+      .def_property_readonly("info", [](const PyDevice& d) { return device_dict(d.device->info()); })
+      .def("__repr__", [](const PyDevice& d) { return "<inertialnet.Device " + d.device->info().name + ">"; });
+
+  py::class_<CameraIntrinsics>(m, "Camera", "Pinhole intrinsics with optional lens distortion.")
+      .def(py::init([](int width, int height, double fx, double fy, double cx, double cy, const std::string& distortion,
+                       const std::vector<double>& coefficients) {
+             CameraIntrinsics c;
+             c.width = width;
+             c.height = height;
+             c.fx = fx;
+             c.fy = fy;
+             c.cx = cx;
+             c.cy = cy;
+             if (distortion == "none") {
+               c.distortion = LensDistortion::None;
+             } else if (distortion == "radtan") {
+               c.distortion = LensDistortion::RadialTangential;
+             } else if (distortion == "equidistant") {
+               c.distortion = LensDistortion::Equidistant;
+             } else {
+               throw invalid_input("unknown distortion '" + distortion + "'; expected none, radtan or equidistant");
+             }
+             c.coefficients = coefficients;
+             c.validate();
+             return c;
+           }),
+           py::arg("width"), py::arg("height"), py::arg("fx"), py::arg("fy"), py::arg("cx"), py::arg("cy"),
+           py::arg("distortion") = "none", py::arg("coefficients") = std::vector<double>{})
+      .def_readonly("width", &CameraIntrinsics::width)
+      .def_readonly("height", &CameraIntrinsics::height)
+      .def_readonly("fx", &CameraIntrinsics::fx)
+      .def_readonly("fy", &CameraIntrinsics::fy)
+      .def_readonly("cx", &CameraIntrinsics::cx)
+      .def_readonly("cy", &CameraIntrinsics::cy)
+      .def_readonly("coefficients", &CameraIntrinsics::coefficients)
+      .def("__repr__", [](const CameraIntrinsics& c) {
+        return "<inertialnet.Camera " + std::to_string(c.width) + "x" + std::to_string(c.height) +
+               " fx=" + std::to_string(c.fx) + " fy=" + std::to_string(c.fy) + ">";
+      });
+
+  py::class_<PyFlowNet>(m, "_FlowNet")
+      .def(py::init<const py::object&, const py::object&, const std::string&>(), py::arg("weights"),
+           py::arg("device") = py::none(), py::arg("model") = "")
+      .def("flow", &PyFlowNet::flow, py::arg("img1"), py::arg("img2"), py::arg("order") = "rgb")
+      .def_property_readonly("model", &PyFlowNet::model)
+      .def_property_readonly("device", &PyFlowNet::device)
+      .def_property_readonly("synthetic", &PyFlowNet::synthetic);
+
+  m.def("dis_flow", &dis_flow, py::arg("img1"), py::arg("img2"), py::arg("order") = "rgb",
+        "OpenCV DIS optical flow (no weights) from img1 to img2: float32 (H, W, 2), or (N, H, W, 2) for batches.");
+
+  py::class_<PyGeometricHead>(m, "GeometricHead", "Angular velocity from flow by geometry alone (no weights).")
+      .def(py::init<const py::object&, const std::string&, int>(), py::arg("device") = py::none(),
+           py::arg("solver") = "motion-field", py::arg("stride") = 4)
+      .def("rates", &PyGeometricHead::rates, py::arg("flow"), py::arg("camera"), py::arg("dt"),
+           py::arg("camera_to_body") = py::none(),
+           "ω (rad/s, (3,)) from the flow (H, W, 2) of a frame pair dt seconds apart; camera frame, or the body "
+           "frame with camera_to_body (3x3).");
+
+  py::class_<PyInertialNetHead>(m, "_InertialNetHead")
+      .def(py::init<const py::object&, const py::object&>(), py::arg("weights"), py::arg("device") = py::none())
+      .def("rates", &PyInertialNetHead::rates, py::arg("flow"))
+      .def_property_readonly("config", &PyInertialNetHead::config);
+
+  py::class_<PySequence>(m, "Sequence", "A EuRoC folder, an image folder or a video, frame by frame.")
+      .def(py::init<const std::filesystem::path&, double>(), py::arg("path"), py::arg("rate_hz") = 0.0)
+      .def("__len__", &PySequence::size)
+      .def("__getitem__", &PySequence::frame, py::arg("index"), "Frame `index` as uint8 RGB (H, W, 3).")
+      .def_property_readonly("timestamps_ns", &PySequence::timestamps)
+      .def_property_readonly("camera", &PySequence::camera)
+      .def_property_readonly("camera_to_body", &PySequence::camera_to_body)
+      .def_property_readonly("description", &PySequence::description);
+
+  m.def("read_image", [](const std::filesystem::path& path) { return to_uint8_rgb(load_rgb_image(path)); },
+        py::arg("path"), "An image file as uint8 RGB (H, W, 3), gray replicated, as the CLI reads frames.");
+
+  m.def("_predict",
+        [](const std::filesystem::path& sequence, const std::vector<std::string>& weights, const std::string& model,
+           const std::string& flow, const std::string& head, const std::string& solver, double fx, double fy, double cx,
+           double cy, double rate_hz, const std::string& device, bool keep_flow, std::size_t max_pairs, int lanes,
+           int decode_threads) {
+          PredictSettings s;
+          s.sequence = sequence;
+          s.weights = weights;
+          s.model = model;
+          s.flow = flow;
+          s.head = head;
+          s.solver = solver;
+          s.fx = fx;
+          s.fy = fy;
+          s.cx = cx;
+          s.cy = cy;
+          s.rate_hz = rate_hz;
+          s.device = device;
+          s.keep_flow = keep_flow;
+          if (lanes < 1 || decode_threads < 1) throw invalid_input("lanes and decode_threads must be at least 1");
+          return predict(s, max_pairs, lanes, decode_threads);
+        });
+  m.def("_evaluate_json", &evaluate_json);
+  m.def("_write_rates_csv",
+        [](const std::filesystem::path& path, const std::vector<std::string>& columns, const py::array& t,
+           const py::array& values) {
+          const auto ta = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(t);
+          const auto va = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(values);
+          const auto rows = static_cast<std::size_t>(ta.size());
+          const std::size_t k = columns.size();
+          if (k < 3 || static_cast<std::size_t>(va.size()) != rows * k) {
+            throw invalid_input("a rates table needs wx, wy, wz and one value per row and column.");
+          }
+          RatesTable table;
+          table.t_ns.assign(ta.data(), ta.data() + rows);
+          table.extra_names.assign(columns.begin() + 3, columns.end());
+          table.extra.assign(k - 3, std::vector<double>(rows));
+          for (std::size_t r = 0; r < rows; ++r) {
+            const double* row = va.data() + r * k;
+            table.w.push_back({row[0], row[1], row[2]});
+            for (std::size_t c = 3; c < k; ++c) table.extra[c - 3][r] = row[c];
+          }
+          write_rates_csv(path, table);
+        });
+
+  m.def("read_flo", [](const std::filesystem::path& path) { return flow_to_array(read_flo(path)); }, py::arg("path"),
+        "A Middlebury .flo file as float32 (H, W, 2).");
+  m.def("write_flo", [](const std::filesystem::path& path, const py::array& flow) { write_flo(path, flow_from_array(flow)); },
+        py::arg("path"), py::arg("flow"), "Writes (H, W, 2) flow as Middlebury .flo (atomically).");
+  m.def("read_kitti_flow", [](const std::filesystem::path& path) { return flow_to_array(read_kitti_flow_png(path)); },
+        py::arg("path"), "A KITTI 16-bit flow PNG as float32 (H, W, 2); invalid pixels are 1e10 (unknown flow).");
+  m.def("write_kitti_flow",
+        [](const std::filesystem::path& path, const py::array& flow) { write_kitti_flow_png(path, flow_from_array(flow)); },
+        py::arg("path"), py::arg("flow"), "Writes (H, W, 2) flow as a KITTI 16-bit flow PNG (1/64 px steps).");
+  m.def("read_flow", [](const std::filesystem::path& path) { return flow_to_array(read_flow_file(path)); },
+        py::arg("path"), "A .flo or KITTI flow PNG file, recognised by its content, as float32 (H, W, 2).");
+  m.def("flow_to_color",
+        [](const py::array& flow, float max_magnitude, bool legend) {
+          ColorImage image = flow_to_color(flow_from_array(flow), max_magnitude);
+          if (legend && std::min(image.width, image.height) / 4 >= 8) {
+            paste_legend(image, color_wheel_legend(std::min(image.width, image.height) / 4));
+          }
+          py::array_t<std::uint8_t> out({image.height, image.width, 3});
+          std::copy(image.rgb.begin(), image.rgb.end(), out.mutable_data());
+          return out;
+        },
+        py::arg("flow"), py::arg("max_magnitude") = 0.0f, py::arg("legend") = false,
+        "Middlebury colour coding of (H, W, 2) flow as uint8 RGB (H, W, 3); max_magnitude 0: the field's maximum.");
+  m.def("write_flow_png",
+        [](const std::filesystem::path& path, const py::array& flow, float max_magnitude) {
+          write_flow_png(path, flow_from_array(flow), max_magnitude);
+        },
+        py::arg("path"), py::arg("flow"), py::arg("max_magnitude") = 0.0f, "flow_to_color() saved as a PNG.");
+
+  m.def("synth",
+        [](const std::filesystem::path& out, int frames, const std::string& motion, std::uint64_t seed, int width,
+           int height, bool noise, bool overwrite) {
+          SynthOptions o;
+          o.frames = frames;
+          o.motion = parse_synth_motion(motion);
+          o.seed = seed;
+          o.width = width;
+          o.height = height;
+          o.noise = noise;
+          o.overwrite = overwrite;
+          py::gil_scoped_release release;
+          const SynthReport report = write_synthetic_sequence(out, o);
+          return report.frames;
+        },
+        py::arg("out"), py::arg("frames") = 40, py::arg("motion") = "rotation", py::arg("seed") = 1,
+        py::arg("width") = 752, py::arg("height") = 480, py::arg("noise") = true, py::arg("overwrite") = false,
+        "Renders a synthetic EuRoC-layout sequence into `out` (as `inertialnet synth`); returns the frame count.");
+  m.attr("__version__") = "0.1.0";
+}

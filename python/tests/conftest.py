@@ -1,0 +1,46 @@
+"""Shared fixtures: a small synthetic sequence and the `inertialnet` command line to compare with.
+
+The command line is $INERTIALNET_CLI, else build/inertialnet in the repository (what
+tools/build.sh makes); the tests that compare with it are skipped, saying so, when neither exists.
+"""
+import csv
+import os
+import pathlib
+import subprocess
+
+import numpy as np
+import pytest
+
+import inertialnet
+
+REPO = pathlib.Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture(scope="session")
+def cli():
+    path = os.environ.get("INERTIALNET_CLI") or str(REPO / "build" / "inertialnet")
+    if not os.access(path, os.X_OK):
+        pytest.skip(f"no inertialnet command line at {path} (set INERTIALNET_CLI)")
+
+    def run(*args, cwd=None, expect=0, stdout_only=False):
+        """Runs `inertialnet ARGS`, checks the exit code, returns stdout + stderr (or stdout)."""
+        done = subprocess.run([path, *map(str, args)], cwd=cwd, capture_output=True, text=True)
+        assert done.returncode == expect, f"inertialnet {' '.join(map(str, args))}: exit {done.returncode}\n{done.stdout}{done.stderr}"
+        return done.stdout if stdout_only else done.stdout + done.stderr
+
+    return run
+
+
+@pytest.fixture(scope="session")
+def sequence(tmp_path_factory):
+    """A 5-frame 128x96 synthetic EuRoC sequence (rotation, EuRoC noise), written by the library."""
+    out = tmp_path_factory.mktemp("seq") / "rotation"
+    assert inertialnet.synth(out, frames=5, width=128, height=96, seed=7) == 5
+    return out
+
+
+def read_rates_csv(path):
+    with open(path) as f:
+        rows = list(csv.reader(f))
+    header, body = rows[0], rows[1:]
+    return header, np.array([[int(r[0])] + [float(v) for v in r[1:]] for r in body], dtype=object)

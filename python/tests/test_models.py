@@ -1,0 +1,70 @@
+"""The networks through Python: FlowNet2 (synthetic weights, small frames) against the CLI's .flo
+bit for bit, batches, and the InertialNet head against `inertialnet predict`."""
+import numpy as np
+import pytest
+
+import inertialnet
+from conftest import read_rates_csv
+
+
+@pytest.fixture(scope="module")
+def frames(sequence):
+    return sorted((sequence / "mav0" / "cam0" / "data").glob("*.png"))
+
+
+@pytest.fixture(scope="module")
+def flownet2_weights(cli, tmp_path_factory):
+    path = tmp_path_factory.mktemp("weights") / "flownet2.safetensors"
+    cli("weights", "--synthetic", "FlowNet2", "-o", path)
+    return path
+
+
+def test_flownet2_matches_the_cli_flo_bit_for_bit(cli, frames, flownet2_weights, tmp_path):
+    cli("flow", frames[0], frames[1], "-w", flownet2_weights, "-o", tmp_path / "cli.flo")
+    from_cli = inertialnet.read_flo(tmp_path / "cli.flo")
+    net = inertialnet.FlowNet2.load(flownet2_weights)
+    assert net.model == "FlowNet2" and net.synthetic
+    flow = net.flow(inertialnet.read_image(frames[0]), inertialnet.read_image(frames[1]))
+    assert flow.shape == (96, 128, 2) and flow.dtype == np.float32
+    np.testing.assert_array_equal(flow.view(np.uint32), from_cli.view(np.uint32))
+
+
+def test_flownet_takes_its_model_from_the_weights_and_refuses_others(flownet2_weights):
+    assert inertialnet.FlowNet.load(flownet2_weights, device="0").model == "FlowNet2"
+    with pytest.raises(ValueError, match="flownetc"):
+        inertialnet.FlowNet2C.load(flownet2_weights)
+
+
+def test_flownet_batches_and_gray_frames(cli, frames, tmp_path):
+    weights = tmp_path / "c.safetensors"
+    cli("weights", "--synthetic", "FlowNet2-C", "-o", weights)
+    net = inertialnet.FlowNet2C.load(weights, device=inertialnet.Device())
+    a = [inertialnet.read_image(f) for f in frames[:3]]
+    single = [net.flow(a[i], a[i + 1]) for i in range(2)]
+    batch = net.flow(np.stack(a[:2]), np.stack(a[1:3]))
+    assert batch.shape == (2, 96, 128, 2)
+    for i in range(2):
+        np.testing.assert_allclose(batch[i], single[i], atol=1e-4)
+    # Frames of a size that is no multiple of 64, gray: the flow keeps the frames' size.
+    gray = [f[:70, :90, 0].copy() for f in a[:2]]
+    assert net.flow(gray[0], gray[1]).shape == (70, 90, 2)
+
+
+def test_inertialnet_head_matches_the_cli(cli, sequence, tmp_path):
+    head_weights = tmp_path / "head.safetensors"
+    cli("weights", "--synthetic", "InertialNetHead", "--size", "128x96", "-o", head_weights)
+    cli("predict", sequence, "-w", head_weights, "--flow", "dis", "--head", "both", "-o", tmp_path / "rates.csv")
+    header, expected = read_rates_csv(tmp_path / "rates.csv")
+    rates = inertialnet.predict(sequence, head_weights, flow="dis", head="both")
+    assert list(rates.dtype.names) == header
+    for i, name in enumerate(header[1:], start=1):
+        assert ["%.9g" % v for v in rates[name]] == ["%.9g" % v for v in expected[:, i].astype(float)]
+    head = inertialnet.InertialNetHead.load(head_weights)
+    seq = inertialnet.Sequence(sequence)
+    flows = np.stack([inertialnet.dis_flow(seq[k - 1], seq[k]) for k in range(1, len(seq))])
+    w = head.rates(flows)
+    assert w.shape == (len(seq) - 1, 3)
+    np.testing.assert_allclose(w[:, 0], rates["wx"], rtol=1e-6, atol=1e-9)
+    assert head.rates(flows[0]).shape == (3,)
+    with pytest.raises(ValueError, match="128x96|96"):
+        head.rates(np.zeros((64, 64, 2), np.float32))

@@ -1,0 +1,99 @@
+"""Acceptance: Python computes the numbers of the command line.
+
+DIS flow + the geometric head, through predict() and step by step through dis_flow() and
+GeometricHead.rates(), against `inertialnet predict`'s CSV; evaluate() against `inertialnet eval
+--json`; `inertialnet flow --flow dis` against dis_flow()."""
+import json
+
+import numpy as np
+import pytest
+
+import inertialnet
+from conftest import read_rates_csv
+
+
+def cli_rates(cli, sequence, tmp_path, *args):
+    out = tmp_path / "rates.csv"
+    cli("predict", sequence, "-o", out, *args)
+    return read_rates_csv(out)
+
+
+def test_predict_matches_the_cli(cli, sequence, tmp_path):
+    header, expected = cli_rates(cli, sequence, tmp_path)
+    rates = inertialnet.predict(sequence)
+    assert list(rates.dtype.names) == header == ["timestamp_ns", "wx", "wy", "wz"]
+    assert len(rates) == len(expected) == 4
+    np.testing.assert_array_equal(rates["timestamp_ns"], expected[:, 0].astype(np.int64))
+    for i, name in enumerate(header[1:], start=1):
+        # The CSV holds %.9g: the same doubles, printed to 9 significant digits.
+        np.testing.assert_array_equal(np.array(["%.9g" % v for v in rates[name]]),
+                                      np.array(["%.9g" % v for v in expected[:, i].astype(float)]))
+
+
+def test_dis_flow_and_geometric_head_step_by_step_match_the_cli(cli, sequence, tmp_path):
+    _, expected = cli_rates(cli, sequence, tmp_path)
+    seq = inertialnet.Sequence(sequence)
+    camera, to_body, t = seq.camera, seq.camera_to_body, seq.timestamps_ns
+    assert camera.width == 128 and to_body.shape == (3, 3)
+    head = inertialnet.GeometricHead()
+    for k in range(1, len(seq)):
+        flow = inertialnet.dis_flow(seq[k - 1], seq[k])
+        assert flow.shape == (96, 128, 2) and flow.dtype == np.float32
+        w = head.rates(flow, camera, dt=(t[k] - t[k - 1]) * 1e-9, camera_to_body=to_body)
+        assert ["%.9g" % v for v in w] == ["%.9g" % v for v in expected[k - 1, 1:].astype(float)]
+
+
+def test_cli_flow_dis_matches_dis_flow_bit_for_bit(cli, sequence, tmp_path):
+    frames = sorted((sequence / "mav0" / "cam0" / "data").glob("*.png"))
+    cli("flow", frames[0], frames[1], "-o", tmp_path / "dis.flo")
+    from_cli = inertialnet.read_flo(tmp_path / "dis.flo")
+    ours = inertialnet.dis_flow(inertialnet.read_image(frames[0]), inertialnet.read_image(frames[1]))
+    np.testing.assert_array_equal(ours.view(np.uint32), from_cli.view(np.uint32))
+    # BGR input with order="bgr" and gray input give the same field (gray frames are replicated).
+    bgr = inertialnet.dis_flow(inertialnet.read_image(frames[0])[..., ::-1], inertialnet.read_image(frames[1])[..., ::-1],
+                               order="bgr")
+    np.testing.assert_array_equal(bgr, ours)
+    batch = inertialnet.dis_flow(np.stack([inertialnet.read_image(f) for f in frames[:2]]),
+                                 np.stack([inertialnet.read_image(f) for f in frames[1:3]]))
+    assert batch.shape == (2, 96, 128, 2)
+    np.testing.assert_array_equal(batch[0], ours)
+
+
+def test_save_flow_matches_keep_flow(cli, sequence, tmp_path):
+    cli("predict", sequence, "-o", tmp_path / "r.csv", "--save-flow", tmp_path / "flows")
+    rates, flows = inertialnet.predict(sequence, keep_flow=True, max_pairs=2)
+    assert len(rates) == len(flows) == 2
+    for t, flow in zip(rates["timestamp_ns"], flows):
+        np.testing.assert_array_equal(flow, inertialnet.read_flo(tmp_path / "flows" / f"{t}.flo"))
+
+
+def test_evaluate_matches_cli_eval_json(cli, sequence, tmp_path):
+    header, _ = cli_rates(cli, sequence, tmp_path)
+    from_cli = json.loads(cli("eval", tmp_path / "rates.csv", sequence, "--json", stdout_only=True))
+    report = inertialnet.evaluate(tmp_path / "rates.csv", sequence)
+    assert report == from_cli
+    # From predict()'s array, through the same CSV writer: the same metrics.
+    from_array = inertialnet.evaluate(inertialnet.predict(sequence), sequence)
+    assert from_array["bias_corrected"] == report["bias_corrected"]
+
+
+def test_errors_map_to_python_exceptions_with_the_cli_messages(cli, sequence, tmp_path):
+    message = cli("predict", sequence, "--head", "inertialnet", expect=2)
+    with pytest.raises(ValueError) as error:
+        inertialnet.predict(sequence, head="inertialnet")
+    assert str(error.value) in message
+    with pytest.raises(ValueError, match="nosuch"):
+        inertialnet.Device("nosuch")
+    with pytest.raises(ValueError, match="No such file"):
+        inertialnet.FlowNet2.load(tmp_path / "missing.safetensors")
+    with pytest.raises(ValueError, match="uint8"):
+        inertialnet.dis_flow(np.zeros((32, 32), np.float32), np.zeros((32, 32), np.float32))
+    with pytest.raises(ValueError, match="at least 16x16"):
+        inertialnet.dis_flow(np.zeros((8, 8), np.uint8), np.zeros((8, 8), np.uint8))
+
+
+def test_devices_and_selection():
+    devices = inertialnet.devices()
+    assert devices and {"index", "name", "platform", "type"} <= set(devices[0])
+    assert inertialnet.select_devices("0")[0]["index"] == 0
+    assert inertialnet.Device("0").name == devices[0]["name"]

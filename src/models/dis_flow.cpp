@@ -1,0 +1,68 @@
+#include "inertialnet/models/dis_flow.hpp"
+
+#include <algorithm>
+#include <cstdint>
+#include <string>
+
+#include <opencv2/core.hpp>
+#include <opencv2/video/tracking.hpp>
+
+#include "inertialnet/runtime/error.hpp"
+
+namespace inertialnet {
+
+namespace {
+
+// 8-bit luminance (BT.601) of a planar RGB frame; a replicated gray frame comes back exactly.
+cv::Mat gray8(const HostImage& image) {
+  cv::Mat gray(image.height, image.width, CV_8UC1);
+  const std::size_t plane = image.plane_size();
+  for (int y = 0; y < image.height; ++y) {
+    auto* row = gray.ptr<std::uint8_t>(y);
+    for (int x = 0; x < image.width; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(image.width) + static_cast<std::size_t>(x);
+      const float v = 0.299f * image.data[i] + 0.587f * image.data[plane + i] + 0.114f * image.data[2 * plane + i];
+      row[x] = cv::saturate_cast<std::uint8_t>(v);
+    }
+  }
+  return gray;
+}
+
+std::string size_of(const HostImage& image) { return std::to_string(image.width) + "x" + std::to_string(image.height); }
+
+}  // namespace
+
+struct DisFlow::State {
+  cv::Ptr<cv::DISOpticalFlow> dis = cv::DISOpticalFlow::create(cv::DISOpticalFlow::PRESET_MEDIUM);
+};
+
+DisFlow::DisFlow() : state_(std::make_unique<State>()) {}
+DisFlow::~DisFlow() = default;
+
+FlowField DisFlow::compute(const HostImage& first, const HostImage& second) {
+  if (first.width != second.width || first.height != second.height) {
+    throw invalid_input("the frames differ in size: the first is " + size_of(first) + ", the second " +
+                        size_of(second) + "; DIS optical flow needs two frames of one size.");
+  }
+  if (first.width < kDisMinimumSide || first.height < kDisMinimumSide) {
+    throw invalid_input("the frames are " + size_of(first) + "; DIS optical flow needs frames of at least " +
+                        std::to_string(kDisMinimumSide) + "x" + std::to_string(kDisMinimumSide) + " pixels.");
+  }
+  if (first.data.size() != 3 * first.plane_size() || second.data.size() != 3 * second.plane_size()) {
+    throw invalid_input("a " + size_of(first) + " frame needs " + std::to_string(3 * first.plane_size()) +
+                        " values (three planes).");
+  }
+  // T-API: UMat lets OpenCV run DIS through its own OpenCL path where it has one.
+  cv::UMat a, b, uv;
+  gray8(first).copyTo(a);
+  gray8(second).copyTo(b);
+  state_->dis->calc(a, b, uv);
+  cv::Mat planes[2];
+  cv::split(uv.getMat(cv::ACCESS_READ), planes);
+  FlowField flow(first.width, first.height);
+  std::copy(planes[0].begin<float>(), planes[0].end<float>(), flow.u.begin());
+  std::copy(planes[1].begin<float>(), planes[1].end<float>(), flow.v.begin());
+  return flow;
+}
+
+}  // namespace inertialnet

@@ -1,0 +1,189 @@
+#include "inertialnet/pipeline/predict.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cmath>
+#include <optional>
+
+#include "inertialnet/io/camera.hpp"
+#include "inertialnet/runtime/device_selection.hpp"
+#include "inertialnet/runtime/error.hpp"
+
+namespace inertialnet {
+
+namespace {
+
+ModelKind flow_model_of(const WeightSet& weights, const std::string& requested) {
+  if (!requested.empty()) return model_kind_from_string(requested);
+  for (const ModelKind kind : weights.models()) {
+    if (kind != ModelKind::InertialNetHead) return kind;
+  }
+  return ModelKind::FlowNet2;
+}
+
+const char* kNoWeightsHelp =
+    "Convert a flownet2-pytorch checkpoint with `python3 tools/convert_checkpoint.py FlowNet2_checkpoint.pth.tar "
+    "flownet2.safetensors` (and the head the same way), or write synthetic weights for a trial run with "
+    "`inertialnet weights --synthetic FlowNet2 -o flownet2.safetensors` and `inertialnet weights --synthetic "
+    "InertialNetHead --size WxH -o head.safetensors`";
+
+}  // namespace
+
+Prediction::Prediction(const PredictSettings& s) : settings_(s) {
+  const bool have_weights = !s.weights.empty();
+  processor_.flow = parse_flow_method(s.flow.empty() ? (have_weights ? "flownet2" : "dis") : s.flow);
+  const std::string head = s.head.empty() ? (have_weights ? "inertialnet" : "geometric") : s.head;
+  if (head != "inertialnet" && head != "geometric" && head != "both") {
+    throw invalid_input("unknown head '" + head + "'; expected inertialnet, geometric or both");
+  }
+  processor_.inertialnet_head = head != "geometric";
+  processor_.geometric_head = head != "inertialnet";
+  if (!have_weights && (processor_.flow == FlowMethod::FlowNet || processor_.inertialnet_head)) {
+    throw invalid_input(std::string("--flow flownet2 and --head inertialnet need weights: --weights FILE with the "
+                                    "FlowNet2 and InertialNet head tensors (safetensors). ") + kNoWeightsHelp +
+                        ". Without weights, predict runs DIS flow + the geometric head.");
+  }
+  if (s.solver == "opengv") {
+    processor_.geometric.solver = GeometricSolver::OpenGV;
+  } else if (s.solver != "motion-field") {
+    throw invalid_input("unknown solver '" + s.solver + "'; expected motion-field or opengv");
+  }
+  if (!std::isfinite(s.readout_time_s) || s.readout_time_s < 0 || s.readout_time_s > 1) {
+    throw invalid_input("the readout time should be between 0 and 1 s, got " + std::to_string(s.readout_time_s));
+  }
+  if (s.time_offset_s && (!std::isfinite(*s.time_offset_s) || std::abs(*s.time_offset_s) > 3600)) {
+    throw invalid_input("the time offset should be a finite number of seconds within an hour, got " +
+                        std::to_string(*s.time_offset_s));
+  }
+  processor_.geometric.readout_time_s = s.readout_time_s;
+  source_ = open_frame_source(s.sequence, s.rate_hz > 0 ? std::optional<double>(s.rate_hz) : std::nullopt);
+  notes_ = source_->notes();
+  if (processor_.geometric_head) {
+    const bool given = s.fx > 0 || s.fy > 0;
+    if (given) {
+      CameraIntrinsics camera;
+      const HostImage first = source_->decode(0);
+      camera.width = first.width;
+      camera.height = first.height;
+      camera.fx = s.fx;
+      camera.fy = s.fy > 0 ? s.fy : s.fx;
+      camera.cx = s.cx > 0 ? s.cx : (first.width - 1) / 2.0;
+      camera.cy = s.cy > 0 ? s.cy : (first.height - 1) / 2.0;
+      camera.validate();
+      processor_.camera = camera;
+    } else if (const auto calibration = source_->calibration()) {
+      processor_.camera = CameraIntrinsics::from_calibration(*calibration);
+      // The geometric head allocates per pixel of the calibrated size: compare it with the
+      // images before, so that a wrong resolution is a clear message, not gigabytes asked for.
+      const HostImage first = source_->decode(0);
+      if (first.width != processor_.camera->width || first.height != processor_.camera->height) {
+        throw invalid_input(source_->description() + ": cam0/sensor.yaml gives the resolution " +
+                            std::to_string(processor_.camera->width) + "x" + std::to_string(processor_.camera->height) +
+                            ", which does not match the images (" + std::to_string(first.width) + "x" +
+                            std::to_string(first.height) + ").");
+      }
+      processor_.camera_to_body = calibration->rotation_BS();
+    } else {
+      throw invalid_input("the geometric head needs the camera: " + source_->description() +
+                          " has no cam0/sensor.yaml; give --fx (and --fy --cx --cy)");
+    }
+  }
+  processor_.keep_flow = s.keep_flow;
+
+  // Devices and their weights (one set per device).
+  infos_ = select_devices(device_spec_or_environment(s.device), discover_devices());
+  for (const auto& info : infos_) {
+    DeviceOptions options;
+    if (s.no_cache) options.program_cache = DiskCacheMode::Off;
+    options.profiler = s.profiler;
+    devices_.push_back(std::make_unique<Device>(info, options));
+    if (have_weights) {
+      weight_sets_.push_back(std::make_unique<WeightSet>(WeightSet::load(*devices_.back(), s.weights)));
+      weights_of_[devices_.back().get()] = weight_sets_.back().get();
+    }
+  }
+  if (have_weights) processor_.flow_model = flow_model_of(*weight_sets_.front(), s.model);
+}
+
+Prediction::~Prediction() = default;
+
+std::size_t Prediction::pairs(std::size_t max_pairs) const {
+  const std::size_t all = source_->size() - 1;
+  return max_pairs ? std::min(max_pairs, all) : all;
+}
+
+std::string Prediction::method() const {
+  std::string method = processor_.flow == FlowMethod::DIS ? std::string("DIS flow") : to_string(processor_.flow_model);
+  method += processor_.inertialnet_head && processor_.geometric_head ? " + InertialNet and geometric heads"
+            : processor_.inertialnet_head                            ? " + InertialNet head"
+                                                                     : " + geometric head";
+  return method;
+}
+
+std::vector<std::string> Prediction::columns() const {
+  std::vector<std::string> columns = {"wx", "wy", "wz"};
+  if (processor_.inertialnet_head && processor_.geometric_head) {
+    columns.insert(columns.end(), {"wx_geometric", "wy_geometric", "wz_geometric"});
+  }
+  return columns;
+}
+
+std::vector<std::pair<std::string, std::string>> Prediction::csv_metadata() const {
+  const auto format_number = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.9g", v);
+    return std::string(buf);
+  };
+  std::vector<std::pair<std::string, std::string>> metadata;
+  const char* geometric_frame = processor_.camera_to_body ? "body" : "camera";
+  if (processor_.inertialnet_head) {
+    // InertialNet is trained against the gyro, so it answers in the body (IMU) frame.
+    metadata = {{"frame", "body"}, {"estimator", "network"}};
+    if (processor_.geometric_head) {
+      metadata.push_back({"frame_geometric", geometric_frame});
+      metadata.push_back({"estimator_geometric", "inter_frame"});
+    }
+  } else {
+    metadata = {{"frame", geometric_frame}, {"estimator", "inter_frame"}};
+  }
+  if (settings_.time_offset_s) metadata.push_back({"time_offset_s", format_number(*settings_.time_offset_s)});
+  if (settings_.readout_time_s > 0) metadata.push_back({"readout_time_s", format_number(settings_.readout_time_s)});
+  return metadata;
+}
+
+void Prediction::warm_up(const std::function<void(const DeviceInfo& device, double seconds)>& report) {
+  auto source = open_frame_source(settings_.sequence,
+                                  settings_.rate_hz > 0 ? std::optional<double>(settings_.rate_hz) : std::nullopt);
+  const Frame first{0, source->timestamp_ns(0), source->decode(0)};
+  const Frame second{1, source->timestamp_ns(1), source->decode(1)};
+  const std::atomic<bool> keep_going{false};
+  const auto factory = rates_processor(weights_of_, processor_);
+  for (const auto& device : devices_) {
+    const auto start = std::chrono::steady_clock::now();
+    PairResult discarded;
+    factory(*device, 0)->process(first, second, discarded, keep_going);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (report) report(device->info(), seconds);
+  }
+}
+
+PipelineStats Prediction::run(const std::function<void(const PairResult&)>& sink, const PipelineOptions& options) {
+  const auto factory = rates_processor(weights_of_, processor_);
+  std::vector<Device*> devices;
+  for (const auto& d : devices_) devices.push_back(d.get());
+  auto checked = [&sink](const PairResult& r) {
+    // Inputs are checked where they enter; a NaN here is a failure of the computation, never a rate.
+    for (const auto& [name, w] : r.rates) {
+      if (!std::isfinite(w[0]) || !std::isfinite(w[1]) || !std::isfinite(w[2])) {
+        throw runtime_error("the rates computed for the frame at timestamp " + std::to_string(r.t1_ns) +
+                            " are not finite (NaN or infinity); stopping rather than writing them.");
+      }
+    }
+    sink(r);
+  };
+  return run_pipeline(*source_, devices, factory, checked, options);
+}
+
+}  // namespace inertialnet

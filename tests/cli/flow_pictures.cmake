@@ -1,0 +1,60 @@
+# Flow without weights and flow pictures: `flow --flow dis`, `predict --save-flow --flow-format`,
+# and `viz` on .flo and KITTI files (colours are checked pixel by pixel in python/tests).
+#   cmake -DCLI=<inertialnet> -DWORK=<scratch dir> -P flow_pictures.cmake
+file(REMOVE_RECURSE "${WORK}")
+file(MAKE_DIRECTORY "${WORK}")
+
+include(${CMAKE_CURRENT_LIST_DIR}/run_helpers.cmake)
+
+function(expect_file path)
+  if(NOT EXISTS "${WORK}/${path}")
+    message(FATAL_ERROR "${path} was not written")
+  endif()
+endfunction()
+
+run(0 ${CLI} synth seq --frames 3 --size 96x64 --seed 3)
+file(GLOB frames "${WORK}/seq/mav0/cam0/data/*.png")
+list(SORT frames)
+list(GET frames 0 first)
+list(GET frames 1 second)
+
+# 1. flow without weights is DIS; every output format.
+run(0 ${CLI} flow ${first} ${second} -o dis.flo --png dis.png --kitti dis_kitti.png)
+expect_match("DIS")
+expect_file(dis.flo)
+expect_file(dis.png)
+expect_file(dis_kitti.png)
+run(0 ${CLI} flow ${first} ${second} --flow dis)
+expect_match("no output file")
+run(2 ${CLI} flow ${first} ${second} --flow flownet2)
+expect_match("needs --weights")
+run(2 ${CLI} flow ${first} ${second} --flow dis --model FlowNet2-C)
+expect_match("takes no --weights")
+
+# 2. predict --save-flow in each format, named by the pair's second frame.
+foreach(format flo png kitti)
+  run(0 ${CLI} predict seq -o rates_${format}.csv --save-flow flows_${format} --flow-format ${format})
+  file(GLOB saved "${WORK}/flows_${format}/*")
+  list(LENGTH saved count)
+  if(NOT count EQUAL 2)
+    message(FATAL_ERROR "--flow-format ${format}: ${count} files instead of 2")
+  endif()
+endforeach()
+run(2 ${CLI} predict seq --save-flow flows_x --flow-format jpeg)
+expect_match("flow-format")
+run(2 ${CLI} predict seq --flow-format png)  # not silently ignored without --save-flow
+expect_match("--flow-format requires --save-flow")
+
+# 3. viz: .flo and KITTI inputs, beside the inputs or into a new folder, scales and legend.
+file(GLOB kitti RELATIVE "${WORK}" "${WORK}/flows_kitti/*.png")
+run(0 ${CLI} viz dis.flo ${kitti} -o pictures --legend --shared-scale)
+expect_match("dis.flo -> pictures/dis_color.png")
+expect_file(pictures/dis_color.png)
+run(0 ${CLI} viz dis_kitti.png --max-magnitude 2)
+expect_match("scale 2 px")
+expect_file(dis_kitti_color.png)
+run(2 ${CLI} viz seq/mav0/cam0/sensor.yaml)
+expect_match("neither a Middlebury .flo file")
+run(2 ${CLI} viz ${first})
+expect_match("not a KITTI flow PNG")
+run(2 ${CLI} viz dis.flo --max-magnitude 2 --shared-scale)

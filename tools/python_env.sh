@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Makes (or completes) a Python virtual environment with what building and testing the Python
+# package needs, from PyPI: pybind11 and scikit-build-core (the build), numpy, pytest (the tests).
+#   bash tools/python_env.sh [FOLDER]     (default: .venv-python; prints the interpreter's path)
+# Needs python3-venv and python3-dev (tools/setup.sh installs them).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+venv=${1:-.venv-python}
+if [ ! -x "$venv/bin/python" ]; then
+  python3 -m venv "$venv" >&2
+fi
+if ! "$venv/bin/python" -c "import pybind11, scikit_build_core, numpy, pytest" 2>/dev/null; then
+  "$venv/bin/python" -m pip install -q --disable-pip-version-check "pybind11>=2.12" "scikit-build-core>=0.9" \
+    "numpy>=1.21" "pytest>=7" >&2
+fi
+echo "$PWD/$venv/bin/python"
