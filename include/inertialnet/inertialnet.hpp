@@ -53,6 +53,7 @@
 // models
 #include "inertialnet/models/flownet.hpp"
 #include "inertialnet/models/geometric_head.hpp"
+#include "inertialnet/models/head_backprop.hpp"
 #include "inertialnet/models/inertialnet_head.hpp"
 #include "inertialnet/models/parameters.hpp"
 #include "inertialnet/models/synthetic_weights.hpp"
