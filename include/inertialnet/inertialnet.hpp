@@ -52,6 +52,7 @@
 
 // models
 #include "inertialnet/models/flownet.hpp"
+#include "inertialnet/models/dis_flow.hpp"
 #include "inertialnet/models/geometric_head.hpp"
 #include "inertialnet/models/head_backprop.hpp"
 #include "inertialnet/models/inertialnet_head.hpp"
@@ -83,3 +84,7 @@
 // pipeline
 #include "inertialnet/pipeline/pipeline.hpp"
 #include "inertialnet/pipeline/rates_processor.hpp"
+
+// train
+#include "inertialnet/train/trainer.hpp"
+#include "inertialnet/train/training_set.hpp"

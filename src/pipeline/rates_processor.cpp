@@ -1,9 +1,8 @@
 #include <chrono>
 #include <string>
-#include <opencv2/core.hpp>
-#include <opencv2/video/tracking.hpp>
 
 #include "inertialnet/runtime/error.hpp"
+#include "inertialnet/models/dis_flow.hpp"
 #include "inertialnet/models/flownet.hpp"
 #include "inertialnet/models/inertialnet_head.hpp"
 #include "inertialnet/pipeline/rates_processor.hpp"
@@ -14,25 +13,6 @@ namespace inertialnet {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-// DIS matches 8×8 patches and builds its pyramid above them: smaller frames end in an OpenCV
-// assertion. Twice the patch leaves one pyramid level to refine.
-constexpr int kDisMinimumSide = 16;
-
-// 8-bit luminance (BT.601) of a planar RGB frame; a replicated gray frame comes back exactly.
-cv::Mat gray8(const HostImage& image) {
-  cv::Mat gray(image.height, image.width, CV_8UC1);
-  const std::size_t plane = image.plane_size();
-  for (int y = 0; y < image.height; ++y) {
-    auto* row = gray.ptr<std::uint8_t>(y);
-    for (int x = 0; x < image.width; ++x) {
-      const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(image.width) + static_cast<std::size_t>(x);
-      const float v = 0.299f * image.data[i] + 0.587f * image.data[plane + i] + 0.114f * image.data[2 * plane + i];
-      row[x] = cv::saturate_cast<std::uint8_t>(v);
-    }
-  }
-  return gray;
-}
 
 Vec3 to_body(const std::optional<Mat3>& r, const Vec3& w) {
   if (!r) return w;
@@ -46,7 +26,7 @@ class RatesProcessor : public PairProcessor {
   RatesProcessor(Device& device, const WeightSet* weights, const RatesProcessorOptions& options)
       : options_(options), queue_(device.create_queue()) {
     if (options.flow == FlowMethod::FlowNet) flownet_ = std::make_unique<FlowNet>(device, options.flow_model, *weights);
-    if (options.flow == FlowMethod::DIS) dis_ = cv::DISOpticalFlow::create(cv::DISOpticalFlow::PRESET_MEDIUM);
+    if (options.flow == FlowMethod::DIS) dis_ = std::make_unique<DisFlow>();
     if (options.inertialnet_head) head_ = std::make_unique<InertialNetHead>(device, *weights);
     if (options.geometric_head) geometric_ = std::make_unique<GeometricHead>(device, *options.camera, options.geometric);
   }
@@ -66,16 +46,7 @@ class RatesProcessor : public PairProcessor {
       flow = flownet_->compute(q, frame1, frame2, &stop);
       q.finish();
     } else {
-      // T-API: UMat lets OpenCV run DIS through its own OpenCL path where it has one.
-      cv::UMat a, b, uv;
-      gray8(previous.image).copyTo(a);
-      gray8(current.image).copyTo(b);
-      dis_->calc(a, b, uv);
-      cv::Mat planes[2];
-      cv::split(uv.getMat(cv::ACCESS_READ), planes);
-      std::vector<float> data(2 * static_cast<std::size_t>(width) * static_cast<std::size_t>(height));
-      std::copy(planes[0].begin<float>(), planes[0].end<float>(), data.begin());
-      std::copy(planes[1].begin<float>(), planes[1].end<float>(), data.begin() + static_cast<std::ptrdiff_t>(data.size() / 2));
+      const std::vector<float> data = dis_->compute(previous.image, current.image);
       flow = Tensor::from_host(q, {1, 2, height, width}, data);
     }
     t = lap(result, "flow", t);
@@ -129,7 +100,7 @@ class RatesProcessor : public PairProcessor {
   RatesProcessorOptions options_;
   std::unique_ptr<Queue> queue_;
   std::unique_ptr<FlowNet> flownet_;
-  cv::Ptr<cv::DISOpticalFlow> dis_;
+  std::unique_ptr<DisFlow> dis_;
   std::unique_ptr<InertialNetHead> head_;
   std::unique_ptr<GeometricHead> geometric_;
 };
