@@ -23,5 +23,6 @@ Command register_predict(CLI::App& app, const GlobalOptions& global);
 Command register_eval(CLI::App& app, const GlobalOptions& global);
 Command register_synth(CLI::App& app, const GlobalOptions& global);
 Command register_bench(CLI::App& app, const GlobalOptions& global);
+Command register_train(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace inertialnet::cli
