@@ -86,5 +86,6 @@
 #include "inertialnet/pipeline/rates_processor.hpp"
 
 // train
+#include "inertialnet/train/flip_augmentation.hpp"
 #include "inertialnet/train/trainer.hpp"
 #include "inertialnet/train/training_set.hpp"

@@ -13,6 +13,7 @@
 #include "inertialnet/io/safetensors_writer.hpp"
 #include "inertialnet/ops/optimizer_step.hpp"
 #include "inertialnet/runtime/error.hpp"
+#include "inertialnet/train/flip_augmentation.hpp"
 #include "runtime/hash.hpp"
 
 namespace inertialnet {
@@ -174,6 +175,7 @@ bool Trainer::train(const TrainingSet& train_set, const TrainingSet& val_set, co
     const auto start = std::chrono::steady_clock::now();
     const double lr = lr_for(epoch);
     const auto order = shuffled(train_set.size(), options_.seed, epoch);
+    SplitMix64 flips(options_.seed ^ 0xF11F5ull, static_cast<std::uint64_t>(epoch));  // this epoch's flips
     double loss_sum = 0;
     for (std::size_t b = 0; b < batches; ++b) {
       if (callbacks.stop && callbacks.stop->load()) return false;
@@ -183,7 +185,13 @@ bool Trainer::train(const TrainingSet& train_set, const TrainingSet& val_set, co
       for (std::size_t i = 0; i < count; ++i) {
         const std::size_t s = order[first + i];
         train_set.flow(s, flows.data() + i * floats);
-        for (int a = 0; a < 3; ++a) targets[3 * i + static_cast<std::size_t>(a)] = static_cast<float>(train_set.target(s)[a]);
+        Vec3 t = train_set.target(s);
+        if (options_.flip_augmentation) {
+          const auto flip = static_cast<Flip>(flips.next() & 3u);
+          flip_flow(flows.data() + i * floats, train_set.width(), train_set.height(), flip);
+          t = flip_body_rates(t, train_set.camera_to_body(s), flip);
+        }
+        for (int a = 0; a < 3; ++a) targets[3 * i + static_cast<std::size_t>(a)] = static_cast<float>(t[a]);
       }
       const auto n = static_cast<std::int64_t>(count);
       const Tensor flow = Tensor::from_host(*queue_, {n, 2, train_set.height(), train_set.width()}, flows);

@@ -162,6 +162,11 @@ std::size_t TrainingSet::add_sequence(const std::filesystem::path& root, const F
   const GyroTruth truth = sync_gyro(sequence, sync);
   for (const auto& note : truth.notes) notes_.push_back(sequence.name + ": " + note);
   notes_.push_back(sequence.name + ": targets bias-corrected from " + to_string(truth.bias_source));
+  Mat3 camera_to_body{1, 0, 0, 0, 1, 0, 0, 0, 1};
+  if (sequence.camera) {
+    const Mat3 r = imu_to_camera_rotation(sequence);  // R_CS: IMU → camera; its transpose back
+    camera_to_body = {r[0], r[3], r[6], r[1], r[4], r[7], r[2], r[5], r[8]};
+  }
   const auto flows = pair_flows(sequence, root, progress);
   const auto corrected = truth.corrected();
   std::size_t added = 0;
@@ -172,6 +177,7 @@ std::size_t TrainingSet::add_sequence(const std::filesystem::path& root, const F
     flows_.insert(flows_.end(), begin, begin + static_cast<std::ptrdiff_t>(flow_floats()));
     targets_.push_back(corrected[j]);
     t_ns_.push_back(truth.t_ns[j]);
+    camera_to_body_.push_back(camera_to_body);
     ++added;
   }
   sequences_.push_back(sequence.name.empty() ? root.filename().string() : sequence.name);

@@ -13,18 +13,15 @@ std::size_t at4(std::int64_t a, std::int64_t b, std::int64_t c, std::int64_t d, 
   return static_cast<std::size_t>(((a * nb + b) * nc + c) * nd + d);
 }
 
-}  // namespace
-
-std::vector<float> conv2d_backward_data(const ConvShape& s, const std::vector<float>& grad_output,
-                                        const std::vector<float>& weight) {
+// Every (output pixel, tap) pair of a convolution whose input sample lies inside the input:
+// visit(out_index, in_index, weight_index) with the row-major indices of the three tensors.
+template <class Visit>
+void for_each_tap(const ConvShape& s, Visit&& visit) {
   const int ho = s.conv_out_h(), wo = s.conv_out_w();
-  std::vector<double> acc(static_cast<std::size_t>(s.batch) * s.in_channels * s.height * s.width, 0.0);
-  // Scatter: out[n, o, oy, ox] read in[n, c, oy·s − p + ky, ox·s − p + kx] · w[o, c, ky, kx].
   for (int n = 0; n < s.batch; ++n)
     for (int o = 0; o < s.out_channels; ++o)
       for (int oy = 0; oy < ho; ++oy)
-        for (int ox = 0; ox < wo; ++ox) {
-          const double g = grad_output[at4(n, o, oy, ox, s.out_channels, ho, wo)];
+        for (int ox = 0; ox < wo; ++ox)
           for (int c = 0; c < s.in_channels; ++c)
             for (int ky = 0; ky < s.kernel_h; ++ky) {
               const int y = oy * s.stride - s.padding + ky;
@@ -32,35 +29,30 @@ std::vector<float> conv2d_backward_data(const ConvShape& s, const std::vector<fl
               for (int kx = 0; kx < s.kernel_w; ++kx) {
                 const int x = ox * s.stride - s.padding + kx;
                 if (x < 0 || x >= s.width) continue;
-                acc[at4(n, c, y, x, s.in_channels, s.height, s.width)] +=
-                    g * weight[at4(o, c, ky, kx, s.in_channels, s.kernel_h, s.kernel_w)];
+                visit(at4(n, o, oy, ox, s.out_channels, ho, wo), at4(n, c, y, x, s.in_channels, s.height, s.width),
+                      at4(o, c, ky, kx, s.in_channels, s.kernel_h, s.kernel_w));
               }
             }
-        }
+}
+
+}  // namespace
+
+std::vector<float> conv2d_backward_data(const ConvShape& s, const std::vector<float>& grad_output,
+                                        const std::vector<float>& weight) {
+  // The forward pass reads in[in_index] · w[weight_index] into out[out_index]; its adjoint scatters back.
+  std::vector<double> acc(static_cast<std::size_t>(s.batch) * s.in_channels * s.height * s.width, 0.0);
+  for_each_tap(s, [&](std::size_t out, std::size_t in, std::size_t w) {
+    acc[in] += static_cast<double>(grad_output[out]) * weight[w];
+  });
   return {acc.begin(), acc.end()};
 }
 
 std::vector<float> conv2d_backward_weight(const ConvShape& s, const std::vector<float>& input,
                                           const std::vector<float>& grad_output) {
-  const int ho = s.conv_out_h(), wo = s.conv_out_w();
   std::vector<double> acc(static_cast<std::size_t>(s.out_channels) * s.in_channels * s.kernel_h * s.kernel_w, 0.0);
-  for (int n = 0; n < s.batch; ++n)
-    for (int o = 0; o < s.out_channels; ++o)
-      for (int oy = 0; oy < ho; ++oy)
-        for (int ox = 0; ox < wo; ++ox) {
-          const double g = grad_output[at4(n, o, oy, ox, s.out_channels, ho, wo)];
-          for (int c = 0; c < s.in_channels; ++c)
-            for (int ky = 0; ky < s.kernel_h; ++ky) {
-              const int y = oy * s.stride - s.padding + ky;
-              if (y < 0 || y >= s.height) continue;
-              for (int kx = 0; kx < s.kernel_w; ++kx) {
-                const int x = ox * s.stride - s.padding + kx;
-                if (x < 0 || x >= s.width) continue;
-                acc[at4(o, c, ky, kx, s.in_channels, s.kernel_h, s.kernel_w)] +=
-                    g * input[at4(n, c, y, x, s.in_channels, s.height, s.width)];
-              }
-            }
-        }
+  for_each_tap(s, [&](std::size_t out, std::size_t in, std::size_t w) {
+    acc[w] += static_cast<double>(grad_output[out]) * input[in];
+  });
   return {acc.begin(), acc.end()};
 }
 

@@ -37,7 +37,7 @@ struct TrainCliOptions {
   float lr = 1e-6f, momentum = 0.0f, weight_decay = 0.0f;
   std::uint64_t seed = 1;
   double cache_budget_mb = -1;
-  bool resume = false, no_flow_cache = false;
+  bool resume = false, no_flow_cache = false, augment_flips = false;
 };
 
 std::filesystem::path sibling(const std::filesystem::path& out, const std::string& suffix) {
@@ -65,6 +65,7 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
   app.add_option("--head-size", o->head_size, "the head's flow size WxH (flows are resized to it)")->capture_default_str();
   app.add_option("--target", o->target, "spline (the paper's) or mean")->capture_default_str();
   app.add_option("-o,--output", o->out, "the best head (safetensors)")->required();
+  app.add_flag("--augment-flips", o->augment_flips, "mirror training flows at random, with the matching sign changes of the rates");
   app.add_flag("--resume", o->resume, "continue from <stem>.state.safetensors beside -o");
   app.add_option("--log", o->log, "per-epoch CSV");
   app.add_option("--plot", o->plot, "loss curves (PNG)");
@@ -84,6 +85,7 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
     options.epochs = o->epochs;
     options.batch = o->batch;
     options.seed = o->seed;
+    options.flip_augmentation = o->augment_flips;
     options.head.validate();
 
     std::unique_ptr<Device> device = open_device(global);
@@ -156,6 +158,7 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
       j["epochs"] = options.epochs;
       j["batch"] = options.batch;
       j["seed"] = options.seed;
+      j["augment_flips"] = options.flip_augmentation;
       j["flow"] = to_string(set_options.flow);
       j["input_size"] = std::to_string(width) + "x" + std::to_string(height);
       j["target"] = to_string(set_options.target);

@@ -49,6 +49,9 @@ struct TrainerOptions {
   int epochs = 20;
   int batch = 10;
   std::uint64_t seed = 1;
+  // Each training sample mirrored at random (none, horizontal, vertical, both; from the seed)
+  // with its target's signs changed to match (train/flip_augmentation.hpp).
+  bool flip_augmentation = false;
 };
 
 struct EpochReport {

@@ -66,6 +66,9 @@ class TrainingSet {
   void set_targets(std::vector<Vec3> targets);
   const std::vector<Vec3>& targets() const noexcept { return targets_; }
   std::int64_t timestamp_ns(std::size_t i) const { return t_ns_.at(i); }
+  // The rotation from the camera frame to the frame of the targets (the body/IMU frame): the
+  // sequence's cam0 calibration, else the identity. Flip augmentation needs it.
+  const Mat3& camera_to_body(std::size_t i) const { return camera_to_body_.at(i); }
 
   const std::vector<std::string>& sequences() const noexcept { return sequences_; }
   const std::vector<std::string>& notes() const noexcept { return notes_; }
@@ -78,6 +81,7 @@ class TrainingSet {
   std::vector<std::uint16_t> flows_;  // float16, flow_floats() per sample
   std::vector<Vec3> targets_;
   std::vector<std::int64_t> t_ns_;
+  std::vector<Mat3> camera_to_body_;
   std::vector<std::string> sequences_;
   std::vector<std::string> notes_;
 };
