@@ -106,7 +106,10 @@ std::vector<std::uint16_t> TrainingSet::pair_flows(const EurocSequence& sequence
   if (options_.flow == FlowMethod::DIS) {
     dis = std::make_unique<DisFlow>();
   } else {
-    flownet = std::make_unique<FlowNet>(*options_.device, ModelKind::FlowNet2, *options_.flownet_weights);
+    // The family member the weight file declares (FlowNet2 when it says nothing).
+    const auto& kinds = options_.flownet_weights->models();
+    flownet = std::make_unique<FlowNet>(*options_.device, kinds.empty() ? ModelKind::FlowNet2 : kinds.front(),
+                                        *options_.flownet_weights);
     queue = options_.device->create_queue();
   }
   HostImage previous = load_rgb_image(sequence.frames[0].path);

@@ -40,6 +40,16 @@ run(0 ${CLI} predict b --weights head.safetensors --flow dis -o rates.csv)
 run(2 ${CLI} predict big --weights head.safetensors --flow dis -o rates.csv)
 expect_match("built for 64×48 flow")
 
+# FlowNet flows (FlowNet2-C with synthetic weights, the lightest family member): the flow method
+# and the weights' identity key the cache apart from DIS's.
+run(0 ${CLI} weights --synthetic FlowNet2-C -o c.safetensors)
+run(0 ${CLI} train --train a --val b --flow flownet2 --weights c.safetensors --head-size 32x24 --epochs 1
+    -o fc.safetensors --cache cache)
+expect_match("synthetic")
+expect_match("flows cached in")
+run(0 ${CLI} weights --info fc.safetensors)
+expect_match("\"flow\":\"flownet2\"")
+
 run(2 ${CLI} train --train a --val b --head-size 64x48 --optimizer nadam -o x.safetensors)
 expect_match("unknown optimizer 'nadam'")
 run(2 ${CLI} train --train a --val b --flow flownet2 --head-size 64x48 -o x.safetensors)

@@ -7,7 +7,8 @@
 // static start), in the body (IMU) frame — so a trained head predicts what the gyro measures, in
 // the frame `predict` reports. Pairs without a target (outside the IMU's span) are skipped.
 //
-// Flows come from DIS (weight-free) or FlowNet2 (with weights), at the frames' size, resized
+// Flows come from DIS (weight-free) or FlowNet2 (with weights; the family member the file declares),
+// at the frames' size, resized
 // bilinearly to the head's input size with u and v scaled by the size ratio. They are computed
 // once per sequence and kept, float16, in memory and in an on-disk cache keyed by the sequence's
 // path and timestamps, the flow method, the weights' identity and the size: a second run, or the
