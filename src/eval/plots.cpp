@@ -257,4 +257,39 @@ void plot_error_histograms(const std::filesystem::path& png, const std::array<Hi
   write_png(png, img);
 }
 
+void plot_loss_curves(const std::filesystem::path& png, const std::vector<double>& epochs,
+                      const std::vector<std::pair<std::string, std::vector<double>>>& series, const std::string& title,
+                      const PlotStyle& style) {
+  check_size(style);
+  double lo = 0, hi = 0;
+  for (const auto& [name, values] : series) {
+    if (values.size() != epochs.size() || epochs.empty()) {
+      throw invalid_input("Loss plot: the series " + name + " has " + std::to_string(values.size()) + " values for " +
+                          std::to_string(epochs.size()) + " epochs; expected equal, non-zero counts.");
+    }
+    for (double v : values) hi = std::max(hi, v);
+  }
+  cv::Mat img(style.height, style.width, CV_8UC3, kWhite);
+  draw_title(img, title);
+  const int left = 100, right = 25, top = 55, bottom = 70;
+  double x0 = epochs.front(), x1 = epochs.back();
+  if (!(x1 > x0)) x1 = x0 + 1;
+  Panel p{cv::Rect(left, top, style.width - left - right, style.height - top - bottom), x0, x1, lo,
+          hi > lo ? hi * 1.05 : 1.0};
+  draw_axes(img, p, "epoch", "loss", "", false);
+  const cv::Scalar colours[] = {kTruth, kPredicted, kBar};
+  std::vector<std::pair<std::string, cv::Scalar>> legend;
+  for (std::size_t k = 0; k < series.size(); ++k) {
+    // The polyline helper draws one axis of Vec3 rows in deg/s; undo its scale for a plain series.
+    std::vector<Vec3> rows(epochs.size());
+    for (std::size_t i = 0; i < epochs.size(); ++i) rows[i][0] = series[k].second[i] / kDegreesPerRadian;
+    const cv::Scalar& colour = colours[k % 3];
+    polyline(img, p, epochs, rows, 0, colour);
+    legend.emplace_back(series[k].first, colour);
+  }
+  cv::rectangle(img, p.area, kAxisGrey, 1);
+  draw_legend(img, p.area, legend);
+  write_png(png, img);
+}
+
 }  // namespace inertialnet

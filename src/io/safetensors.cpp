@@ -15,6 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/float16.hpp"
 #include "inertialnet/runtime/error.hpp"
 
 // The data section is reinterpreted as little-endian floats without swapping.
@@ -67,31 +68,6 @@ std::string known_dtypes() {
 }
 
 std::string errno_text(int err) { return std::strerror(err); }
-
-// Exact IEEE binary16 -> binary32: every half value is representable as a float.
-float half_to_float(uint16_t h) {
-  const uint32_t sign = static_cast<uint32_t>(h & 0x8000u) << 16;
-  const uint32_t exponent = (h >> 10) & 0x1Fu;
-  const uint32_t mantissa = h & 0x3FFu;
-  uint32_t bits;
-  if (exponent == 0) {
-    if (mantissa == 0) {
-      bits = sign;
-    } else {
-      // Subnormal half: mantissa · 2^-24, a normal float; ldexp of a small integer is exact.
-      float magnitude = std::ldexp(static_cast<float>(mantissa), -24);
-      std::memcpy(&bits, &magnitude, sizeof bits);
-      bits |= sign;
-    }
-  } else if (exponent == 0x1F) {
-    bits = sign | 0x7F800000u | (mantissa << 13);  // infinity, or NaN with its payload kept
-  } else {
-    bits = sign | ((exponent - 15 + 127) << 23) | (mantissa << 13);
-  }
-  float value;
-  std::memcpy(&value, &bits, sizeof value);
-  return value;
-}
 
 // A read-only private mapping of a whole file.
 class MappedFile {
@@ -349,7 +325,7 @@ std::vector<float> SafetensorsFile::to_float32(const std::string& name) const {
       for (std::size_t i = 0; i < n; ++i) {
         uint16_t h;
         std::memcpy(&h, src + 2 * i, sizeof h);
-        out[i] = half_to_float(h);
+        out[i] = detail::half_to_float(h);
       }
       break;
     default:

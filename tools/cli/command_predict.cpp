@@ -95,7 +95,6 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
   app.add_option("--fy", o->fy, "focal length y (px)")->check(finite_positive);
   app.add_option("--cx", o->cx, "principal point x (px)")->check(finite);
   app.add_option("--cy", o->cy, "principal point y (px)")->check(finite);
-<<<<<<< HEAD
   app.add_option("-o,--output", o->output, "rates CSV to write, folders created as needed (default: standard output)");
   auto* save_flow_option = app.add_option(
       "--save-flow", o->save_flow, "write each pair's flow as <timestamp>.flo (or .png) into this folder (created as needed)");
@@ -104,16 +103,6 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
       ->capture_default_str()
       ->transform(choice("flow format", {"flo", "png", "kitti"}))
       ->needs(save_flow_option);
-=======
-  app.add_option("-o,--output", o->output, "rates CSV to write (default: standard output)");
-  auto* save_flow_option =
-      app.add_option("--save-flow", o->save_flow, "write each pair's flow as <timestamp>.flo (or .png) into this folder");
-  app.add_option("--flow-format", o->flow_format,
-                 "--save-flow format: flo (Middlebury), png (colour wheel) or kitti (KITTI 16-bit flow PNG)")
-      ->capture_default_str()
-      ->check(CLI::IsMember({"flo", "png", "kitti"}))
-      ->needs(save_flow_option);
->>>>>>> python
   app.add_option("--rate", o->rate_hz, "frame rate for image folders and videos without timestamps (Hz)")
       ->check(finite_positive);
   app.add_option("--time-offset", o->time_offset,

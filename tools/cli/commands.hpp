@@ -28,5 +28,6 @@ Command register_synth(CLI::App& app, const GlobalOptions& global);
 Command register_bench(CLI::App& app, const GlobalOptions& global);
 Command register_calibrate_time(CLI::App& app, const GlobalOptions& global);
 Command register_viz(CLI::App& app, const GlobalOptions& global);
+Command register_train(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace inertialnet::cli

@@ -32,6 +32,14 @@ std::string help_examples(const std::string& subcommand) {
       {"calibrate-time",
        "  inertialnet calibrate-time data/seq                  # predicts weight-free, then estimates\n"
        "  inertialnet calibrate-time data/seq rates.csv --range 0.3\n"},
+      {"viz",
+       "  inertialnet viz out/flows/*.flo -o out/pictures --shared-scale   # one scale for a sequence\n"
+       "  inertialnet viz ab.flo --legend --max-magnitude 20\n"},
+      {"train",
+       "  inertialnet train --train data/s1 data/s2 --val data/s3 -o head.safetensors --epochs 20\n"
+       "  inertialnet train --train data/s1 --val data/s2 --optimizer adam --lr 1e-3 --head-size 64x48 \\\n"
+       "      --log out/train.csv --plot out/loss.png -o out/head.safetensors\n"
+       "  inertialnet train --train data/s1 --val data/s2 -o head.safetensors --resume\n"},
       {"synth",
        "  inertialnet synth data/seq --frames 40 --seed 1\n"
        "  inertialnet synth data/general --motion general --size 376x240 --no-noise --overwrite\n"},

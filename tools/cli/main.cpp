@@ -60,6 +60,7 @@ int main(int argc, char** argv) {
       {"synth", "render a EuRoC-layout sequence from a known camera motion", cli::register_synth},
       {"bench", "pairs per second, stage split and per-layer profile (synthetic weights)", cli::register_bench},
       {"weights", "write synthetic weights, or describe a weight file", cli::register_weights},
+      {"train", "train the InertialNet head on sequences with an IMU", cli::register_train},
   };
   std::map<CLI::App*, cli::Command> commands;
   for (const Subcommand& s : kSubcommands) {

@@ -18,5 +18,6 @@ export PYTHONDONTWRITEBYTECODE=1
 "$PY" -m pytest -q -p no:cacheprovider --ignore="$ROOT/tools/reference/tests/test_fixtures.py" \
   "$ROOT/tools/reference/tests"
 "$PY" "$ROOT/tools/reference/make_fixtures.py" "$@"
+"$PY" "$ROOT/tools/reference/make_head_gradient_fixture.py"
 # Then the written fixtures against a fresh run.
 "$PY" -m pytest -q -p no:cacheprovider "$ROOT/tools/reference/tests/test_fixtures.py"

@@ -7,6 +7,7 @@
 #include <array>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "inertialnet/eval/metrics.hpp"
@@ -29,5 +30,11 @@ void plot_rates(const std::filesystem::path& png, const std::vector<double>& t_s
 // Three panels side by side, one per axis, of histograms of the error (deg/s).
 void plot_error_histograms(const std::filesystem::path& png, const std::array<Histogram, 3>& histograms,
                            const std::string& title, const PlotStyle& style = {});
+
+// Training curves (the paper's Fig. 2): one panel of loss per epoch, one line per named series
+// (each as long as `epochs`).
+void plot_loss_curves(const std::filesystem::path& png, const std::vector<double>& epochs,
+                      const std::vector<std::pair<std::string, std::vector<double>>>& series, const std::string& title,
+                      const PlotStyle& style = {});
 
 }  // namespace inertialnet

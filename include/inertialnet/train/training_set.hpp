@@ -1,0 +1,90 @@
+// A training (or validation) set for the InertialNet head: every consecutive frame pair of one or
+// more sequences, as a flow at the head's input size and the angular rate it should predict.
+//
+// Sequences are EuRoC folders (mav0/cam0 + imu0, `inertialnet synth` output included). The target
+// of pair (k−1, k) is the gyro synchronised onto frame k's time (eval/imu_sync.hpp: `spline`, the
+// paper's, or `mean` over the interval), bias-corrected when a bias is known (ground truth, else a
+// static start), in the body (IMU) frame — so a trained head predicts what the gyro measures, in
+// the frame `predict` reports. Pairs without a target (outside the IMU's span) are skipped.
+//
+// Flows come from DIS (weight-free) or FlowNet2 (with weights; the family member the file declares),
+// at the frames' size, resized
+// bilinearly to the head's input size with u and v scaled by the size ratio. They are computed
+// once per sequence and kept, float16, in memory and in an on-disk cache keyed by the sequence's
+// path and timestamps, the flow method, the weights' identity and the size: a second run, or the
+// next epoch, never recomputes them. A cache that would exceed the disk budget is not written
+// (the flows are then recomputed on the next run).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "inertialnet/core/vec3.hpp"
+#include "inertialnet/eval/imu_sync.hpp"
+#include "inertialnet/models/weights.hpp"
+#include "inertialnet/pipeline/rates_processor.hpp"
+#include "inertialnet/runtime/device.hpp"
+
+namespace inertialnet {
+
+struct TrainingSetOptions {
+  int width = 0, height = 0;  // the head's input (flow) size
+  FlowMethod flow = FlowMethod::DIS;
+  // FlowNet2 weights (with FlowMethod::FlowNet) on the device that computes the flows, and a
+  // string identifying them for the cache key (a hash of the files).
+  const WeightSet* flownet_weights = nullptr;
+  Device* device = nullptr;
+  std::string weights_id;
+  SyncTarget target = SyncTarget::Spline;
+  std::filesystem::path cache_dir;  // empty: no disk cache
+  std::uint64_t cache_budget_bytes = std::numeric_limits<std::uint64_t>::max();
+};
+
+// Called once per pair whose flow is computed (not for cached ones): sequence, pair, pairs.
+using FlowProgress = std::function<void(const std::string& sequence, std::size_t pair, std::size_t pairs)>;
+
+class TrainingSet {
+ public:
+  explicit TrainingSet(const TrainingSetOptions& options);
+
+  // Adds every pair of the EuRoC sequence at `root` that has a target; returns how many. Notes
+  // (dropped pairs, the bias used, whether the cache was read or written) go to notes().
+  std::size_t add_sequence(const std::filesystem::path& root, const FlowProgress& progress = {});
+
+  std::size_t size() const noexcept { return targets_.size(); }
+  int width() const noexcept { return options_.width; }
+  int height() const noexcept { return options_.height; }
+  std::size_t flow_floats() const noexcept { return 2 * static_cast<std::size_t>(options_.width) * static_cast<std::size_t>(options_.height); }
+
+  // Sample i's flow [2, H, W] into `out` (flow_floats() floats).
+  void flow(std::size_t i, float* out) const;
+  const Vec3& target(std::size_t i) const { return targets_.at(i); }
+  // Replaces the targets (tests plant label errors with it); the size must not change.
+  void set_targets(std::vector<Vec3> targets);
+  const std::vector<Vec3>& targets() const noexcept { return targets_; }
+  std::int64_t timestamp_ns(std::size_t i) const { return t_ns_.at(i); }
+  // The rotation from the camera frame to the frame of the targets (the body/IMU frame): the
+  // sequence's cam0 calibration, else the identity. Flip augmentation needs it.
+  const Mat3& camera_to_body(std::size_t i) const { return camera_to_body_.at(i); }
+
+  const std::vector<std::string>& sequences() const noexcept { return sequences_; }
+  const std::vector<std::string>& notes() const noexcept { return notes_; }
+
+ private:
+  std::vector<std::uint16_t> pair_flows(const EurocSequence& sequence, const std::filesystem::path& root,
+                                        const FlowProgress& progress);
+
+  TrainingSetOptions options_;
+  std::vector<std::uint16_t> flows_;  // float16, flow_floats() per sample
+  std::vector<Vec3> targets_;
+  std::vector<std::int64_t> t_ns_;
+  std::vector<Mat3> camera_to_body_;
+  std::vector<std::string> sequences_;
+  std::vector<std::string> notes_;
+};
+
+}  // namespace inertialnet

@@ -1,0 +1,302 @@
+#include "inertialnet/train/trainer.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+
+#include "inertialnet/core/constants.hpp"
+#include "inertialnet/core/random.hpp"
+#include "inertialnet/eval/metrics.hpp"
+#include "inertialnet/io/safetensors.hpp"
+#include "inertialnet/io/safetensors_writer.hpp"
+#include "inertialnet/ops/optimizer_step.hpp"
+#include "inertialnet/runtime/error.hpp"
+#include "inertialnet/train/flip_augmentation.hpp"
+#include "runtime/hash.hpp"
+
+namespace inertialnet {
+
+namespace {
+
+constexpr const char* kStateEpoch = "inertialnet.train.epoch";
+constexpr const char* kStateSteps = "inertialnet.train.steps";
+constexpr const char* kStateBest = "inertialnet.train.best_rmse";
+
+// Σ over axes of the RMSE: the one number "best" compares.
+double mean_rmse(const Vec3& v) { return (v[0] + v[1] + v[2]) / 3.0; }
+
+// Samples 0..n−1 in the order of epoch `epoch`: Fisher–Yates from a stream of (seed, epoch).
+std::vector<std::size_t> shuffled(std::size_t n, std::uint64_t seed, int epoch) {
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  SplitMix64 rng(seed, static_cast<std::uint64_t>(epoch));  // one stream per epoch
+  for (std::size_t i = n; i > 1; --i) std::swap(order[i - 1], order[rng.next() % i]);
+  return order;
+}
+
+Vec3 spread(const std::vector<Vec3>& v) {
+  Vec3 mean{}, var{};
+  for (const auto& x : v)
+    for (int a = 0; a < 3; ++a) mean[a] += x[a] / static_cast<double>(v.size());
+  for (const auto& x : v)
+    for (int a = 0; a < 3; ++a) var[a] += (x[a] - mean[a]) * (x[a] - mean[a]) / static_cast<double>(v.size());
+  return {std::sqrt(var[0]), std::sqrt(var[1]), std::sqrt(var[2])};
+}
+
+}  // namespace
+
+std::string to_string(OptimizerKind kind) { return kind == OptimizerKind::Adam ? "adam" : "sgd"; }
+
+std::string to_string(LrSchedule schedule) {
+  switch (schedule) {
+    case LrSchedule::Step: return "step";
+    case LrSchedule::Cosine: return "cosine";
+    default: return "constant";
+  }
+}
+
+OptimizerKind parse_optimizer(const std::string& text) {
+  if (text == "sgd") return OptimizerKind::SGD;
+  if (text == "adam") return OptimizerKind::Adam;
+  throw invalid_input("unknown optimizer '" + text + "'; expected sgd or adam");
+}
+
+LrSchedule parse_lr_schedule(const std::string& text) {
+  if (text == "constant") return LrSchedule::Constant;
+  if (text == "step") return LrSchedule::Step;
+  if (text == "cosine") return LrSchedule::Cosine;
+  throw invalid_input("unknown learning-rate schedule '" + text + "'; expected constant, step or cosine");
+}
+
+Trainer::Trainer(Device& device, const TrainerOptions& options)
+    : device_(device), options_(options), queue_(device.create_queue()) {
+  options_.head.validate();
+  if (options.epochs < 1 || options.batch < 1) throw invalid_input("training: epochs and batch must be at least 1");
+  if (!(options.lr > 0.0f) || !std::isfinite(options.lr)) throw invalid_input("training: the learning rate must be positive");
+  // torch.nn's defaults for Conv2d and Linear: weights and biases uniform in ±1/sqrt(fan-in).
+  for (const auto& spec : head_parameters(options_.head)) {
+    const std::string weight_name = spec.name.substr(0, spec.name.rfind('.')) + ".weight";
+    std::int64_t fan_in = 1;
+    for (const auto& s : head_parameters(options_.head)) {
+      if (s.name == weight_name) fan_in = element_count(s.shape) / s.shape[0];
+    }
+    const double bound = 1.0 / std::sqrt(static_cast<double>(fan_in));
+    SplitMix64 rng(options.seed, detail::fnv1a64(spec.name));  // one stream per tensor
+    std::vector<float> values(static_cast<std::size_t>(element_count(spec.shape)));
+    for (auto& v : values) v = static_cast<float>(rng.uniform(-bound, bound));
+    params_.emplace(spec.name, Tensor::from_host(*queue_, spec.shape, values));
+  }
+  HeadBackprop zeros(options_.head);
+  grads_ = zeros.zeros_like_parameters(*queue_);
+  moment1_ = zeros.zeros_like_parameters(*queue_);
+  moment2_ = zeros.zeros_like_parameters(*queue_);
+  queue_->finish();
+}
+
+Trainer::~Trainer() = default;
+
+HeadBackprop& Trainer::head_for(std::int64_t batch) {
+  auto& head = heads_[batch];
+  if (!head) head = std::make_unique<HeadBackprop>(options_.head);
+  return *head;
+}
+
+double Trainer::lr_for(int epoch) const {
+  const double lr = options_.lr;
+  switch (options_.schedule) {
+    case LrSchedule::Step:
+      return lr * std::pow(static_cast<double>(options_.step_gamma), (epoch - 1) / std::max(1, options_.step_epochs));
+    case LrSchedule::Cosine:
+      return 0.5 * lr * (1.0 + std::cos(kPi * (epoch - 1) / std::max(1, options_.epochs)));
+    default:
+      return lr;
+  }
+}
+
+void Trainer::step(Queue& queue, double lr) {
+  ++steps_;
+  for (const auto& [name, param] : params_) {
+    if (options_.optimizer == OptimizerKind::Adam) {
+      AdamOptions adam;
+      adam.lr = static_cast<float>(lr);
+      adam.weight_decay = options_.weight_decay;
+      adam_step(queue, param, grads_.at(name), moment1_.at(name), moment2_.at(name), steps_, adam);
+    } else {
+      sgd_step(queue, param, grads_.at(name), moment1_.at(name),
+               {static_cast<float>(lr), options_.momentum, options_.weight_decay});
+    }
+  }
+}
+
+Evaluation Trainer::evaluate(const TrainingSet& set) {
+  Evaluation e;
+  if (set.size() == 0) throw invalid_input("training: the validation set has no samples");
+  const std::size_t floats = set.flow_floats();
+  const auto batch = static_cast<std::size_t>(options_.batch);
+  std::vector<float> host;
+  for (std::size_t first = 0; first < set.size(); first += batch) {
+    const std::size_t count = std::min(batch, set.size() - first);
+    host.resize(count * floats);
+    for (std::size_t i = 0; i < count; ++i) set.flow(first + i, host.data() + i * floats);
+    const auto n = static_cast<std::int64_t>(count);
+    const Tensor flow = Tensor::from_host(*queue_, {n, 2, set.height(), set.width()}, host);
+    const auto out = head_for(n).predict(*queue_, params_, flow).to_host(*queue_);
+    for (std::size_t i = 0; i < count; ++i) e.predicted.push_back({out[3 * i], out[3 * i + 1], out[3 * i + 2]});
+  }
+  const std::vector<Vec3> zeros(set.size(), Vec3{});
+  e.rmse_deg_s = rmse_deg_s(e.predicted, set.targets());
+  e.zero_rmse_deg_s = rmse_deg_s(zeros, set.targets());
+  for (int a = 0; a < 3; ++a) {
+    const double r = e.rmse_deg_s[a] / kDegreesPerRadian;
+    e.loss += r * r / 3.0;
+  }
+  const Vec3 sp = spread(e.predicted), st = spread(set.targets());
+  for (int a = 0; a < 3; ++a) e.spread_ratio[a] = st[a] > 0 ? sp[a] / st[a] : 0.0;
+  return e;
+}
+
+bool Trainer::train(const TrainingSet& train_set, const TrainingSet& val_set, const TrainerCallbacks& callbacks,
+                    const std::function<void(const EpochReport&)>& on_best,
+                    const std::function<void(const EpochReport&)>& on_last) {
+  if (train_set.width() != options_.head.input_width || train_set.height() != options_.head.input_height) {
+    throw invalid_input("training: the training set's flows are " + std::to_string(train_set.width()) + "x" +
+                        std::to_string(train_set.height()) + " but the head takes " +
+                        std::to_string(options_.head.input_width) + "x" + std::to_string(options_.head.input_height));
+  }
+  if (train_set.size() == 0) throw invalid_input("training: the training set has no samples");
+  const std::size_t floats = train_set.flow_floats();
+  const auto batch = static_cast<std::size_t>(options_.batch);
+  const std::size_t batches = (train_set.size() + batch - 1) / batch;
+  std::vector<float> flows, targets;
+  while (epoch_ < options_.epochs) {
+    const int epoch = epoch_ + 1;
+    const auto start = std::chrono::steady_clock::now();
+    const double lr = lr_for(epoch);
+    const auto order = shuffled(train_set.size(), options_.seed, epoch);
+    SplitMix64 flips(options_.seed ^ 0xF11F5ull, static_cast<std::uint64_t>(epoch));  // this epoch's flips
+    double loss_sum = 0;
+    for (std::size_t b = 0; b < batches; ++b) {
+      if (callbacks.stop && callbacks.stop->load()) return false;
+      const std::size_t first = b * batch, count = std::min(batch, train_set.size() - first);
+      flows.resize(count * floats);
+      targets.resize(count * 3);
+      for (std::size_t i = 0; i < count; ++i) {
+        const std::size_t s = order[first + i];
+        train_set.flow(s, flows.data() + i * floats);
+        Vec3 t = train_set.target(s);
+        if (options_.flip_augmentation) {
+          const auto flip = static_cast<Flip>(flips.next() & 3u);
+          flip_flow(flows.data() + i * floats, train_set.width(), train_set.height(), flip);
+          t = flip_body_rates(t, train_set.camera_to_body(s), flip);
+        }
+        for (int a = 0; a < 3; ++a) targets[3 * i + static_cast<std::size_t>(a)] = static_cast<float>(t[a]);
+      }
+      const auto n = static_cast<std::int64_t>(count);
+      const Tensor flow = Tensor::from_host(*queue_, {n, 2, train_set.height(), train_set.width()}, flows);
+      const Tensor target = Tensor::from_host(*queue_, {n, 3}, targets);
+      const std::uint64_t dropout_seed = splitmix64(options_.seed + 0x9E3779B97F4A7C15ull * static_cast<std::uint64_t>(steps_ + 1));
+      const double loss = head_for(n).loss_and_gradients(*queue_, params_, flow, target, dropout_seed, grads_);
+      step(*queue_, lr);
+      loss_sum += loss;
+      if (callbacks.on_batch) callbacks.on_batch(epoch, b + 1, batches, loss);
+    }
+    queue_->finish();
+    epoch_ = epoch;
+    const Evaluation e = evaluate(val_set);
+    EpochReport r;
+    r.epoch = epoch;
+    r.epochs = options_.epochs;
+    r.lr = lr;
+    r.train_loss = loss_sum / static_cast<double>(batches);
+    r.val_loss = e.loss;
+    r.val_rmse_deg_s = e.rmse_deg_s;
+    r.zero_rmse_deg_s = e.zero_rmse_deg_s;
+    r.spread_ratio = e.spread_ratio;
+    r.collapsed = *std::min_element(e.spread_ratio.begin(), e.spread_ratio.end()) < kCollapseRatio;
+    r.best = best_rmse_ < 0 || mean_rmse(e.rmse_deg_s) < best_rmse_;
+    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (r.best) {
+      best_rmse_ = mean_rmse(e.rmse_deg_s);
+      best_ = r;
+    }
+    last_ = r;
+    if (callbacks.on_epoch) callbacks.on_epoch(r);
+    if (r.best && on_best) on_best(r);
+    if (on_last) on_last(r);
+  }
+  return true;
+}
+
+std::map<std::string, std::vector<float>> Trainer::parameters() const {
+  std::map<std::string, std::vector<float>> out;
+  for (const auto& [name, t] : params_) out.emplace(name, t.to_host(*queue_));
+  return out;
+}
+
+void Trainer::save_head(const std::filesystem::path& path, const std::map<std::string, std::string>& metadata) const {
+  std::vector<HostTensor> tensors;
+  for (const auto& spec : head_parameters(options_.head)) {
+    HostTensor t;
+    t.name = spec.name;
+    t.shape = spec.shape;
+    t.data = params_.at(spec.name).to_host(*queue_);
+    tensors.push_back(std::move(t));
+  }
+  auto meta = metadata;
+  meta[kMetadataModel] = to_string(ModelKind::InertialNetHead);
+  meta[kMetadataHead] = head_config_to_json(options_.head);
+  write_safetensors(path.string(), tensors, meta);
+}
+
+void Trainer::save_state(const std::filesystem::path& path) const {
+  std::vector<HostTensor> tensors;
+  const std::pair<const char*, const NamedTensors*> groups[] = {
+      {"", &params_}, {"optimizer.m1.", &moment1_}, {"optimizer.m2.", &moment2_}};
+  for (const auto& [prefix, group] : groups) {
+    for (const auto& [name, t] : *group) {
+      HostTensor h;
+      h.name = prefix + name;
+      h.shape = t.shape();
+      h.data = t.to_host(*queue_);
+      tensors.push_back(std::move(h));
+    }
+  }
+  char best[64];
+  std::snprintf(best, sizeof best, "%.17g", best_rmse_);
+  write_safetensors(path.string(), tensors,
+                    {{kMetadataHead, head_config_to_json(options_.head)},
+                     {kStateEpoch, std::to_string(epoch_)},
+                     {kStateSteps, std::to_string(steps_)},
+                     {kStateBest, best}});
+}
+
+void Trainer::resume(const std::filesystem::path& path) {
+  const SafetensorsFile file(path.string());
+  const auto& meta = file.metadata();
+  const auto config = meta.find(kMetadataHead);
+  if (config == meta.end() || head_config_from_json(config->second) != options_.head) {
+    throw invalid_input(path.string() + " is the state of a head of another configuration than this run's");
+  }
+  for (auto* key : {kStateEpoch, kStateSteps, kStateBest}) {
+    if (!meta.count(key)) throw invalid_input(path.string() + " is not a training state (no " + std::string(key) + ")");
+  }
+  const std::pair<const char*, NamedTensors*> groups[] = {
+      {"", &params_}, {"optimizer.m1.", &moment1_}, {"optimizer.m2.", &moment2_}};
+  for (const auto& [prefix, group] : groups) {
+    for (auto& [name, t] : *group) {
+      const auto values = file.to_float32(prefix + name);
+      if (static_cast<std::int64_t>(values.size()) != t.numel()) {
+        throw invalid_input(path.string() + ": " + prefix + name + " has the wrong size");
+      }
+      t = Tensor::from_host(*queue_, t.shape(), values);
+    }
+  }
+  epoch_ = std::stoi(meta.at(kStateEpoch));
+  steps_ = std::stoll(meta.at(kStateSteps));
+  best_rmse_ = std::stod(meta.at(kStateBest));
+  queue_->finish();
+}
+
+}  // namespace inertialnet

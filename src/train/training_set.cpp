@@ -1,0 +1,206 @@
+#include "inertialnet/train/training_set.hpp"
+
+#include <cstring>
+#include <fstream>
+#include <iomanip>
+#include <memory>
+#include <sstream>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "core/float16.hpp"
+#include "inertialnet/io/euroc.hpp"
+#include "inertialnet/io/image_io.hpp"
+#include "inertialnet/models/dis_flow.hpp"
+#include "inertialnet/models/flownet.hpp"
+#include "inertialnet/runtime/error.hpp"
+#include "runtime/atomic_file.hpp"
+#include "runtime/hash.hpp"
+
+namespace inertialnet {
+
+namespace {
+
+constexpr char kCacheMagic[8] = {'I', 'N', 'F', 'L', 'O', 'W', '1', '6'};
+
+// Planar [2, h, w] flow at the head's size: bilinear, vectors scaled by the size ratio.
+std::vector<float> resize_flow(const std::vector<float>& flow, int w, int h, int out_w, int out_h) {
+  if (w == out_w && h == out_h) return flow;
+  std::vector<float> out(2 * static_cast<std::size_t>(out_w) * static_cast<std::size_t>(out_h));
+  const double scale[2] = {static_cast<double>(out_w) / w, static_cast<double>(out_h) / h};
+  for (int c = 0; c < 2; ++c) {
+    const cv::Mat in(h, w, CV_32FC1, const_cast<float*>(flow.data()) + static_cast<std::size_t>(c) * w * h);
+    cv::Mat resized(out_h, out_w, CV_32FC1, out.data() + static_cast<std::size_t>(c) * out_w * out_h);
+    // INTER_AREA averages when shrinking (no aliasing of fine flow detail), bilinear otherwise.
+    cv::resize(in, resized, resized.size(), 0, 0, out_w < w ? cv::INTER_AREA : cv::INTER_LINEAR);
+    resized *= scale[c];
+  }
+  return out;
+}
+
+std::string cache_key(const std::filesystem::path& root, const EurocSequence& sequence, const TrainingSetOptions& o) {
+  std::ostringstream key;
+  std::error_code ec;
+  const auto canonical = std::filesystem::weakly_canonical(root, ec);
+  key << "inertialnet.flowcache/1|" << (ec ? root : canonical).string() << '|' << to_string(o.flow) << '|'
+      << o.weights_id << '|' << o.width << 'x' << o.height << '|' << sequence.frames.size() << '|'
+      << sequence.frames.front().t_ns << '|' << sequence.frames.back().t_ns;
+  std::ostringstream name;
+  name << std::hex << std::setw(16) << std::setfill('0') << detail::fnv1a64(key.str()) << ".flow16";
+  return name.str();
+}
+
+// The cached flows of `pairs` pairs, or empty when the file is missing or not what we expect.
+std::vector<std::uint16_t> read_cache(const std::filesystem::path& path, std::size_t floats) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return {};
+  char magic[8];
+  std::uint64_t count = 0;
+  if (!in.read(magic, 8) || std::memcmp(magic, kCacheMagic, 8) != 0) return {};
+  if (!in.read(reinterpret_cast<char*>(&count), sizeof count) || count != floats) return {};
+  std::vector<std::uint16_t> data(floats);
+  if (!in.read(reinterpret_cast<char*>(data.data()), static_cast<std::streamsize>(floats * sizeof(std::uint16_t)))) return {};
+  return data;
+}
+
+void write_cache(const std::filesystem::path& path, const std::vector<std::uint16_t>& data) {
+  std::string bytes(kCacheMagic, 8);
+  const std::uint64_t count = data.size();
+  bytes.append(reinterpret_cast<const char*>(&count), sizeof count);
+  bytes.append(reinterpret_cast<const char*>(data.data()), data.size() * sizeof(std::uint16_t));
+  std::filesystem::create_directories(path.parent_path());
+  write_file_atomically(path, bytes.data(), bytes.size());
+}
+
+}  // namespace
+
+TrainingSet::TrainingSet(const TrainingSetOptions& options) : options_(options) {
+  if (options.width < kDisMinimumSide || options.height < kDisMinimumSide) {
+    throw invalid_input("training set: the head's input size " + std::to_string(options.width) + "x" +
+                        std::to_string(options.height) + " is too small (at least " +
+                        std::to_string(kDisMinimumSide) + " pixels a side)");
+  }
+  if (options.flow == FlowMethod::FlowNet && (!options.flownet_weights || !options.device)) {
+    throw invalid_input("training set: FlowNet2 flow needs weights (--weights) and a device");
+  }
+}
+
+std::vector<std::uint16_t> TrainingSet::pair_flows(const EurocSequence& sequence, const std::filesystem::path& root,
+                                                   const FlowProgress& progress) {
+  const std::size_t pairs = sequence.frames.size() - 1;
+  const std::size_t floats = pairs * flow_floats();
+  std::filesystem::path cache;
+  if (!options_.cache_dir.empty()) {
+    cache = options_.cache_dir / cache_key(root, sequence, options_);
+    auto cached = read_cache(cache, floats);
+    if (!cached.empty()) {
+      notes_.push_back(sequence.name + ": flows read from the cache " + cache.string());
+      return cached;
+    }
+  }
+  std::vector<std::uint16_t> out(floats);
+  std::unique_ptr<DisFlow> dis;
+  std::unique_ptr<FlowNet> flownet;
+  std::unique_ptr<Queue> queue;
+  if (options_.flow == FlowMethod::DIS) {
+    dis = std::make_unique<DisFlow>();
+  } else {
+    // The family member the weight file declares (FlowNet2 when it says nothing).
+    const auto& kinds = options_.flownet_weights->models();
+    flownet = std::make_unique<FlowNet>(*options_.device, kinds.empty() ? ModelKind::FlowNet2 : kinds.front(),
+                                        *options_.flownet_weights);
+    queue = options_.device->create_queue();
+  }
+  HostImage previous = load_rgb_image(sequence.frames[0].path);
+  for (std::size_t k = 1; k <= pairs; ++k) {
+    HostImage current = load_rgb_image(sequence.frames[k].path);
+    if (current.width != previous.width || current.height != previous.height) {
+      throw invalid_input(sequence.frames[k].path.string() + " is " + std::to_string(current.width) + "x" +
+                          std::to_string(current.height) + " but the frame before it is " +
+                          std::to_string(previous.width) + "x" + std::to_string(previous.height));
+    }
+    std::vector<float> flow;
+    if (dis) {
+      if (current.width < kDisMinimumSide || current.height < kDisMinimumSide) {
+        throw invalid_input(sequence.frames[k].path.string() + " is smaller than DIS optical flow's " +
+                            std::to_string(kDisMinimumSide) + "x" + std::to_string(kDisMinimumSide) + " pixels");
+      }
+      const FlowField field = dis->compute(previous, current);
+      flow = field.u;  // planar [2, H, W]: u then v, as FlowNet's output
+      flow.insert(flow.end(), field.v.begin(), field.v.end());
+    } else {
+      const Shape shape{1, 3, current.height, current.width};
+      flow = flownet->compute(*queue, Tensor::from_host(*queue, shape, previous.data), Tensor::from_host(*queue, shape, current.data))
+                 .to_host(*queue);
+    }
+    const auto resized = resize_flow(flow, current.width, current.height, options_.width, options_.height);
+    std::uint16_t* dst = out.data() + (k - 1) * flow_floats();
+    for (std::size_t i = 0; i < resized.size(); ++i) dst[i] = detail::float_to_half(resized[i]);
+    if (progress) progress(sequence.name, k, pairs);
+    previous = std::move(current);
+  }
+  if (!cache.empty()) {
+    const std::uint64_t bytes = floats * sizeof(std::uint16_t);
+    if (bytes <= options_.cache_budget_bytes) {
+      write_cache(cache, out);
+      notes_.push_back(sequence.name + ": flows cached in " + cache.string());
+    } else {
+      notes_.push_back(sequence.name + ": flows (" + std::to_string(bytes >> 20) +
+                       " MiB) exceed the cache budget; not cached, a later run recomputes them");
+    }
+  }
+  return out;
+}
+
+std::size_t TrainingSet::add_sequence(const std::filesystem::path& root, const FlowProgress& progress) {
+  if (!is_euroc_folder(root)) {
+    throw invalid_input(root.string() + " is not a EuRoC sequence (no mav0/ with cam0/ and imu0/); training needs "
+                        "the IMU for its targets");
+  }
+  const EurocSequence sequence = read_euroc(root);
+  if (sequence.frames.size() < 2) throw invalid_input(root.string() + " has fewer than two frames");
+  SyncOptions sync;
+  sync.target = options_.target;
+  sync.camera_frame = false;  // the body (IMU) frame, as the gyro measures and predict reports
+  sync.bias = BiasSource::Automatic;
+  const GyroTruth truth = sync_gyro(sequence, sync);
+  for (const auto& note : truth.notes) notes_.push_back(sequence.name + ": " + note);
+  notes_.push_back(sequence.name + ": targets bias-corrected from " + to_string(truth.bias_source));
+  Mat3 camera_to_body{1, 0, 0, 0, 1, 0, 0, 0, 1};
+  if (sequence.camera) {
+    const Mat3 r = imu_to_camera_rotation(sequence);  // R_CS: IMU → camera; its transpose back
+    camera_to_body = {r[0], r[3], r[6], r[1], r[4], r[7], r[2], r[5], r[8]};
+  }
+  const auto flows = pair_flows(sequence, root, progress);
+  const auto corrected = truth.corrected();
+  std::size_t added = 0;
+  for (std::size_t j = 0; j < truth.frame_index.size(); ++j) {
+    const std::size_t k = truth.frame_index[j];
+    if (k == 0) continue;  // frame 0 ends no pair
+    const auto begin = flows.begin() + static_cast<std::ptrdiff_t>((k - 1) * flow_floats());
+    flows_.insert(flows_.end(), begin, begin + static_cast<std::ptrdiff_t>(flow_floats()));
+    targets_.push_back(corrected[j]);
+    t_ns_.push_back(truth.t_ns[j]);
+    camera_to_body_.push_back(camera_to_body);
+    ++added;
+  }
+  sequences_.push_back(sequence.name.empty() ? root.filename().string() : sequence.name);
+  return added;
+}
+
+void TrainingSet::flow(std::size_t i, float* out) const {
+  if (i >= size()) throw invalid_input("training set: sample " + std::to_string(i) + " of " + std::to_string(size()));
+  const std::uint16_t* src = flows_.data() + i * flow_floats();
+  for (std::size_t j = 0; j < flow_floats(); ++j) out[j] = detail::half_to_float(src[j]);
+}
+
+void TrainingSet::set_targets(std::vector<Vec3> targets) {
+  if (targets.size() != targets_.size()) {
+    throw invalid_input("training set: " + std::to_string(targets.size()) + " targets for " +
+                        std::to_string(targets_.size()) + " samples");
+  }
+  targets_ = std::move(targets);
+}
+
+}  // namespace inertialnet

@@ -1,0 +1,249 @@
+// `inertialnet train`: trains the InertialNet head on flows of EuRoC sequences against their gyro
+// (include/inertialnet/train/trainer.hpp), on the selected OpenCL device. Writes the best head by
+// validation RMSE (-o), the last one (<stem>.last.safetensors) and a resumable state
+// (<stem>.state.safetensors) after every epoch; Ctrl-C stops after the current mini-batch with
+// both checkpoints valid (exit 1).
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <memory>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "common.hpp"
+#include "progress.hpp"
+#include "inertialnet/eval/plots.hpp"
+#include "inertialnet/models/weights.hpp"
+#include "inertialnet/runtime/error.hpp"
+#include "inertialnet/runtime/program_cache.hpp"
+#include "inertialnet/train/trainer.hpp"
+#include "inertialnet/train/training_set.hpp"
+
+namespace inertialnet::cli {
+
+namespace {
+
+std::atomic<bool> train_interrupted{false};
+extern "C" void on_train_interrupt(int) { train_interrupted = true; }
+
+struct TrainCliOptions {
+  std::vector<std::string> train, val, weights;
+  std::string flow = "dis", optimizer = "sgd", schedule = "constant", head_size = "752x480", target = "spline";
+  std::string out, log, plot, cache;
+  int epochs = 20, batch = 10;
+  float lr = 1e-6f, momentum = 0.0f, weight_decay = 0.0f;
+  std::uint64_t seed = 1;
+  double cache_budget_mb = -1;
+  bool resume = false, no_flow_cache = false, augment_flips = false;
+};
+
+std::filesystem::path sibling(const std::filesystem::path& out, const std::string& suffix) {
+  return out.parent_path() / (out.stem().string() + suffix);
+}
+
+std::string vec3_json(const Vec3& v) { return nlohmann::json(std::vector<double>{v[0], v[1], v[2]}).dump(); }
+
+}  // namespace
+
+Command register_train(CLI::App& app, const GlobalOptions& global) {
+  auto o = std::make_shared<TrainCliOptions>();
+  app.add_option("--train", o->train, "training sequences (EuRoC folders)")->required();
+  app.add_option("--val", o->val, "validation sequences (EuRoC folders)")->required();
+  app.add_option("--flow", o->flow, "dis (weight-free) or flownet2 (needs --weights)")->capture_default_str();
+  app.add_option("--weights", o->weights, "FlowNet2 weights, for --flow flownet2");
+  app.add_option("--epochs", o->epochs, "epochs")->capture_default_str()->check(CLI::Range(1, 100000));
+  app.add_option("--batch", o->batch, "mini-batch size")->capture_default_str()->check(CLI::Range(1, 100000));
+  app.add_option("--lr", o->lr, "learning rate (the paper: 1e-6 with SGD)")->capture_default_str();
+  app.add_option("--optimizer", o->optimizer, "sgd or adam")->capture_default_str();
+  app.add_option("--momentum", o->momentum, "SGD momentum")->capture_default_str();
+  app.add_option("--weight-decay", o->weight_decay, "L2 weight decay")->capture_default_str();
+  app.add_option("--lr-schedule", o->schedule, "constant, step (x0.1 every 10 epochs) or cosine")->capture_default_str();
+  app.add_option("--seed", o->seed, "seed of the initialisation, shuffles and dropout")->capture_default_str();
+  app.add_option("--head-size", o->head_size, "the head's flow size WxH (flows are resized to it)")->capture_default_str();
+  app.add_option("--target", o->target, "spline (the paper's) or mean")->capture_default_str();
+  app.add_option("-o,--output", o->out, "the best head (safetensors)")->required();
+  app.add_flag("--augment-flips", o->augment_flips, "mirror training flows at random, with the matching sign changes of the rates");
+  app.add_flag("--resume", o->resume, "continue from <stem>.state.safetensors beside -o");
+  app.add_option("--log", o->log, "per-epoch CSV");
+  app.add_option("--plot", o->plot, "loss curves (PNG)");
+  app.add_option("--cache", o->cache, "flow cache folder (default: <program cache>/flows)");
+  app.add_option("--cache-budget", o->cache_budget_mb, "largest flow cache per sequence, MB (else not cached)");
+  app.add_flag("--no-flow-cache", o->no_flow_cache, "compute flows afresh and cache nothing");
+  return [o, &global]() {
+    const auto [width, height] = parse_size(o->head_size);
+    TrainerOptions options;
+    options.head.input_width = width;
+    options.head.input_height = height;
+    options.optimizer = parse_optimizer(o->optimizer);
+    options.schedule = parse_lr_schedule(o->schedule);
+    options.lr = o->lr;
+    options.momentum = o->momentum;
+    options.weight_decay = o->weight_decay;
+    options.epochs = o->epochs;
+    options.batch = o->batch;
+    options.seed = o->seed;
+    options.flip_augmentation = o->augment_flips;
+    options.head.validate();
+
+    std::unique_ptr<Device> device = open_device(global);
+    TrainingSetOptions set_options;
+    set_options.width = static_cast<int>(width);
+    set_options.height = static_cast<int>(height);
+    set_options.flow = parse_flow_method(o->flow);
+    set_options.target = parse_sync_target(o->target);
+    WeightSet flownet;
+    if (set_options.flow == FlowMethod::FlowNet) {
+      if (o->weights.empty()) throw invalid_input("--flow flownet2 needs FlowNet2 weights (--weights FILE)");
+      flownet = WeightSet::load(*device, o->weights);
+      warn_if_synthetic(flownet);
+      set_options.flownet_weights = &flownet;
+      set_options.device = device.get();
+      std::string id;
+      for (const auto& w : o->weights) {
+        std::error_code ec;
+        id += w + ":" + std::to_string(std::filesystem::file_size(w, ec)) + ":" +
+              std::to_string(std::filesystem::last_write_time(w, ec).time_since_epoch().count()) + ";";
+      }
+      set_options.weights_id = id;
+    }
+    if (!o->no_flow_cache) set_options.cache_dir = o->cache.empty() ? default_cache_directory() / "flows" : std::filesystem::path(o->cache);
+    if (o->cache_budget_mb >= 0) set_options.cache_budget_bytes = static_cast<std::uint64_t>(o->cache_budget_mb * 1048576.0);
+
+    TrainingSet train_set(set_options), val_set(set_options);
+    auto load = [&](TrainingSet& set, const std::vector<std::string>& roots, const char* what) {
+      for (const auto& root : roots) {
+        std::unique_ptr<Progress> progress;
+        const std::size_t n = set.add_sequence(root, [&](const std::string& name, std::size_t pair, std::size_t pairs) {
+          if (!progress) progress = std::make_unique<Progress>(std::string(what) + " flows " + name, pairs);
+          progress->update(pair);
+        });
+        progress.reset();
+        std::cerr << what << " " << root << ": " << n << " pairs\n";
+      }
+      for (const auto& note : set.notes()) std::cerr << "  " << note << "\n";
+    };
+    load(train_set, o->train, "train");
+    load(val_set, o->val, "val");
+
+    Trainer trainer(*device, options);
+    const std::filesystem::path out = o->out;
+    const std::filesystem::path last_path = sibling(out, ".last.safetensors");
+    const std::filesystem::path state_path = sibling(out, ".state.safetensors");
+    if (o->resume) {
+      trainer.resume(state_path);
+      std::cerr << "resuming after epoch " << trainer.epochs_done() << " from " << state_path << "\n";
+    }
+
+    std::ofstream log;
+    if (!o->log.empty()) {
+      log.open(o->log, o->resume ? std::ios::app : std::ios::trunc);
+      if (!log) throw invalid_input("cannot write the log " + o->log);
+      if (!o->resume) {
+        log << "epoch,lr,train_loss,val_loss,rmse_x_deg_s,rmse_y_deg_s,rmse_z_deg_s,zero_rmse_x_deg_s,"
+               "zero_rmse_y_deg_s,zero_rmse_z_deg_s,spread_ratio_x,spread_ratio_y,spread_ratio_z,best,seconds\n";
+      }
+    }
+    std::vector<double> plot_epochs, plot_train, plot_val;
+
+    auto metadata = [&](const EpochReport& r) {
+      nlohmann::json j;
+      j["optimizer"] = to_string(options.optimizer);
+      j["lr"] = options.lr;
+      j["momentum"] = options.momentum;
+      j["weight_decay"] = options.weight_decay;
+      j["lr_schedule"] = to_string(options.schedule);
+      j["epochs"] = options.epochs;
+      j["batch"] = options.batch;
+      j["seed"] = options.seed;
+      j["augment_flips"] = options.flip_augmentation;
+      j["flow"] = to_string(set_options.flow);
+      j["input_size"] = std::to_string(width) + "x" + std::to_string(height);
+      j["target"] = to_string(set_options.target);
+      j["frame"] = "body";
+      j["train_sequences"] = train_set.sequences();
+      j["val_sequences"] = val_set.sequences();
+      j["epoch"] = r.epoch;
+      j["val_rmse_deg_s"] = nlohmann::json::parse(vec3_json(r.val_rmse_deg_s));
+      j["zero_rmse_deg_s"] = nlohmann::json::parse(vec3_json(r.zero_rmse_deg_s));
+      j["spread_ratio"] = nlohmann::json::parse(vec3_json(r.spread_ratio));
+      return std::map<std::string, std::string>{{"inertialnet.training", j.dump()}};
+    };
+
+    Progress* bar = nullptr;
+    std::unique_ptr<Progress> epoch_bar;
+    TrainerCallbacks callbacks;
+    callbacks.stop = &train_interrupted;
+    callbacks.on_batch = [&](int epoch, std::size_t b, std::size_t batches, double) {
+      if (b == 1) {
+        epoch_bar = std::make_unique<Progress>("epoch " + std::to_string(epoch) + "/" + std::to_string(options.epochs), batches);
+        bar = epoch_bar.get();
+      }
+      bar->update(b);
+    };
+    callbacks.on_epoch = [&](const EpochReport& r) {
+      epoch_bar.reset();
+      char line[512];
+      std::snprintf(line, sizeof line,
+                    "epoch %d/%d  lr %.3g  train %.5g  val %.5g  RMSE %.2f %.2f %.2f deg/s (zero %.2f %.2f %.2f)  "
+                    "spread %.2f %.2f %.2f  %.1f s%s",
+                    r.epoch, r.epochs, r.lr, r.train_loss, r.val_loss, r.val_rmse_deg_s[0], r.val_rmse_deg_s[1],
+                    r.val_rmse_deg_s[2], r.zero_rmse_deg_s[0], r.zero_rmse_deg_s[1], r.zero_rmse_deg_s[2],
+                    r.spread_ratio[0], r.spread_ratio[1], r.spread_ratio[2], r.seconds, r.best ? "  best" : "");
+      std::cerr << line << "\n";
+      if (r.collapsed) {
+        std::cerr << "warning: the predictions' spread fell below " << kCollapseRatio
+                  << " of the targets' on some axis: the head is collapsing towards the mean (the paper's "
+                     "\"same-value problem\"); try a larger learning rate, Adam, or more epochs\n";
+      }
+      if (log) {
+        log << r.epoch << ',' << r.lr << ',' << r.train_loss << ',' << r.val_loss;
+        for (double v : r.val_rmse_deg_s) log << ',' << v;
+        for (double v : r.zero_rmse_deg_s) log << ',' << v;
+        for (double v : r.spread_ratio) log << ',' << v;
+        log << ',' << (r.best ? 1 : 0) << ',' << r.seconds << '\n';
+        log.flush();
+      }
+      plot_epochs.push_back(r.epoch);
+      plot_train.push_back(r.train_loss);
+      plot_val.push_back(r.val_loss);
+      if (!o->plot.empty()) {
+        plot_loss_curves(o->plot, plot_epochs, {{"train", plot_train}, {"validation", plot_val}},
+                         "InertialNet head training (MSE, rad^2/s^2)");
+      }
+    };
+    auto on_best = [&](const EpochReport& r) { trainer.save_head(out, metadata(r)); };
+    auto on_last = [&](const EpochReport& r) {
+      trainer.save_head(last_path, metadata(r));
+      trainer.save_state(state_path);
+    };
+
+    std::signal(SIGINT, on_train_interrupt);
+    std::signal(SIGTERM, on_train_interrupt);
+    const bool finished = trainer.train(train_set, val_set, callbacks, on_best, on_last);
+    std::signal(SIGINT, SIG_DFL);
+    std::signal(SIGTERM, SIG_DFL);
+    epoch_bar.reset();
+    if (!finished) {
+      // The interrupted epoch does not count; its partial updates are in the last head.
+      EpochReport r = trainer.last();
+      trainer.save_head(last_path, metadata(r));
+      if (trainer.epochs_done() == 0) trainer.save_head(out, metadata(r));
+      std::cerr << "interrupted: " << last_path << " holds the weights so far; " << state_path
+                << " resumes after epoch " << trainer.epochs_done() << "\n";
+      return 1;
+    }
+    const EpochReport& best = trainer.best();
+    std::printf("best epoch %d: validation RMSE %.3f %.3f %.3f deg/s (zero predictor %.3f %.3f %.3f), spread %.2f %.2f %.2f\n",
+                best.epoch, best.val_rmse_deg_s[0], best.val_rmse_deg_s[1], best.val_rmse_deg_s[2],
+                best.zero_rmse_deg_s[0], best.zero_rmse_deg_s[1], best.zero_rmse_deg_s[2], best.spread_ratio[0],
+                best.spread_ratio[1], best.spread_ratio[2]);
+    std::printf("wrote %s (best), %s (last)\n", out.string().c_str(), last_path.string().c_str());
+    flush_standard_output();
+    return 0;
+  };
+}
+
+}  // namespace inertialnet::cli
