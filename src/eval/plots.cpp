@@ -278,14 +278,14 @@ void plot_loss_curves(const std::filesystem::path& png, const std::vector<double
           hi > lo ? hi * 1.05 : 1.0};
   draw_axes(img, p, "epoch", "loss", "", false);
   const cv::Scalar colours[] = {kTruth, kPredicted, kBar};
-  std::vector<std::pair<std::string, cv::Scalar>> legend;
+  std::vector<LegendItem> legend;
   for (std::size_t k = 0; k < series.size(); ++k) {
     // The polyline helper draws one axis of Vec3 rows in deg/s; undo its scale for a plain series.
     std::vector<Vec3> rows(epochs.size());
     for (std::size_t i = 0; i < epochs.size(); ++i) rows[i][0] = series[k].second[i] / kDegreesPerRadian;
     const cv::Scalar& colour = colours[k % 3];
-    polyline(img, p, epochs, rows, 0, colour);
-    legend.emplace_back(series[k].first, colour);
+    polyline(img, p, epochs, rows, 0, colour, 2);
+    legend.push_back({series[k].first, colour, 2});
   }
   cv::rectangle(img, p.area, kAxisGrey, 1);
   draw_legend(img, p.area, legend);
