@@ -12,6 +12,7 @@ namespace inertialnet::cli {
 struct GlobalOptions {
   std::string device;  // --device SPEC (else $INERTIALNET_DEVICE, else the default device)
   bool no_cache = false;
+  std::string plan;  // --plan clblast|packed|winograd|auto: sets $INERTIALNET_PLAN for the run
 };
 
 using Command = std::function<int()>;
@@ -23,5 +24,6 @@ Command register_predict(CLI::App& app, const GlobalOptions& global);
 Command register_eval(CLI::App& app, const GlobalOptions& global);
 Command register_synth(CLI::App& app, const GlobalOptions& global);
 Command register_bench(CLI::App& app, const GlobalOptions& global);
+Command register_tune(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace inertialnet::cli

@@ -6,6 +6,7 @@
 
 #include "commands.hpp"
 #include "common.hpp"
+#include "inertialnet/ops/gemm_backend.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/runtime/program_cache.hpp"
 
@@ -18,7 +19,9 @@ int main(int argc, char** argv) {
   cli::GlobalOptions global;
   app.add_option("-d,--device", global.device,
                  "device: N, P:D, cpu, gpu, accelerator, a name substring, or all (env INERTIALNET_DEVICE)");
-  app.add_flag("--no-cache", global.no_cache, "do not read or write the on-disk program cache");
+  app.add_flag("--no-cache", global.no_cache, "do not read or write the on-disk caches (programs, GEMM plans, tuning)");
+  app.add_option("--plan", global.plan, "GEMM backend of every layer: clblast, packed, winograd, or auto (timed; env INERTIALNET_PLAN)")
+      ->check(CLI::IsMember({"clblast", "packed", "winograd", "auto"}));
   app.set_version_flag("--version", "inertialnet 0.1.0");
   app.footer("Exit codes: 0 ok, 1 runtime failure, 2 bad usage or bad input.");
 
@@ -35,6 +38,7 @@ int main(int argc, char** argv) {
       {"eval", "the paper's metrics for a rates CSV against a EuRoC sequence", cli::register_eval},
       {"synth", "render a EuRoC-layout sequence from a known camera motion", cli::register_synth},
       {"bench", "pairs per second, stage split and per-layer profile (synthetic weights)", cli::register_bench},
+      {"tune", "measure and store this device's GEMM parameters, applied at every later start", cli::register_tune},
       {"weights", "write synthetic weights, or describe a weight file", cli::register_weights},
   };
   std::map<CLI::App*, cli::Command> commands;
@@ -57,6 +61,7 @@ int main(int argc, char** argv) {
   }
 
   if (global.no_cache) ::setenv(kNoCacheEnvironmentVariable, "1", 1);
+  if (!global.plan.empty()) ::setenv(kPlanEnvironmentVariable, global.plan.c_str(), 1);
   try {
     for (auto& [sub, run] : commands) {
       if (!sub->parsed()) continue;
