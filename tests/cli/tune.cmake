@@ -11,14 +11,6 @@ set(ENV{INERTIALNET_CACHE_DIR} "${WORK}/cache")
 unset(ENV{INERTIALNET_NO_CACHE})
 include(${CMAKE_CURRENT_LIST_DIR}/run_helpers.cmake)
 
-function(expect_json document)  # expect_json(<json> <path>...): sets `value`, fails when absent
-  string(JSON value ERROR_VARIABLE problem GET "${document}" ${ARGN})
-  if(problem)
-    message(FATAL_ERROR "field ${ARGN}: ${problem}")
-  endif()
-  set(value "${value}" PARENT_SCOPE)
-endfunction()
-
 # 1. The quick search and its document.
 execute_process(COMMAND ${CLI} tune --quick --json RESULT_VARIABLE code OUTPUT_VARIABLE doc ERROR_VARIABLE err
                 TIMEOUT 600)
@@ -42,7 +34,6 @@ endforeach()
 foreach(field MR PANELS_FIRST)
   expect_json("${doc}" packed parameters ${field})
 endforeach()
-set(mr "${value}")
 expect_json("${doc}" packed parameters MR)
 set(mr "${value}")
 foreach(field seconds_default seconds_tuned)
