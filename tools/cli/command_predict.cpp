@@ -38,7 +38,7 @@ struct PredictOptions {
   std::string output;
   std::string save_flow;
   double rate_hz = 0;
-  int lanes = 2;
+  int lanes = 0;  // 0: default_lanes_per_device()
   int decode_threads = 2;
   std::size_t max_pairs = 0;
   bool stats = false;
@@ -96,7 +96,8 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
   app.add_option("--save-flow", o->save_flow, "write each pair's flow as <timestamp>.flo into this folder");
   app.add_option("--rate", o->rate_hz, "frame rate for image folders and videos without timestamps (Hz)")
       ->check(finite_positive);
-  app.add_option("--lanes", o->lanes, "frame pairs in flight per device")->capture_default_str()->check(CLI::Range(1, 16));
+  app.add_option("--lanes", o->lanes, "frame pairs in flight per device (default: 1 on CPU devices, 2 on others)")
+      ->check(CLI::Range(1, 16));
   app.add_option("--decode-threads", o->decode_threads, "image decoding threads")->capture_default_str()->check(CLI::Range(1, 64));
   app.add_option("--max-pairs", o->max_pairs, "stop after this many pairs")
       ->check(CLI::Validator(
@@ -247,7 +248,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
     };
 
     PipelineOptions options;
-    options.lanes_per_device = o->lanes;
+    options.lanes_per_device = o->lanes > 0 ? o->lanes : default_lanes_per_device(infos);
     options.decode_threads = o->decode_threads;
     options.max_pairs = o->max_pairs;
     options.cancel = &interrupted;
@@ -275,7 +276,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
         l.seconds /= static_cast<double>(stats.pairs);
         l.layer.flops /= static_cast<double>(stats.pairs);
       }
-      print_profile("per pair, mean over " + std::to_string(stats.pairs) + " pairs and " + std::to_string(o->lanes) +
+      print_profile("per pair, mean over " + std::to_string(stats.pairs) + " pairs and " + std::to_string(options.lanes_per_device) +
                         " lanes in flight per device; the first pairs include compiling",
                     per_pair);
     }
