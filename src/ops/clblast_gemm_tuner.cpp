@@ -41,11 +41,10 @@ double total_seconds(Queue& queue, const std::vector<GemmShape>& shapes, const s
 
 }  // namespace
 
-ClblastGemmTuning tune_clblast_gemm(Queue& queue, const std::vector<GemmShape>& shapes,
-                                    const std::vector<GemmShape>& search_shapes, double fraction, int runs) {
-  ClblastGemmTuning result;
+ClblastGemmStep tune_clblast_gemm_step(Queue& queue, const std::vector<GemmShape>& shapes,
+                                       const GemmShape& search_shape, double fraction, int runs) {
+  ClblastGemmStep result;
   const DeviceInfo& info = queue.device().info();
-  const auto before = detail::current_clblast_parameters(info, result.kernel);
   std::vector<Operands> operands;
   for (const GemmShape& s : shapes) {
     // Zeros: the values do not change CLBlast's time, and nothing is checked here (CLBlast's
@@ -55,40 +54,33 @@ ClblastGemmTuning tune_clblast_gemm(Queue& queue, const std::vector<GemmShape>& 
                         Tensor::empty(queue, {static_cast<std::int64_t>(s.m * s.n)})});
   }
   result.seconds_before = total_seconds(queue, shapes, operands, runs);
-  result.seconds_after = result.seconds_before;
 
-  std::map<std::string, std::size_t> best;
-  std::string failures;
-  for (const GemmShape& s : search_shapes) {
-    // CLBlast's tuner needs m and n multiples of its largest work-group tile (128) and k of its
-    // largest k-step (32): it searches on the shape rounded up; the timing below uses the real ones.
-    const std::size_t m = round_up(s.m, 128), n = round_up(s.n, 128), k = round_up(s.k, 32);
-    const std::string name = "TuneXgemm " + std::to_string(m) + "x" + std::to_string(n) + "x" + std::to_string(k);
-    std::unordered_map<std::string, std::size_t> found;
-    cl_command_queue handle = queue.handle();
-    clblast::StatusCode status = clblast::StatusCode::kSuccess;
-    try {
-      status = clblast::TuneXgemm<float>(&handle, m, n, k, fraction, found);
-    } catch (const std::exception& e) {  // CLBlast 1.5's tuner throws for arguments it refuses
-      failures += (failures.empty() ? "" : "; ") + name + ": " + e.what();
-      continue;
-    }
-    if (status != clblast::StatusCode::kSuccess || found.empty()) {
-      failures += (failures.empty() ? "" : "; ") + name + ": " + clblast_status_name(static_cast<int>(status));
-      continue;
-    }
-    ++result.candidates;
-    const std::map<std::string, std::size_t> candidate(found.begin(), found.end());
-    if (detail::apply_clblast_parameters(info, {{result.kernel, candidate}}).empty()) continue;
-    const double seconds = total_seconds(queue, shapes, operands, runs);
-    if (seconds < result.seconds_after) {
-      result.seconds_after = seconds;
-      best = candidate;
-    }
+  // CLBlast's tuner needs m and n multiples of its largest work-group tile (128) and k of its
+  // largest k-step (32): it searches on the shape rounded up; the timing uses the real ones.
+  const std::size_t m = round_up(search_shape.m, 128), n = round_up(search_shape.n, 128),
+                    k = round_up(search_shape.k, 32);
+  result.search = std::to_string(m) + "x" + std::to_string(n) + "x" + std::to_string(k);
+  std::unordered_map<std::string, std::size_t> found;
+  cl_command_queue handle = queue.handle();
+  clblast::StatusCode status = clblast::StatusCode::kSuccess;
+  try {
+    status = clblast::TuneXgemm<float>(&handle, m, n, k, fraction, found);
+  } catch (const std::exception& e) {  // CLBlast 1.5's tuner throws for arguments it refuses
+    result.status = std::string("TuneXgemm: ") + e.what();
+    return result;
   }
-  detail::apply_clblast_parameters(info, {{result.kernel, best.empty() ? before : best}});
-  result.parameters = best;
-  result.status = !best.empty() ? "improved" : result.candidates > 0 ? "kept" : "failed: " + failures;
+  if (status != clblast::StatusCode::kSuccess || found.empty()) {
+    result.status = std::string("TuneXgemm: ") + clblast_status_name(static_cast<int>(status));
+    return result;
+  }
+  const std::map<std::string, std::size_t> candidate(found.begin(), found.end());
+  if (detail::apply_clblast_parameters(info, {{result.kernel, candidate}}).empty()) {
+    result.status = "CLBlast refused the parameters its tuner returned";
+    return result;
+  }
+  result.parameters = candidate;
+  result.seconds_tuned = total_seconds(queue, shapes, operands, runs);
+  result.status = "ok";
   return result;
 }
 

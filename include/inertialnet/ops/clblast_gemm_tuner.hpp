@@ -1,8 +1,9 @@
-// CLBlast's own tuner on a network's GEMM shapes (`inertialnet tune`): clblast::TuneXgemm (a
-// random search over that fraction of its parameter space) on each of `search_shapes`, then
-// every set it found and the set in use now timed through clblast::Gemm on all of `shapes`; a
-// set is kept only when its total beats the current one. The winner stays applied on the device
-// (clblast::OverrideParameters) for the rest of the process, the previous set otherwise.
+// One step of CLBlast's own tuner on a network's GEMM shapes (`inertialnet tune`):
+// clblast::TuneXgemm (a random search over `fraction` of its parameter space) on `search_shape`,
+// then the set in use now and the set it found timed through clblast::Gemm on all of `shapes`.
+// The found set stays applied on the device (clblast::OverrideParameters) for the rest of the
+// process, which is why `tune` runs each step in a process of its own (a candidate CLBlast
+// returns may fault when PoCL runs it; the caller compares the totals and keeps the winner).
 #pragma once
 
 #include <map>
@@ -14,15 +15,15 @@
 
 namespace inertialnet {
 
-struct ClblastGemmTuning {
+struct ClblastGemmStep {
   std::string kernel = "Xgemm";
-  std::map<std::string, std::size_t> parameters;  // the winner; empty when the current set stays
-  double seconds_before = 0, seconds_after = 0;   // total over `shapes`
-  int candidates = 0;                             // sets CLBlast's search returned
-  std::string status;                             // "improved", "kept", or what failed
+  std::string search;                             // the shape searched on, "MxNxK" (rounded up)
+  std::map<std::string, std::size_t> parameters;  // the set found; empty when the search failed
+  double seconds_before = 0, seconds_tuned = 0;   // totals over `shapes`, set in use / set found
+  std::string status;                             // "ok", or what failed
 };
 
-ClblastGemmTuning tune_clblast_gemm(Queue& queue, const std::vector<GemmShape>& shapes,
-                                    const std::vector<GemmShape>& search_shapes, double fraction, int runs);
+ClblastGemmStep tune_clblast_gemm_step(Queue& queue, const std::vector<GemmShape>& shapes,
+                                       const GemmShape& search_shape, double fraction, int runs);
 
 }  // namespace inertialnet
