@@ -165,7 +165,12 @@ nlohmann::json search_clblast(const GlobalOptions& global, const TuneOptions& o,
     if (outcome.exited && outcome.exit_code == 0) {
       try {
         step = nlohmann::json::parse(outcome.result);
-        if (step.at("status").get<std::string>() != "ok") reason = step["status"].get<std::string>();
+        if (step.at("status").get<std::string>() != "ok") {
+          reason = step["status"].get<std::string>();
+        } else if (!(step.at("seconds_tuned").get<double>() > 0 && step.at("seconds_before").get<double>() > 0) ||
+                   !step.at("parameters").is_object()) {
+          reason = "its process returned no readable result";
+        }
       } catch (const nlohmann::json::exception&) {
         reason = "its process returned no readable result";
       }
