@@ -73,6 +73,7 @@ Tensor FlowNet::intermediate(const std::string& name) const {
 FlowNetMemory FlowNet::memory() const {
   FlowNetMemory m;
   for (const auto& spec : model_parameters(kind_)) m.weight_bytes += static_cast<std::size_t>(spec.numel()) * sizeof(float);
+  m.prepared_weight_bytes = weights_.prepared().packed_bytes();
   if (plan_) {
     m.activation_bytes = plan_->executor->arena_bytes();
     m.unplanned_activation_bytes = static_cast<std::size_t>(plan_->executor->plan().unplanned_floats) * sizeof(float);

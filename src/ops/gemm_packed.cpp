@@ -74,12 +74,19 @@ const std::vector<PackedGemmParameter>& packed_gemm_parameters() {
   return parameters;
 }
 
-int packed_gemm_tile_rows(std::size_t m, int requested) {
+int packed_gemm_setting(const Device& device, const char* name) {
+  const auto& tuned = device.tuning().packed;
+  const auto found = tuned.find(name);
+  if (found != tuned.end() && is_candidate(name, found->second)) return found->second;
+  return parameter_default(name);
+}
+
+int packed_gemm_tile_rows(std::size_t m, int requested, int standard) {
   if (requested > 0) {
     if (!is_candidate("MR", requested)) throw invalid_input("packed GEMM: MR=" + std::to_string(requested) + " is not supported");
     return requested;
   }
-  const int standard = parameter_default("MR");
+  if (standard <= 0) standard = parameter_default("MR");
   // A small m fills one short tile instead of padding to the standard one.
   for (const int mr : {1, 2, 4}) {
     if (m <= static_cast<std::size_t>(mr) && mr < standard) return mr;
@@ -109,7 +116,7 @@ PackedPanels pack_a(Queue& queue, Transpose transpose, std::size_t m, std::size_
   if (m == 0 || k == 0) throw invalid_input("packed GEMM: A is empty (" + std::to_string(m) + "×" + std::to_string(k) + ")");
   const bool t = transpose == Transpose::Yes;
   detail::check_gemm_operand("A", a, t ? k : m, t ? m : k);
-  const int width = packed_gemm_tile_rows(m, tile_rows);
+  const int width = packed_gemm_tile_rows(m, tile_rows, packed_gemm_setting(queue.device(), "MR"));
   // Row i of op(A), element q: A[i][q] = (lda, 1); stored transposed, A[q][i] = (1, lda).
   return pack(queue, m, k, width, a, t ? 1 : a.leading_dimension, t ? a.leading_dimension : 1, long_lived, Tensor());
 }
@@ -153,7 +160,7 @@ PackedPanels im2col_panels(Queue& queue, const Tensor& sample, const Im2colGeome
 }
 
 void gemm_packed(Queue& queue, const PackedPanels& a, const PackedPanels& b, const MatrixView& c,
-                 const GemmEpilogue& epilogue) {
+                 const GemmEpilogue& epilogue, int panels_first) {
   if (a.depth != b.depth) {
     throw invalid_input("packed GEMM: A has depth " + std::to_string(a.depth) + ", B " + std::to_string(b.depth));
   }
@@ -166,7 +173,7 @@ void gemm_packed(Queue& queue, const PackedPanels& a, const PackedPanels& b, con
                         std::to_string(m) + " rows");
   }
   const bool has_beta = epilogue.beta != 0.0f;
-  const int panels_first = parameter_default("PANELS_FIRST");
+  if (panels_first != 0 && panels_first != 1) panels_first = packed_gemm_setting(queue.device(), "PANELS_FIRST");
   Kernel& kernel = queue.kernel("gemm_packed", "gemm_packed",
                                 KernelDefines()
                                     .add("MR", a.width)

@@ -1,26 +1,15 @@
 #include "inertialnet/ops/gemm_plan.hpp"
 
-#include <algorithm>
-#include <chrono>
 #include <vector>
 
 #include "inertialnet/ops/gemm_plan_cache.hpp"
 #include "inertialnet/runtime/device.hpp"
+#include "ops/median_timing.hpp"
 #include "ops/winograd.hpp"
 
 namespace inertialnet {
 
 namespace {
-
-// Seconds of one run of `layer` with `weights`, as the host sees it (the queue drained before
-// and after, so the time is the layer's alone).
-double seconds_of(Queue& queue, const PlannedLayer& layer, const GemmWeights& weights) {
-  queue.finish();
-  const auto start = std::chrono::steady_clock::now();
-  layer.run(weights);
-  queue.finish();
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 // Times every candidate of the device on `layer`, records the choice in `plans`, and returns the
 // fastest candidate's prepared weights. The first candidate is the deterministic choice: a tie
@@ -33,11 +22,7 @@ GemmWeights time_candidates(Queue& queue, const PlannedLayer& layer, Prepare& pr
   bool have_best = false;
   for (const GemmBackend candidate : gemm_candidates(queue.device().info())) {
     GemmWeights weights = prepare(candidate);
-    seconds_of(queue, layer, weights);  // warm-up: builds the kernels, touches the buffers
-    std::vector<double> runs;
-    for (int run = 0; run < kPlanTimedRuns; ++run) runs.push_back(seconds_of(queue, layer, weights));
-    std::nth_element(runs.begin(), runs.begin() + runs.size() / 2, runs.end());
-    const double median = runs[runs.size() / 2];
+    const double median = detail::median_seconds(queue, [&] { layer.run(weights); }, kPlanTimedRuns);
     medians[candidate] = median;
     if (!have_best || median < best_seconds) {
       best = std::move(weights);
@@ -96,8 +81,12 @@ const GemmWeights& PreparedWeights::get(Queue& queue, const std::string& name, P
   if (layer && gemm_plan_timed()) {
     if (!plans_) {
       Device& device = queue.device();
-      plans_ = plan_directory_.empty() ? std::make_unique<GemmPlanCache>(device)
-                                       : std::make_unique<GemmPlanCache>(device.info(), plan_directory_);
+      if (disk_cache_turned_off_by_environment()) {
+        plans_ = std::make_unique<GemmPlanCache>(device.info());  // time, but neither read nor write
+      } else {
+        plans_ = plan_directory_.empty() ? std::make_unique<GemmPlanCache>(device)
+                                         : std::make_unique<GemmPlanCache>(device.info(), plan_directory_);
+      }
     }
     const auto cached = plans_->find(layer->key);
     prepared = cached ? prepare(*cached) : time_candidates(queue, *layer, prepare, *plans_);

@@ -42,10 +42,18 @@ std::filesystem::path GemmPlanCache::file_for(const DeviceInfo& device, const st
 GemmPlanCache::GemmPlanCache(const DeviceInfo& device, const std::filesystem::path& cache_directory)
     : device_(device), file_(file_for(device, cache_directory)), plans_(read()) {}
 
-GemmPlanCache::GemmPlanCache(Device& device) : GemmPlanCache(device.info(), device.programs().directory()) {}
+GemmPlanCache::GemmPlanCache(Device& device) : device_(device.info()) {
+  if (device.programs().disk_cache_enabled() && !disk_cache_turned_off_by_environment()) {
+    file_ = file_for(device_, device.programs().directory());
+    plans_ = read();
+  }
+}
+
+GemmPlanCache::GemmPlanCache(const DeviceInfo& device) : device_(device) {}
 
 std::map<std::string, GemmPlanCache::Entry> GemmPlanCache::read() const {
   std::map<std::string, Entry> plans;
+  if (file_.empty()) return plans;
   std::ifstream in(file_);
   if (!in) return plans;
   // Anything unexpected makes the whole file count as absent: it is rewritten on the next store.
@@ -82,6 +90,7 @@ void GemmPlanCache::store(const std::string& key, GemmBackend chosen, const std:
   // Another process may have added plans since this one read the file: keep them.
   for (auto& [other_key, entry] : read()) plans_.insert({other_key, std::move(entry)});
   plans_[key] = Entry{chosen, seconds};
+  if (file_.empty()) return;
 
   nlohmann::json plans = nlohmann::json::object();
   for (const auto& [plan_key, entry] : plans_) {

@@ -104,6 +104,13 @@ void lane_loop(Schedule& s, Device& device, int lane, const ProcessorFactory& fa
 
 }  // namespace
 
+int default_lanes_per_device(const std::vector<DeviceInfo>& devices) {
+  for (const DeviceInfo& device : devices) {
+    if (device.type != DeviceType::CPU) return 2;
+  }
+  return 1;
+}
+
 PipelineStats run_pipeline(FrameSource& source, const std::vector<Device*>& devices, const ProcessorFactory& factory,
                            const std::function<void(const PairResult&)>& sink, const PipelineOptions& options) {
   if (devices.empty()) throw invalid_input("the pipeline needs at least one device");

@@ -6,6 +6,7 @@
 #include <cctype>
 #include <cstdio>
 #include <cstdlib>
+#include <map>
 #include <mutex>
 #include <set>
 #include <unordered_map>
@@ -51,9 +52,13 @@ std::vector<const ClblastOverride*> clblast_overrides_for(const DeviceInfo& devi
   return matches;
 }
 
-std::string apply_clblast_tuning(const DeviceInfo& device) {
+bool clblast_tuning_disabled() {
   const char* setting = std::getenv(kClblastTuningEnvironmentVariable);
-  if (setting && std::string(setting) == "0") return {};
+  return setting && std::string(setting) == "0";
+}
+
+std::string apply_clblast_tuning(const DeviceInfo& device) {
+  if (clblast_tuning_disabled()) return {};
   const auto matches = clblast_overrides_for(device);
   if (matches.empty() || !device.device_id) return {};
   static std::mutex mutex;
@@ -75,6 +80,45 @@ std::string apply_clblast_tuning(const DeviceInfo& device) {
     }
   }
   return description;
+}
+
+}  // namespace inertialnet::detail
+
+namespace inertialnet::detail {
+
+std::vector<std::string> apply_clblast_parameters(const DeviceInfo& device, const ClblastParameters& parameters) {
+  static std::mutex mutex;
+  static std::map<std::pair<cl_device_id, std::string>, std::map<std::string, std::size_t>> last_applied;
+  std::lock_guard<std::mutex> lock(mutex);
+  std::vector<std::string> accepted;
+  for (const auto& [kernel, values] : parameters) {
+    auto& last = last_applied[{device.device_id, kernel}];
+    if (last == values) {
+      accepted.push_back(kernel);
+      continue;
+    }
+    const std::unordered_map<std::string, std::size_t> map(values.begin(), values.end());
+    const auto status = clblast::OverrideParameters(device.device_id, kernel, clblast::Precision::kSingle, map);
+    if (status != clblast::StatusCode::kSuccess) {
+      std::fprintf(stderr, "inertialnet: warning: CLBlast refused the stored %s parameters for '%s' (%s)\n",
+                   kernel.c_str(), device.name.c_str(), clblast_status_name(static_cast<int>(status)).c_str());
+      last.clear();
+      continue;
+    }
+    last = values;
+    accepted.push_back(kernel);
+  }
+  return accepted;
+}
+
+std::map<std::string, std::size_t> current_clblast_parameters(const DeviceInfo& device, const std::string& kernel) {
+  std::unordered_map<std::string, std::size_t> parameters;
+  const auto status = clblast::RetrieveParameters(device.device_id, kernel, clblast::Precision::kSingle, parameters);
+  if (status != clblast::StatusCode::kSuccess) {
+    throw runtime_error("CLBlast cannot report its " + kernel + " parameters for '" + device.name +
+                        "': " + clblast_status_name(static_cast<int>(status)));
+  }
+  return {parameters.begin(), parameters.end()};
 }
 
 }  // namespace inertialnet::detail

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstddef>
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -35,5 +36,20 @@ std::vector<const ClblastOverride*> clblast_overrides_for(const DeviceInfo& devi
 // Applies them (once per cl_device_id, thread-safe) unless turned off by the environment.
 // Returns a one-line description of what applies ("" when nothing does).
 std::string apply_clblast_tuning(const DeviceInfo& device);
+
+// Whether INERTIALNET_CLBLAST_TUNING=0 turns every override off (the table's and a stored
+// tuning file's).
+bool clblast_tuning_disabled();
+
+// CLBlast parameters per kernel family ("Xgemm" → its full set), as a tuning file stores them.
+using ClblastParameters = std::map<std::string, std::map<std::string, std::size_t>>;
+
+// Overrides `device`'s parameters with `parameters` (thread-safe; a set equal to the one this
+// process applied last is not applied again, since CLBlast recompiles after every override).
+// Returns the kernel families CLBlast accepted; a refused set is reported on stderr and left out.
+std::vector<std::string> apply_clblast_parameters(const DeviceInfo& device, const ClblastParameters& parameters);
+
+// The parameters CLBlast uses for `kernel` on `device` now (its database, or the last override).
+std::map<std::string, std::size_t> current_clblast_parameters(const DeviceInfo& device, const std::string& kernel);
 
 }  // namespace inertialnet::detail

@@ -17,12 +17,15 @@ void CL_CALLBACK report_context_error(const char* message, const void*, std::siz
 }
 
 DiskCacheMode effective_cache_mode(DiskCacheMode requested) {
-  const char* no_cache = std::getenv(kNoCacheEnvironmentVariable);
-  if (no_cache && *no_cache && std::string(no_cache) != "0") return DiskCacheMode::Off;
-  return requested;
+  return disk_cache_turned_off_by_environment() ? DiskCacheMode::Off : requested;
 }
 
 }  // namespace
+
+bool disk_cache_turned_off_by_environment() {
+  const char* no_cache = std::getenv(kNoCacheEnvironmentVariable);
+  return no_cache && *no_cache && std::string(no_cache) != "0";
+}
 
 Device::Device(const DeviceInfo& info, DeviceOptions options) : info_(info) {
   if (!info_.device_id) throw invalid_input("device '" + info_.name + "' has no OpenCL handle (not discovered)");
@@ -39,7 +42,33 @@ Device::Device(const DeviceInfo& info, DeviceOptions options) : info_(info) {
   buffers_ = std::make_unique<BufferPool>(context_.get(), info_.name, info_.max_alloc_bytes);
   profiler_ = options.profiler;
   queue_ = create_queue(options.profiling);
-  gemm_tuning_ = detail::apply_clblast_tuning(info_);
+  table_tuning_ = gemm_tuning_ = detail::apply_clblast_tuning(info_);
+  // The stored tuning lives beside the program cache and follows its switch: --no-cache
+  // neither reads nor writes it.
+  if (programs_->disk_cache_enabled()) {
+    if (auto stored = load_device_tuning(info_, programs_->directory())) set_tuning(std::move(*stored));
+  }
+}
+
+void Device::set_tuning(DeviceTuning tuning) {
+  tuning_ = std::move(tuning);
+  std::string applied;
+  if (!tuning_.clblast.empty() && !detail::clblast_tuning_disabled()) {
+    for (const auto& kernel : detail::apply_clblast_parameters(info_, tuning_.clblast)) {
+      applied += (applied.empty() ? "CLBlast " : ", ") + kernel;
+    }
+  }
+  if (!tuning_.packed.empty()) {
+    applied += std::string(applied.empty() ? "" : "; ") + "packed";
+    for (const auto& [name, value] : tuning_.packed) applied += " " + name + "=" + std::to_string(value);
+  }
+  gemm_tuning_ = table_tuning_;
+  if (applied.empty()) return;
+  const std::string stored =
+      applied + " from `inertialnet tune` (" + device_tuning_file(info_, programs_->directory()).string() + ")";
+  // CLBlast parameters from the file replace the table's; packed ones come on top of them.
+  const bool replaces_table = applied.rfind("CLBlast", 0) == 0;
+  gemm_tuning_ = replaces_table || gemm_tuning_.empty() ? stored : gemm_tuning_ + "; " + stored;
 }
 
 Device::~Device() {

@@ -1,4 +1,4 @@
-# What the CLI scripts share (end_to_end, outputs, bad_inputs): run a command in ${WORK}, check
+# What the CLI scripts share (end_to_end, outputs, bad_inputs, bench_json, tune): run a command in ${WORK}, check
 # its exit code, and match its output.
 
 # run(<expected exit code> <command>...): runs in ${WORK}; sets `output` to stdout + stderr.
@@ -16,4 +16,13 @@ function(expect_match regex)
   if(NOT output MATCHES "${regex}")
     message(FATAL_ERROR "output does not match '${regex}'")
   endif()
+endfunction()
+
+# expect_json(<json> <path>...): sets `value` to the member at <path>; FATAL_ERROR when it is absent.
+function(expect_json document)
+  string(JSON value ERROR_VARIABLE problem GET "${document}" ${ARGN})
+  if(problem)
+    message(FATAL_ERROR "field ${ARGN}: ${problem}")
+  endif()
+  set(value "${value}" PARENT_SCOPE)
 endfunction()

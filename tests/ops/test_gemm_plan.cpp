@@ -15,25 +15,9 @@ namespace inertialnet {
 namespace {
 
 // Sets $INERTIALNET_PLAN for one test and restores it after.
-class ScopedPlan {
+class ScopedPlan : public testing::ScopedEnvironment {
  public:
-  explicit ScopedPlan(const char* plan) {
-    const char* old = std::getenv(kPlanEnvironmentVariable);
-    had_ = old != nullptr;
-    if (had_) old_ = old;
-    setenv(kPlanEnvironmentVariable, plan, 1);
-  }
-  ~ScopedPlan() {
-    if (had_) {
-      setenv(kPlanEnvironmentVariable, old_.c_str(), 1);
-    } else {
-      unsetenv(kPlanEnvironmentVariable);
-    }
-  }
-
- private:
-  bool had_ = false;
-  std::string old_;
+  explicit ScopedPlan(const char* plan) : ScopedEnvironment(kPlanEnvironmentVariable, plan) {}
 };
 
 DeviceInfo fake_device(const std::string& driver) {
@@ -174,6 +158,33 @@ TEST(GemmPlan, ForcedPlansOverrideTheCache) {
   ScopedPlan plan("");
   PreparedWeights prepared(dir);
   EXPECT_EQ(run_planned_conv(prepared, "conv"), gemm_backend(testing::test_device().info(), ""));
+}
+
+// --no-cache ($INERTIALNET_NO_CACHE) covers the timed plans too: a timed layer is timed, but no
+// plans file is read or written.
+TEST(GemmPlan, NoCacheNeitherReadsNorWritesThePlans) {
+  const std::string dir = testing::temporary_directory("plans");
+  ScopedPlan plan("auto");
+  testing::ScopedEnvironment no_cache(kNoCacheEnvironmentVariable, "1");
+  {
+    PreparedWeights prepared(dir);
+    run_planned_conv(prepared, "conv");
+  }
+  EXPECT_FALSE(std::filesystem::exists(GemmPlanCache::file_for(testing::test_device().info(), dir)));
+
+  // A stored plan is not read either: the layer is timed again (the file stays as it was).
+  GemmPlanCache(testing::test_device().info(), dir).store(kKey, GemmBackend::CLBlast, {});
+  const auto file = GemmPlanCache::file_for(testing::test_device().info(), dir);
+  const auto written = std::filesystem::last_write_time(file);
+  {
+    PreparedWeights prepared(dir);
+    run_planned_conv(prepared, "conv");
+  }
+  EXPECT_EQ(std::filesystem::last_write_time(file), written);
+  EXPECT_EQ(*GemmPlanCache(testing::test_device().info(), dir).find(kKey), GemmBackend::CLBlast);
+  // The same through a device's own cache directory.
+  GemmPlanCache in_memory(testing::test_device());
+  EXPECT_TRUE(in_memory.file().empty());
 }
 
 }  // namespace

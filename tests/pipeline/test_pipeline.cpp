@@ -200,5 +200,16 @@ TEST(Pipeline, ABadFrameStopsEveryStageWithItsMessage) {
   EXPECT_LT(emitted, 10u);  // pairs after the bad frame never come out
 }
 
+// One lane per CPU device (the lanes would share its cores); two as soon as a GPU is among them.
+TEST(Pipeline, DefaultLanesAreOneOnCpusOnly) {
+  DeviceInfo cpu, gpu;
+  cpu.type = DeviceType::CPU;
+  gpu.type = DeviceType::GPU;
+  EXPECT_EQ(default_lanes_per_device({cpu}), 1);
+  EXPECT_EQ(default_lanes_per_device({cpu, cpu}), 1);
+  EXPECT_EQ(default_lanes_per_device({gpu}), 2);
+  EXPECT_EQ(default_lanes_per_device({cpu, gpu}), 2);
+}
+
 }  // namespace
 }  // namespace inertialnet

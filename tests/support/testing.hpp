@@ -45,4 +45,18 @@ void expect_invalid_input(const std::function<void()>& call, const std::string& 
 // A fresh, empty directory under the system temp dir, removed at process exit.
 std::string temporary_directory(const std::string& stem);
 
+// Sets an environment variable (nullptr: unsets it) for one scope and restores it after.
+class ScopedEnvironment {
+ public:
+  ScopedEnvironment(const char* name, const char* value);
+  ~ScopedEnvironment();
+  ScopedEnvironment(const ScopedEnvironment&) = delete;
+  ScopedEnvironment& operator=(const ScopedEnvironment&) = delete;
+
+ private:
+  std::string name_;
+  bool had_ = false;
+  std::string old_;
+};
+
 }  // namespace inertialnet::testing

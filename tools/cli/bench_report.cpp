@@ -44,9 +44,11 @@ std::string format_bench_text(const BenchResult& r, bool layers) {
   stage("flow", r.flow);
   stage("head", r.head_seconds);
   stage("download", r.download);
-  out += "\ndevice memory: weights " + megabytes(r.weight_bytes) + " (flow) + " + megabytes(r.head_weight_bytes) +
-         " (head); activations " + megabytes(r.activation_bytes) + " planned (" +
-         megabytes(r.unplanned_activation_bytes) + " with one buffer each)\n\n";
+  out += "\ndevice memory: weights " + megabytes(r.weight_bytes) + " (flow) + " +
+         megabytes(r.prepared_weight_bytes) + " (flow, prepared for the GEMM backend) + " +
+         megabytes(r.head_weight_bytes) + " (head); activations " + megabytes(r.activation_bytes) + " planned (" +
+         megabytes(r.unplanned_activation_bytes) + " with one buffer each); total " + megabytes(r.total_bytes()) + "\n";
+  out += "GEMM tuning: " + (r.gemm_tuning.empty() ? std::string("defaults") : r.gemm_tuning) + "\n\n";
   out += "per layer kind (one profiled pair, device time " + fixed(profiled_seconds(r.layers), 3) + " s):\n";
   out += format_kind_table(group_by_kind(r.layers));
   if (layers) out += "\nper layer:\n" + format_layer_table(r.layers);
@@ -75,9 +77,12 @@ std::string format_bench_json(const std::vector<BenchResult>& results) {
     j["seconds_per_pair"] = r.seconds_per_pair();
     j["stages"] = {{"upload", r.upload}, {"flow", r.flow}, {"head", r.head_seconds}, {"download", r.download}};
     j["memory"] = {{"weight_bytes", r.weight_bytes},
+                   {"prepared_weight_bytes", r.prepared_weight_bytes},
                    {"head_weight_bytes", r.head_weight_bytes},
                    {"activation_bytes", r.activation_bytes},
-                   {"unplanned_activation_bytes", r.unplanned_activation_bytes}};
+                   {"unplanned_activation_bytes", r.unplanned_activation_bytes},
+                   {"total_bytes", r.total_bytes()}};
+    j["gemm_tuning"] = r.gemm_tuning;
     const double total = profiled_seconds(r.layers);
     nlohmann::json kinds = nlohmann::json::array(), layers = nlohmann::json::array();
     for (const auto& k : group_by_kind(r.layers)) {

@@ -14,10 +14,16 @@
 //       "warmup_seconds": number             the first (compiling) pair
 //       "pairs_per_second", "seconds_per_pair": number
 //       "stages": { "upload", "flow", "head", "download": seconds per pair }
-//       "memory": { "weight_bytes", "head_weight_bytes", "activation_bytes",
-//                   "unplanned_activation_bytes": int }   device memory of the flow network
-//                                            (planned arena vs one buffer per activation) and
-//                                            of the head's weights
+//       "memory": { "weight_bytes", "prepared_weight_bytes", "head_weight_bytes",
+//                   "activation_bytes", "unplanned_activation_bytes", "total_bytes": int }
+//                                            device memory of the flow network (its weights, the
+//                                            same again packed for the GEMM backend, the planned
+//                                            arena vs one buffer per activation), of the head's
+//                                            weights, and their sum (weights + prepared + head +
+//                                            planned activations)
+//       "gemm_tuning": string                the CLBlast / packed parameters applied beyond the
+//                                            defaults (the shipped table, `inertialnet tune`'s
+//                                            file); "" for none
 //       "profile": {                         one more pair on a profiling queue, device time
 //         "seconds": number                  the sum over layers
 //         "kinds": [ { "kind", "layers", "seconds", "share", "gflops", "backends": [string] } ]
@@ -41,7 +47,11 @@ struct BenchResult {
   int pairs = 0, warmup_pairs = 1;
   double warmup_seconds = 0;
   double upload = 0, flow = 0, head_seconds = 0, download = 0;  // seconds per pair
-  std::size_t weight_bytes = 0, head_weight_bytes = 0, activation_bytes = 0, unplanned_activation_bytes = 0;
+  std::size_t weight_bytes = 0, prepared_weight_bytes = 0, head_weight_bytes = 0, activation_bytes = 0,
+              unplanned_activation_bytes = 0;
+  std::string gemm_tuning;
+
+  std::size_t total_bytes() const { return weight_bytes + prepared_weight_bytes + head_weight_bytes + activation_bytes; }
   std::vector<LayerTime> layers;  // the profiled pair
 
   double seconds_per_pair() const { return upload + flow + head_seconds + download; }

@@ -117,6 +117,8 @@ BenchResult run_bench(const DeviceInfo& info, const GlobalOptions& global, const
   r.network_width = memory.network_width;
   r.network_height = memory.network_height;
   r.weight_bytes = memory.weight_bytes;
+  r.prepared_weight_bytes = memory.prepared_weight_bytes;
+  r.gemm_tuning = device.gemm_tuning();
   r.activation_bytes = memory.activation_bytes;
   r.unplanned_activation_bytes = memory.unplanned_activation_bytes;
   r.head_weight_bytes = head_weights.bytes();

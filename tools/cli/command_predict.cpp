@@ -40,7 +40,7 @@ struct PredictOptions {
   std::string flow_format = "flo";
   double rate_hz = 0;
   std::string time_offset, readout_time;
-  int lanes = 2;
+  int lanes = 0;  // 0: default_lanes_per_device()
   int decode_threads = 2;
   std::size_t max_pairs = 0;
   bool stats = false;
@@ -110,7 +110,8 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
   app.add_option("--readout-time", o->readout_time,
                  "rolling-shutter readout time in seconds: the geometric head corrects each flow vector's interval, "
                  "and the CSV states it for eval (rates belong to mid-exposure)");
-  app.add_option("--lanes", o->lanes, "frame pairs in flight per device")->capture_default_str()->check(CLI::Range(1, 16));
+  app.add_option("--lanes", o->lanes, "frame pairs in flight per device (default: 1 on CPU devices, 2 on others)")
+      ->check(CLI::Range(1, 16));
   app.add_option("--decode-threads", o->decode_threads, "image decoding threads")->capture_default_str()->check(CLI::Range(1, 64));
   app.add_option("--max-pairs", o->max_pairs, "stop after this many pairs")
       ->check(CLI::Validator(
@@ -199,7 +200,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
     };
 
     PipelineOptions options;
-    options.lanes_per_device = o->lanes;
+    options.lanes_per_device = o->lanes > 0 ? o->lanes : default_lanes_per_device(infos);
     options.decode_threads = o->decode_threads;
     options.max_pairs = o->max_pairs;
     options.cancel = &interrupted;
@@ -227,8 +228,8 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
         l.seconds /= static_cast<double>(stats.pairs);
         l.layer.flops /= static_cast<double>(stats.pairs);
       }
-      print_profile("per pair, mean over " + std::to_string(stats.pairs) + " pairs and " + std::to_string(o->lanes) +
-                        " lanes in flight per device, after a warm-up pair",
+      print_profile("per pair, mean over " + std::to_string(stats.pairs) + " pairs and " +
+                        std::to_string(options.lanes_per_device) + " lanes in flight per device, after a warm-up pair",
                     per_pair);
     }
     if (stats.cancelled) {

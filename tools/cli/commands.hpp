@@ -15,6 +15,7 @@ struct GlobalOptions {
   bool no_cache = false;
   bool quiet = false;    // -q: warnings and errors only, no progress line
   bool verbose = false;  // -v: debug messages too (each kernel program compiled or loaded)
+  std::string plan;  // --plan clblast|packed|winograd|auto: sets $INERTIALNET_PLAN for the run
 };
 
 using Command = std::function<int()>;
@@ -29,5 +30,6 @@ Command register_bench(CLI::App& app, const GlobalOptions& global);
 Command register_calibrate_time(CLI::App& app, const GlobalOptions& global);
 Command register_viz(CLI::App& app, const GlobalOptions& global);
 Command register_train(CLI::App& app, const GlobalOptions& global);
+Command register_tune(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace inertialnet::cli

@@ -10,6 +10,7 @@
 #include "docgen.hpp"
 #include "global_options.hpp"
 #include "help_text.hpp"
+#include "inertialnet/ops/gemm_backend.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/runtime/program_cache.hpp"
 #include "inertialnet/runtime/version.hpp"
@@ -59,6 +60,7 @@ int main(int argc, char** argv) {
       {"viz", "flow files (.flo, KITTI PNG) as colour-wheel pictures", cli::register_viz},
       {"synth", "render a EuRoC-layout sequence from a known camera motion", cli::register_synth},
       {"bench", "pairs per second, stage split and per-layer profile (synthetic weights)", cli::register_bench},
+      {"tune", "measure and store this device's GEMM parameters, applied at every later start", cli::register_tune},
       {"weights", "write synthetic weights, or describe a weight file", cli::register_weights},
       {"train", "train the InertialNet head on sequences with an IMU", cli::register_train},
   };
@@ -102,6 +104,7 @@ int main(int argc, char** argv) {
 
   cli::configure_logging(global);
   if (global.no_cache) ::setenv(kNoCacheEnvironmentVariable, "1", 1);
+  if (!global.plan.empty()) ::setenv(kPlanEnvironmentVariable, global.plan.c_str(), 1);
   try {
     for (auto& [sub, run] : commands) {
       if (!sub->parsed()) continue;

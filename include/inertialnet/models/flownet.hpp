@@ -22,10 +22,17 @@ namespace inertialnet {
 
 struct FlowNetMemory {
   std::size_t weight_bytes = 0;
+  // The weights again in the layout their GEMM backend reads (packed panels, Winograd
+  // transforms; ops/gemm_plan.hpp), made on the first compute() and shared by every network on
+  // the same WeightSet: device memory on top of weight_bytes (≈ 650 MB at FlowNet2 on the
+  // packed plan).
+  std::size_t prepared_weight_bytes = 0;
   std::size_t activation_bytes = 0;  // the planned arena
   std::size_t unplanned_activation_bytes = 0;  // what one buffer per activation would take
   std::int64_t network_height = 0;   // the size the network runs at (multiples of 64)
   std::int64_t network_width = 0;
+
+  std::size_t total_bytes() const { return weight_bytes + prepared_weight_bytes + activation_bytes; }
 };
 
 class FlowNet {

@@ -23,6 +23,8 @@
 
 namespace inertialnet {
 
+class Device;
+
 // Columns per B panel and per tile: two float16 registers.
 inline constexpr std::size_t kPackedColumns = 32;
 
@@ -35,9 +37,14 @@ struct PackedGemmParameter {
 };
 const std::vector<PackedGemmParameter>& packed_gemm_parameters();
 
-// The tile rows for an m-row product: the default MR, or a smaller one that wastes fewer padded
-// rows when m is small (m = 2 → 2, m = 4 → 4); `requested` > 0 forces a candidate.
-int packed_gemm_tile_rows(std::size_t m, int requested = 0);
+// The value of a parameter on `device`: what `inertialnet tune` stored for it
+// (Device::tuning()) when that is one of the candidates, else the default.
+int packed_gemm_setting(const Device& device, const char* name);
+
+// The tile rows for an m-row product: the standard MR (`standard`, 0: the default), or a smaller
+// one that wastes fewer padded rows when m is small (m = 2 → 2, m = 4 → 4); `requested` > 0
+// forces a candidate.
+int packed_gemm_tile_rows(std::size_t m, int requested = 0, int standard = 0);
 
 // A matrix packed into panels of `width` lines (rows of A, or columns of B), depth-major.
 struct PackedPanels {
@@ -53,7 +60,8 @@ struct PackedPanels {
   static std::size_t floats(std::size_t lines, std::size_t depth, int width);
 };
 
-// Packs op(A) (m×k; A stored m×k, or k×m when transposed) into panels of `tile_rows`. With a
+// Packs op(A) (m×k; A stored m×k, or k×m when transposed) into panels of `tile_rows` (0: the
+// device's MR, packed_gemm_tile_rows()). With a
 // Device target the panels are long-lived (a layer's weights, packed once); the work runs on
 // `queue`, and the caller finishes the queue before another queue reads them.
 PackedPanels pack_a(Queue& queue, Transpose transpose, std::size_t m, std::size_t k, const MatrixView& a,
@@ -82,9 +90,10 @@ struct GemmEpilogue {
   ActivationSpec activation{};
 };
 
-// C (m×n view, m = a.lines, n = b.lines) from packed operands of equal depth.
+// C (m×n view, m = a.lines, n = b.lines) from packed operands of equal depth. `panels_first`
+// (0 or 1) forces that build option; −1 takes the device's setting.
 void gemm_packed(Queue& queue, const PackedPanels& a, const PackedPanels& b, const MatrixView& c,
-                 const GemmEpilogue& epilogue = {});
+                 const GemmEpilogue& epilogue = {}, int panels_first = -1);
 
 // y[row] = activation(Σ W[row][q]·x[q] + bias[row]) for `rows` rows of a row-major W: one
 // matrix-vector product, reading W in place (a fully connected layer on one sample).

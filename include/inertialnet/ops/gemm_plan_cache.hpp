@@ -33,8 +33,11 @@ class GemmPlanCache {
  public:
   // The plans file of `device` under `cache_directory` (read now; missing is empty).
   GemmPlanCache(const DeviceInfo& device, const std::filesystem::path& cache_directory);
-  // The same in the directory of the device's program cache.
+  // The same in the directory of the device's program cache; with the disk cache off
+  // (--no-cache, $INERTIALNET_NO_CACHE) it lives in memory only: nothing is read or written.
   explicit GemmPlanCache(Device& device);
+  // Plans kept in memory only.
+  explicit GemmPlanCache(const DeviceInfo& device);
 
   static std::filesystem::path file_for(const DeviceInfo& device, const std::filesystem::path& cache_directory);
   const std::filesystem::path& file() const { return file_; }

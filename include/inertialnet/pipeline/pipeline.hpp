@@ -60,6 +60,13 @@ class PairProcessor {
 // Makes the processor of lane `lane` on `device` (called on the lane's thread).
 using ProcessorFactory = std::function<std::unique_ptr<PairProcessor>(Device& device, int lane)>;
 
+// Pairs in flight per device when the caller chooses none: 1 when every device is a CPU, 2
+// otherwise. On a CPU the lanes share the cores the network already fills, so a second lane only
+// adds contention (2-core Xeon under PoCL: the pipeline at 752×480 reached 90–98 % of the bare
+// network's pairs/s with 1 lane, 82–94 % with 2; docs/performance.md); a GPU overlaps one
+// pair's transfers and host work with another's kernels.
+int default_lanes_per_device(const std::vector<DeviceInfo>& devices);
+
 struct PipelineOptions {
   int lanes_per_device = 2;  // pairs in flight per device
   int decode_threads = 2;

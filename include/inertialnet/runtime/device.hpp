@@ -9,6 +9,7 @@
 #include "inertialnet/runtime/buffer_pool.hpp"
 #include "inertialnet/runtime/cl_handle.hpp"
 #include "inertialnet/runtime/device_info.hpp"
+#include "inertialnet/runtime/device_tuning.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/runtime/program_cache.hpp"
 
@@ -16,6 +17,10 @@ namespace inertialnet {
 
 class LayerProfiler;
 class Queue;
+
+// Whether $INERTIALNET_NO_CACHE (what --no-cache sets) turns every on-disk cache off: programs,
+// timed GEMM plans, the stored tuning.
+bool disk_cache_turned_off_by_environment();
 
 struct DeviceOptions {
   DiskCacheMode program_cache = DiskCacheMode::Auto;  // $INERTIALNET_NO_CACHE forces Off
@@ -42,7 +47,13 @@ class Device {
   ProgramCache& programs() noexcept { return *programs_; }
   // The CLBlast parameter overrides applied to this device ("" for CLBlast's own database);
   // see src/runtime/clblast_tuning.hpp, INERTIALNET_CLBLAST_TUNING=0 turns them off.
+  // With a stored `inertialnet tune` file it says so, and the file's CLBlast parameters win.
   const std::string& gemm_tuning() const noexcept { return gemm_tuning_; }
+  // What the device's tuning file holds (runtime/device_tuning.hpp): empty without one, and
+  // with the disk cache off. The packed GEMM reads its build options here.
+  const DeviceTuning& tuning() const noexcept { return tuning_; }
+  // Replaces it for the rest of this Device's life (what `tune` does once it has measured).
+  void set_tuning(DeviceTuning tuning);
   BufferPool& buffers() noexcept { return *buffers_; }
 
   // The default in-order queue. Use it from one thread at a time.
@@ -57,6 +68,8 @@ class Device {
   std::unique_ptr<BufferPool> buffers_;
   std::unique_ptr<Queue> queue_;
   std::string gemm_tuning_;
+  std::string table_tuning_;  // what the shipped table applied (runtime/clblast_tuning.hpp)
+  DeviceTuning tuning_;
   LayerProfiler* profiler_ = nullptr;
 };
 
