@@ -1,11 +1,14 @@
 // `inertialnet predict SEQ`: angular rates for every frame pair of a sequence, through the
 // pipelined scheduler, as a rates CSV (timestamp_ns,wx,wy,wz; rad/s; stamped with t_k).
+#include <signal.h>
+
 #include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <sstream>
 
 #include "commands.hpp"
 #include "common.hpp"
@@ -26,6 +29,31 @@ namespace {
 
 std::atomic<bool> interrupted{false};
 extern "C" void on_interrupt(int) { interrupted = true; }
+
+// Catches `signal` for the run's length and puts back what was there before. A signal that was
+// ignored when the program started stays ignored: a shell starts background jobs with SIGINT
+// ignored so that the terminal's Ctrl-C does not reach them.
+class InterruptHandler {
+ public:
+  explicit InterruptHandler(int signal) : signal_(signal) {
+    struct sigaction handler {};
+    handler.sa_handler = on_interrupt;
+    sigemptyset(&handler.sa_mask);
+    if (::sigaction(signal_, nullptr, &previous_) == 0 && previous_.sa_handler != SIG_IGN) {
+      installed_ = ::sigaction(signal_, &handler, nullptr) == 0;
+    }
+  }
+  ~InterruptHandler() {
+    if (installed_) ::sigaction(signal_, &previous_, nullptr);
+  }
+  InterruptHandler(const InterruptHandler&) = delete;
+  InterruptHandler& operator=(const InterruptHandler&) = delete;
+
+ private:
+  int signal_;
+  struct sigaction previous_ {};
+  bool installed_ = false;
+};
 
 struct PredictOptions {
   std::string sequence;
@@ -64,22 +92,32 @@ const char* kNoWeightsHelp =
 Command register_predict(CLI::App& app, const GlobalOptions& global) {
   auto o = std::make_shared<PredictOptions>();
   // NaN passes "> 0" tests as false and was then taken for "not given": refuse it where it is read.
-  const CLI::Validator finite_positive(
-      [](std::string& text) {
-        double value = 0;
-        if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || !(value > 0)) {
-          return "must be a finite positive number, got " + text;
-        }
-        return std::string();
-      },
-      "POSITIVE");
+  // The upper bounds are far beyond any camera yet keep later products (fx·dt, 1/rate) finite.
+  const auto finite_positive_up_to = [](double limit, const char* unit) {
+    return CLI::Validator(
+        [limit, unit](std::string& text) {
+          double value = 0;
+          if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || !(value > 0)) {
+            return "must be a finite positive number, got " + text;
+          }
+          if (value > limit) {
+            std::ostringstream s;
+            s << "must be at most " << limit << " " << unit << ", got " << text;
+            return s.str();
+          }
+          return std::string();
+        },
+        "POSITIVE");
+  };
   const CLI::Validator finite(
       [](std::string& text) {
         double value = 0;
         if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value)) return "must be a finite number, got " + text;
+        if (std::abs(value) > 1e6) return "must be at most 1e+06 pixels from the origin, got " + text;
         return std::string();
       },
       "NUMBER");
+  const CLI::Validator focal = finite_positive_up_to(1e6, "pixels");
   app.add_option("sequence", o->sequence, "EuRoC folder, image folder or video")->required();
   app.add_option("-w,--weights", o->weights,
                  "weights (safetensors) holding FlowNet2 and/or the InertialNet head; repeat for several files");
@@ -88,14 +126,14 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
   app.add_option("--head", o->head,
                  "inertialnet (default with weights), geometric (default without), or both");
   app.add_option("--solver", o->solver, "geometric head: motion-field (default) or opengv")->capture_default_str();
-  app.add_option("--fx", o->fx, "focal length x (px), when the sequence has no sensor.yaml")->check(finite_positive);
-  app.add_option("--fy", o->fy, "focal length y (px)")->check(finite_positive);
+  app.add_option("--fx", o->fx, "focal length x (px), when the sequence has no sensor.yaml")->check(focal);
+  app.add_option("--fy", o->fy, "focal length y (px)")->check(focal);
   app.add_option("--cx", o->cx, "principal point x (px)")->check(finite);
   app.add_option("--cy", o->cy, "principal point y (px)")->check(finite);
   app.add_option("-o,--output", o->output, "rates CSV to write (default: standard output)");
   app.add_option("--save-flow", o->save_flow, "write each pair's flow as <timestamp>.flo into this folder");
   app.add_option("--rate", o->rate_hz, "frame rate for image folders and videos without timestamps (Hz)")
-      ->check(finite_positive);
+      ->check(finite_positive_up_to(1e6, "Hz"));
   app.add_option("--lanes", o->lanes, "frame pairs in flight per device")->capture_default_str()->check(CLI::Range(1, 16));
   app.add_option("--decode-threads", o->decode_threads, "image decoding threads")->capture_default_str()->check(CLI::Range(1, 64));
   app.add_option("--max-pairs", o->max_pairs, "stop after this many pairs")
@@ -143,7 +181,13 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
         camera.validate();
         processor.camera = camera;
       } else if (const auto calibration = source->calibration()) {
-        processor.camera = CameraIntrinsics::from_calibration(*calibration);
+        try {
+          processor.camera = CameraIntrinsics::from_calibration(*calibration);
+        } catch (const Error& e) {
+          // The library's message names the model or the coefficients; say which file holds them.
+          if (e.kind() != ErrorKind::InvalidInput) throw;
+          throw invalid_input(source->description() + ": cam0/sensor.yaml: " + e.what());
+        }
         // The geometric head allocates per pixel of the calibrated size: compare it with the
         // images before, so that a wrong resolution is a clear message, not gigabytes asked for.
         const HostImage first = source->decode(0);
@@ -251,11 +295,10 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
     options.decode_threads = o->decode_threads;
     options.max_pairs = o->max_pairs;
     options.cancel = &interrupted;
-    std::signal(SIGINT, on_interrupt);
-    std::signal(SIGTERM, on_interrupt);
-    const PipelineStats stats = run_pipeline(*source, device_list, factory, sink, options);
-    std::signal(SIGINT, SIG_DFL);
-    std::signal(SIGTERM, SIG_DFL);
+    const PipelineStats stats = [&] {
+      const InterruptHandler on_sigint(SIGINT), on_sigterm(SIGTERM);
+      return run_pipeline(*source, device_list, factory, sink, options);
+    }();
 
     if (o->stats) {
       std::cerr << "pairs: " << stats.pairs << " in " << stats.seconds << " s = " << stats.pairs_per_second()
@@ -279,6 +322,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
                         " lanes in flight per device; the first pairs include compiling",
                     per_pair);
     }
+    if (file_writer) file_writer->close();  // a failed write or rename is exit 1, not a silent loss
     if (stats.cancelled) {
       std::cerr << "inertialnet: interrupted after " << stats.pairs << " of " << pairs
                 << " pairs; the rates written so far are complete rows\n";
