@@ -17,3 +17,20 @@ function(expect_match regex)
     message(FATAL_ERROR "output does not match '${regex}'")
   endif()
 endfunction()
+
+function(expect_no_match regex)
+  if(output MATCHES "${regex}")
+    message(FATAL_ERROR "output matches '${regex}', which it should not")
+  endif()
+endfunction()
+
+# running_as_root(<var>): TRUE when the tests run as root (device nodes and other users'
+# folders can then be made in the scratch folder; without root those cases are skipped).
+function(running_as_root var)
+  execute_process(COMMAND id -u OUTPUT_VARIABLE uid OUTPUT_STRIP_TRAILING_WHITESPACE)
+  if(uid STREQUAL "0")
+    set(${var} TRUE PARENT_SCOPE)
+  else()
+    set(${var} FALSE PARENT_SCOPE)
+  endif()
+endfunction()
