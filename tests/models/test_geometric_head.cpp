@@ -100,7 +100,8 @@ TEST(NormalizedCoordinateMap, IsThePinholeInverseWithoutDistortion) {
   }
 }
 
-TEST(CameraIntrinsics, FromEurocCalibration) {
+// EuRoC cam0's calibration as its sensor.yaml gives it.
+CameraCalibration euroc_calibration() {
   CameraCalibration c;
   c.width = 752;
   c.height = 480;
@@ -108,6 +109,11 @@ TEST(CameraIntrinsics, FromEurocCalibration) {
   c.intrinsics = {458.654, 457.296, 367.215, 248.375};
   c.distortion_model = "radial-tangential";
   c.distortion = {-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05};
+  return c;
+}
+
+TEST(CameraIntrinsics, FromEurocCalibration) {
+  CameraCalibration c = euroc_calibration();
   const CameraIntrinsics k = CameraIntrinsics::from_calibration(c);
   EXPECT_EQ(k.distortion, LensDistortion::RadialTangential);
   EXPECT_EQ(k.width, 752);
@@ -133,12 +139,7 @@ TEST(CameraIntrinsics, FromEurocCalibration) {
 // A lens model that OpenCV's fixed-point undistortion cannot invert used to give the k1 = 0 answer
 // silently; it is refused naming the coefficients.
 TEST(CameraIntrinsics, RefusesALensModelThatDoesNotInvert) {
-  CameraCalibration c;
-  c.width = 752;
-  c.height = 480;
-  c.camera_model = "pinhole";
-  c.intrinsics = {458.654, 457.296, 367.215, 248.375};
-  c.distortion_model = "radial-tangential";
+  CameraCalibration c = euroc_calibration();
   c.distortion = {1e6, 0, 0, 0};
   testing::expect_invalid_input([&] { CameraIntrinsics::from_calibration(c); },
                                 "radial-tangential distortion coefficients [1e+06, 0, 0, 0] do not invert over the "
