@@ -88,6 +88,11 @@ cv::FileStorage open_yaml(const fs::path& path) {
     // OpenCV 4 puts the parser's message in `func` and the parser function's name in `err`.
     throw invalid_input("Calibration file " + path.string() + " is not valid YAML (OpenCV: " +
                         e.err + " " + e.func + ").");
+  } catch (const std::exception& e) {
+    // The parser also lets standard exceptions through: a mangled key made it ask std::string
+    // for an impossible length (found by fuzzing, tests/fuzz/regressions/sensor_yaml/).
+    throw invalid_input("Calibration file " + path.string() + " is not valid YAML (OpenCV's parser failed: " +
+                        e.what() + ").");
   }
   if (!storage.isOpened()) throw invalid_input("Calibration file " + path.string() + " is not valid YAML.");
   return storage;
