@@ -95,6 +95,11 @@ cv::FileStorage open_yaml(const fs::path& path) {
                         e.what() + ").");
   }
   if (!storage.isOpened()) throw invalid_input("Calibration file " + path.string() + " is not valid YAML.");
+  // Keys are looked up with operator[], which asserts (cv::Exception) on anything but a mapping
+  // (found by fuzzing, tests/fuzz/regressions/sensor_yaml/root_not_a_map.yaml).
+  if (!storage.root().isMap()) {
+    throw invalid_input("Calibration file " + path.string() + " is not a YAML mapping of keys (T_BS, intrinsics, …).");
+  }
   return storage;
 }
 
