@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# CI's sanitizer pass: a second build (build-asan/, clang) with AddressSanitizer, LeakSanitizer
+# The sanitizer pass, meant for CI (not yet in .ci/run; see docs/architecture.md): a second build (build-asan/, clang) with AddressSanitizer, LeakSanitizer
 # and UBSan on the project's own targets (INERTIALNET_SANITIZE; not CMAKE_CXX_FLAGS), running the
 # unit and OpenCL suites and replaying the fuzz corpora, then each libFuzzer target for
 # FUZZ_SECONDS (default 30) through tools/fuzz.sh.
