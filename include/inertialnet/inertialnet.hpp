@@ -9,6 +9,7 @@
 
 // runtime
 #include "inertialnet/runtime/buffer_pool.hpp"
+#include "inertialnet/runtime/cache_directory.hpp"
 #include "inertialnet/runtime/cl_handle.hpp"
 #include "inertialnet/runtime/device.hpp"
 #include "inertialnet/runtime/device_info.hpp"

@@ -200,6 +200,17 @@ EvalReport evaluate(const RatesTable& rates, const EurocSequence& seq, const Eva
                          "ground truth (outside the IMU's span, or frame 0 for the mean target) and "
                          "were ignored.");
   }
+  // A few rows at the ends without ground truth are normal (an IMU that starts a frame late);
+  // metrics over a minority of the rows would describe another run than the one asked about.
+  if (!r.t_ns.empty() && r.rows_without_truth > r.t_ns.size()) {
+    throw invalid_input("The IMU of " + seq.name + " (t = " + std::to_string(seq.imu.front().t_ns) + " to " +
+                        std::to_string(seq.imu.back().t_ns) + " ns) covers only " + std::to_string(r.t_ns.size()) +
+                        " of the " + std::to_string(r.t_ns.size() + r.rows_without_truth) +
+                        " rates rows that fall on camera frames (rates run from " + std::to_string(rates.t_ns.front()) +
+                        " to " + std::to_string(rates.t_ns.back()) +
+                        " ns): refusing to report metrics over a minority of the rows; the spline does not "
+                        "extrapolate.");
+  }
   if (r.t_ns.empty()) {
     throw invalid_input("None of the " + std::to_string(r.rate_rows) + " rows of the rates file "
                         "matches a camera frame of " + seq.name + " that has ground truth (rates run from " +

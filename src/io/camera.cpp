@@ -36,6 +36,7 @@ CameraIntrinsics CameraIntrinsics::from_calibration(const CameraCalibration& c) 
   }
   k.coefficients = c.distortion;
   k.validate();
+  k.check_invertible();
   return k;
 }
 
@@ -106,7 +107,88 @@ std::vector<cv::Point2d> undistort(const CameraIntrinsics& k, const std::vector<
   return out;
 }
 
+// Pixel positions of `normalized` undistorted normalised coordinates: the forward lens model.
+std::vector<cv::Point2d> distort(const CameraIntrinsics& k, const std::vector<cv::Point2d>& normalized) {
+  const cv::Matx33d K(k.fx, 0, k.cx, 0, k.fy, k.cy, 0, 0, 1);
+  const cv::Mat D(k.coefficients, true);
+  std::vector<cv::Point2d> out;
+  if (k.distortion == LensDistortion::Equidistant) {
+    cv::fisheye::distortPoints(normalized, out, K, D);
+  } else {
+    std::vector<cv::Point3d> rays;
+    rays.reserve(normalized.size());
+    for (const auto& p : normalized) rays.emplace_back(p.x, p.y, 1.0);
+    cv::projectPoints(rays, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), K, D, out);
+  }
+  return out;
+}
+
+// The slope of the radial model's distorted radius (radial-tangential: r·(1 + k1 r² + k2 r⁴ + k3 r⁶)
+// over the undistorted radius r; equidistant: θ·(1 + k1 θ² + … + k4 θ⁸) over the angle θ = atan r).
+double radial_slope(const CameraIntrinsics& k, double r) {
+  const auto& c = k.coefficients;
+  if (k.distortion == LensDistortion::Equidistant) {
+    const double t2 = std::atan(r) * std::atan(r);
+    return 1 + t2 * (3 * c[0] + t2 * (5 * c[1] + t2 * (7 * c[2] + t2 * 9 * c[3])));
+  }
+  const double k3 = c.size() > 4 ? c[4] : 0.0;
+  const double r2 = r * r;
+  return 1 + r2 * (3 * c[0] + r2 * (5 * c[1] + r2 * 7 * k3));
+}
+
+std::string coefficient_list(const CameraIntrinsics& k) {
+  std::ostringstream s;
+  s << (k.distortion == LensDistortion::Equidistant ? "equidistant" : "radial-tangential")
+    << " distortion coefficients [";
+  for (std::size_t i = 0; i < k.coefficients.size(); ++i) s << (i ? ", " : "") << k.coefficients[i];
+  s << "]";
+  return s.str();
+}
+
 }  // namespace
+
+void CameraIntrinsics::check_invertible() const {
+  if (distortion == LensDistortion::None) return;
+  // A grid of the image's pixel positions, corners and edges included: enough to see a model
+  // that folds over, and independent of the resolution (which may still be wrong at this point).
+  constexpr int kSteps = 32;
+  std::vector<cv::Point2d> pixels;
+  pixels.reserve((kSteps + 1) * (kSteps + 1));
+  for (int j = 0; j <= kSteps; ++j)
+    for (int i = 0; i <= kSteps; ++i)
+      pixels.emplace_back((width - 1) * static_cast<double>(i) / kSteps, (height - 1) * static_cast<double>(j) / kSteps);
+  const auto normalized = undistort(*this, pixels);
+  const auto back = distort(*this, normalized);
+  // Undistortion is OpenCV's fixed-point iteration: where the model is not invertible it
+  // oscillates or settles anywhere, and only distorting its answer again shows it.
+  constexpr double kTolerancePx = 0.01;
+  double r_max = 0;
+  for (std::size_t i = 0; i < pixels.size(); ++i) {
+    const double error = std::hypot(back[i].x - pixels[i].x, back[i].y - pixels[i].y);
+    if (!(error <= kTolerancePx)) {
+      std::ostringstream s;
+      s << "the " << coefficient_list(*this) << " do not invert over the " << width << "x" << height
+        << " image: pixel (" << pixels[i].x << ", " << pixels[i].y << ") undistorts to (" << normalized[i].x << ", "
+        << normalized[i].y << "), which distorts back to (" << back[i].x << ", " << back[i].y
+        << "); check the coefficients";
+      throw invalid_input(s.str());
+    }
+    r_max = std::max(r_max, std::hypot(normalized[i].x, normalized[i].y));
+  }
+  // A radial model that turns back inside the image maps two radii onto one pixel: the
+  // undistortion found one of them, silently.
+  constexpr int kRadii = 1000;
+  for (int i = 1; i <= kRadii; ++i) {
+    const double r = r_max * i / kRadii;
+    if (!(radial_slope(*this, r) > 0)) {
+      std::ostringstream s;
+      s << "the " << coefficient_list(*this) << " do not invert over the " << width << "x" << height
+        << " image: the radial model turns back at the undistorted radius " << r << " (the image reaches " << r_max
+        << "); check the coefficients";
+      throw invalid_input(s.str());
+    }
+  }
+}
 
 std::array<double, 2> CameraIntrinsics::normalize(double u, double v) const {
   const auto p = undistort(*this, {cv::Point2d(u, v)});

@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <sstream>
 
 #include "inertialnet/runtime/error.hpp"
 
@@ -95,6 +96,18 @@ double parse_double(std::string_view field, const std::filesystem::path& file, s
   if (!std::isfinite(value)) {
     throw invalid_input(file.string() + " line " + std::to_string(line) + ": " + column +
                         " is " + quoted(field) + ", expected a finite number.");
+  }
+  return value;
+}
+
+double parse_bounded(std::string_view field, const std::filesystem::path& file, std::size_t line,
+                     const std::string& column, double limit, const std::string& unit) {
+  const double value = parse_double(field, file, line, column);
+  if (std::fabs(value) > limit) {
+    std::ostringstream bound;
+    bound << limit;
+    throw invalid_input(file.string() + " line " + std::to_string(line) + ": " + column + " is " + quoted(field) +
+                        ", beyond ±" + bound.str() + " " + unit + ".");
   }
   return value;
 }

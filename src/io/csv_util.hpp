@@ -42,6 +42,11 @@ std::int64_t parse_int64(std::string_view field, const std::filesystem::path& fi
                          std::size_t line, const std::string& column);
 double parse_double(std::string_view field, const std::filesystem::path& file, std::size_t line,
                     const std::string& column);
+// parse_double(), then invalid_input "<file> line <n>: <column> is <field>, beyond ±<limit> <unit>"
+// unless |value| ≤ limit: a value that no sensor produces, and whose squares and sums would
+// overflow further on (a gyro of 1e308 rad/s once ended as "Histogram: value 0 is not finite").
+double parse_bounded(std::string_view field, const std::filesystem::path& file, std::size_t line,
+                     const std::string& column, double limit, const std::string& unit);
 bool looks_numeric(std::string_view field);
 
 // Checks that timestamps strictly increase (throws invalid_input naming both rows otherwise) and

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <system_error>
 
 #include <opencv2/core.hpp>
 
@@ -87,8 +88,18 @@ cv::FileStorage open_yaml(const fs::path& path) {
     // OpenCV 4 puts the parser's message in `func` and the parser function's name in `err`.
     throw invalid_input("Calibration file " + path.string() + " is not valid YAML (OpenCV: " +
                         e.err + " " + e.func + ").");
+  } catch (const std::exception& e) {
+    // The parser also lets standard exceptions through: a mangled key made it ask std::string
+    // for an impossible length (found by fuzzing, tests/fuzz/regressions/sensor_yaml/).
+    throw invalid_input("Calibration file " + path.string() + " is not valid YAML (OpenCV's parser failed: " +
+                        e.what() + ").");
   }
   if (!storage.isOpened()) throw invalid_input("Calibration file " + path.string() + " is not valid YAML.");
+  // Keys are looked up with operator[], which asserts (cv::Exception) on anything but a mapping
+  // (found by fuzzing, tests/fuzz/regressions/sensor_yaml/root_not_a_map.yaml).
+  if (!storage.root().isMap()) {
+    throw invalid_input("Calibration file " + path.string() + " is not a YAML mapping of keys (T_BS, intrinsics, …).");
+  }
   return storage;
 }
 
@@ -220,7 +231,15 @@ std::vector<CameraFrame> read_camera_csv(const fs::path& csv, const fs::path& im
     std::size_t missing = 0;
     std::size_t first = 0;
     for (std::size_t i = 0; i < frames.size(); ++i) {
-      if (!fs::is_regular_file(frames[i].path)) {
+      // The error_code form: a symbolic-link loop or an unreadable folder is a message, not a
+      // raw filesystem_error.
+      std::error_code error;
+      const fs::file_status status = fs::status(frames[i].path, error);
+      if (error && error != std::errc::no_such_file_or_directory) {
+        throw invalid_input(csv.string() + " line " + std::to_string(rows[i].line) + ": the image " +
+                            frames[i].path.string() + " cannot be accessed: " + error.message() + ".");
+      }
+      if (!fs::is_regular_file(status)) {
         if (missing++ == 0) first = i;
       }
     }
@@ -292,8 +311,9 @@ std::vector<ImuSample> read_imu_csv(const fs::path& csv, std::vector<std::string
     const auto& r = rows[i];
     imu[i].t_ns = t[i] = csv::parse_int64(r.fields[0], csv, r.line, names[0]);
     for (int k = 0; k < 3; ++k) {
-      imu[i].gyro[k] = csv::parse_double(r.fields[1 + k], csv, r.line, names[1 + k]);
-      imu[i].accel[k] = csv::parse_double(r.fields[4 + k], csv, r.line, names[4 + k]);
+      // Far beyond any IMU's range (EuRoC's saturates near 5 rad/s and 160 m/s²).
+      imu[i].gyro[k] = csv::parse_bounded(r.fields[1 + k], csv, r.line, names[1 + k], 1e3, "rad/s");
+      imu[i].accel[k] = csv::parse_bounded(r.fields[4 + k], csv, r.line, names[4 + k], 1e5, "m/s^2");
     }
   }
   check_order(csv, rows, t, warnings);
@@ -362,9 +382,14 @@ ImageFolder list_image_folder(const fs::path& dir, std::optional<double> rate_hz
   }
   std::vector<std::string> names;
   for (const auto& entry : fs::directory_iterator(dir)) {
-    if (entry.is_regular_file() && is_image_extension(entry.path())) {
-      names.push_back(entry.path().filename().string());
+    if (!is_image_extension(entry.path())) continue;
+    std::error_code error;
+    const bool regular = entry.is_regular_file(error);
+    if (error && error != std::errc::no_such_file_or_directory) {
+      throw invalid_input("Image folder " + dir.string() + ": " + entry.path().filename().string() +
+                          " cannot be accessed: " + error.message() + ".");
     }
+    if (regular) names.push_back(entry.path().filename().string());
   }
   if (names.empty()) throw invalid_input("Image folder " + dir.string() + " holds no .png or .jpg images.");
   std::sort(names.begin(), names.end(), natural_less);

@@ -1,13 +1,20 @@
 #include "inertialnet/io/rates_csv.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <set>
+#include <utility>
 
 #include "inertialnet/runtime/error.hpp"
 #include "io/csv_util.hpp"
+#include "runtime/atomic_file.hpp"
 
 namespace fs = std::filesystem;
 
@@ -171,7 +178,7 @@ RatesTable read_rates_csv(const fs::path& path) {
     }
     table.t_ns.push_back(csv::parse_int64(fields[0], path, ln, "timestamp_ns"));
     Vec3 w;
-    for (int k = 0; k < 3; ++k) w[k] = csv::parse_double(fields[axis_at[k]], path, ln, kAxes[k]);
+    for (int k = 0; k < 3; ++k) w[k] = csv::parse_bounded(fields[axis_at[k]], path, ln, kAxes[k], 1e3, "rad/s");
     table.w.push_back(w);
     for (std::size_t c = 0; c < extra_at.size(); ++c) {
       table.extra[c].push_back(csv::parse_double(fields[extra_at[c]], path, ln, table.extra_names[c]));
@@ -184,8 +191,43 @@ RatesTable read_rates_csv(const fs::path& path) {
   return table;
 }
 
+// A regular file (or a new one) is written through the atomic writer: the rows go to a
+// temporary beside it, which replaces the file when the writer closes, so the final name never
+// holds a torn row and never replaces what is not a regular file. A FIFO or a character device
+// that the user named (`-o /dev/stdout`, a pipe) is what they asked to stream to: written in
+// place.
 struct RatesCsvWriter::Stream {
-  std::ofstream file;
+  std::unique_ptr<AtomicFile> atomic;
+  int fd = -1;
+  fs::path path;
+
+  void write(const std::string& text) {
+    if (atomic) {
+      atomic->write(text.data(), text.size());
+      return;
+    }
+    const char* p = text.data();
+    std::size_t left = text.size();
+    while (left > 0) {
+      const ssize_t n = ::write(fd, p, left);
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0) throw runtime_error("Writing " + path.string() + " failed: " + std::strerror(errno) + ".");
+      p += n;
+      left -= static_cast<std::size_t>(n);
+    }
+  }
+  void close() {
+    if (atomic) {
+      atomic->commit();
+      atomic.reset();
+    } else if (fd >= 0) {
+      const int closing = std::exchange(fd, -1);
+      if (::close(closing) != 0) throw runtime_error("Closing " + path.string() + " failed: " + std::strerror(errno) + ".");
+    }
+  }
+  ~Stream() {
+    if (fd >= 0) ::close(fd);
+  }
 };
 
 std::string rates_csv_header(const std::vector<std::string>& extra_names,
@@ -205,15 +247,35 @@ std::string rates_csv_header(const std::vector<std::string>& extra_names,
 RatesCsvWriter::RatesCsvWriter(const fs::path& path, const std::vector<std::string>& extra_names,
                                const std::vector<std::pair<std::string, std::string>>& metadata)
     : path_(path), extra_count_(extra_names.size()), out_(std::make_unique<Stream>()) {
-  const std::string header = rates_csv_header(extra_names, metadata);
-  out_->file.open(path, std::ios::binary | std::ios::trunc);
-  if (!out_->file) {
-    throw invalid_input("Cannot open " + path.string() + " for writing.");
+  out_->path = path;
+  std::error_code error;
+  const fs::file_status status = fs::status(path, error);
+  if (!error && (fs::is_fifo(status) || fs::is_character_file(status))) {
+    out_->fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+    if (out_->fd < 0) throw invalid_input("Cannot open " + path.string() + " for writing: " + std::strerror(errno) + ".");
+  } else {
+    try {
+      out_->atomic = std::make_unique<AtomicFile>(path);
+    } catch (const Error& e) {
+      if (e.kind() != ErrorKind::InvalidInput) throw;
+      throw invalid_input("Cannot open " + path.string() + " for writing: " + e.what());
+    }
   }
-  out_->file << header << std::flush;
+  out_->write(rates_csv_header(extra_names, metadata));
 }
 
-RatesCsvWriter::~RatesCsvWriter() = default;
+RatesCsvWriter::~RatesCsvWriter() {
+  // Not closed (an error or an interruption unwound past the writer): the rows so far still
+  // make a valid file, as the class promises; a failure here has no one left to tell.
+  try {
+    close();
+  } catch (const Error&) {
+  }
+}
+
+void RatesCsvWriter::close() {
+  if (out_) out_->close();
+}
 
 void RatesCsvWriter::write(std::int64_t t_ns, const Vec3& w, const std::vector<double>& extra) {
   if (extra.size() != extra_count_) {
@@ -232,17 +294,16 @@ void RatesCsvWriter::write(std::int64_t t_ns, const Vec3& w, const std::vector<d
                         ".");
   }
   char buf[48];
-  out_->file << t_ns;
+  std::string row = std::to_string(t_ns);
   for (int k = 0; k < 3; ++k) {
     std::snprintf(buf, sizeof buf, ",%.9g", w[k]);
-    out_->file << buf;
+    row += buf;
   }
   for (const double v : extra) {
     std::snprintf(buf, sizeof buf, ",%.9g", v);
-    out_->file << buf;
+    row += buf;
   }
-  out_->file << '\n' << std::flush;
-  if (!out_->file) throw runtime_error("Writing " + path_.string() + " failed (disk full?).");
+  out_->write(row + "\n");  // one write per row: a reader of a stream sees whole rows
   ++rows_;
   last_t_ns_ = t_ns;
 }
@@ -255,6 +316,7 @@ void write_rates_csv(const fs::path& path, const RatesTable& table) {
     for (std::size_t c = 0; c < extra.size(); ++c) extra[c] = table.extra[c][i];
     writer.write(table.t_ns[i], table.w[i], extra);
   }
+  writer.close();
 }
 
 }  // namespace inertialnet

@@ -101,7 +101,13 @@ void GeometricHead::check_flow(const Tensor& flow) const {
   flow.offset_int();
 }
 
-RotationEstimate GeometricHead::estimate(Queue& queue, const Tensor& flow, double dt) {
+RotationEstimate GeometricHead::estimate(Queue& queue, const Tensor& flow, double dt, const std::atomic<bool>* stop) {
+  // Checked before every pass over the flow, so that the translation search (tens of passes on
+  // the general model) stops soon after the flag is set.
+  const auto check_stop = [stop](const char* where) {
+    if (stop && stop->load()) throw runtime_error(std::string("cancelled in the geometric head (") + where + ")");
+  };
+  check_stop("before the first pass");
   check_flow(flow);
   if (!(dt > 0) || !std::isfinite(dt)) {
     throw invalid_input("geometric head: the frame interval dt must be a positive number of seconds, got " + std::to_string(dt));
@@ -112,8 +118,12 @@ RotationEstimate GeometricHead::estimate(Queue& queue, const Tensor& flow, doubl
       return detail::solve_opengv(motion_field_correspondences(queue, f, map_, options_.stride), dt,
                                   camera_.mean_focal(), options_);
     }
-    return detail::solve_motion_field([&](const MotionFieldParams& p) { return motion_field_moments(queue, f, map_, p); },
-                                      dt, camera_.mean_focal(), options_);
+    return detail::solve_motion_field(
+        [&](const MotionFieldParams& p) {
+          check_stop(p.mode == MotionFieldMode::General ? "translation refinement" : "rotation passes");
+          return motion_field_moments(queue, f, map_, p);
+        },
+        dt, camera_.mean_focal(), options_);
   };
   if (options_.readout_time_s <= 0) return solve(flow);
   // Rolling shutter: each vector spans its own interval (GeometricHeadOptions::readout_time_s).

@@ -74,7 +74,13 @@ Prediction::Prediction(const PredictSettings& s) : settings_(s) {
       camera.validate();
       processor_.camera = camera;
     } else if (const auto calibration = source_->calibration()) {
-      processor_.camera = CameraIntrinsics::from_calibration(*calibration);
+      try {
+        processor_.camera = CameraIntrinsics::from_calibration(*calibration);
+      } catch (const Error& e) {
+        // The library's message names the model or the coefficients; say which file holds them.
+        if (e.kind() != ErrorKind::InvalidInput) throw;
+        throw invalid_input(source_->description() + ": cam0/sensor.yaml: " + e.what());
+      }
       // The geometric head allocates per pixel of the calibrated size: compare it with the
       // images before, so that a wrong resolution is a clear message, not gigabytes asked for.
       const HostImage first = source_->decode(0);

@@ -61,7 +61,7 @@ class RatesProcessor : public PairProcessor {
                             "a signed 64-bit count of nanoseconds.");
       }
       const double dt = static_cast<double>(dt_ns) * 1e-9;
-      const RotationEstimate estimate = geometric_->estimate(q, flow, dt);
+      const RotationEstimate estimate = geometric_->estimate(q, flow, dt, &stop);
       const Vec3 w = to_body(options_.camera_to_body, estimate.omega);
       result.rates.push_back({"geometric", {w[0], w[1], w[2]}});
       t = lap(result, "geometric_head", t);

@@ -8,6 +8,9 @@
 #include <fstream>
 #include <sstream>
 
+#include <unistd.h>
+
+#include "inertialnet/runtime/cache_directory.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/runtime/log.hpp"
 #include "runtime/atomic_file.hpp"
@@ -60,7 +63,10 @@ std::filesystem::path default_cache_directory() {
   if (env_set(kCacheDirEnvironmentVariable)) return std::getenv(kCacheDirEnvironmentVariable);
   if (env_set("XDG_CACHE_HOME")) return std::filesystem::path(std::getenv("XDG_CACHE_HOME")) / "inertialnet";
   if (env_set("HOME")) return std::filesystem::path(std::getenv("HOME")) / ".cache" / "inertialnet";
-  return std::filesystem::temp_directory_path() / "inertialnet-cache";
+  // No home: a per-user folder, never one shared name that another user could create first.
+  // The runtime directory is the user's own (0700, by the XDG specification).
+  if (env_set("XDG_RUNTIME_DIR")) return std::filesystem::path(std::getenv("XDG_RUNTIME_DIR")) / "inertialnet-cache";
+  return std::filesystem::temp_directory_path() / ("inertialnet-cache-" + std::to_string(::geteuid()));
 }
 
 std::vector<std::string> embedded_kernel_families() {
@@ -79,7 +85,13 @@ std::string_view embedded_kernel_source(std::string_view family) {
 ProgramCache::ProgramCache(const DeviceInfo& device, cl_context context, DiskCacheMode mode,
                            std::filesystem::path directory)
     : device_(device), context_(context), disk_enabled_(decide_disk_cache(mode)),
-      directory_(std::move(directory)) {}
+      directory_(std::move(directory)) {
+  if (!disk_enabled_) return;
+  // Binaries are loaded only from a folder of this user's (refused otherwise); one that cannot
+  // be created leaves the cache off.
+  disk_enabled_ = prepare_cache_directory(directory_);
+  if (disk_enabled_) remove_stale_temporaries(directory_);
+}
 
 std::string ProgramCache::build_options(const std::string& defines) const {
   std::string options = "-cl-std=CL" + std::to_string(device_.opencl_c_major) + "." +

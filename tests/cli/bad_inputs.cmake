@@ -77,3 +77,194 @@ if(NOT fifo_code EQUAL 0)
 endif()
 run(2 ${CLI} predict fifo_csv)
 expect_match("fifo_csv/mav0/cam0/data.csv is not a regular file")
+
+# --- The acceptance table of issue 11 continues: one case per bad input or fault, by item. ----
+
+run(0 ${CLI} predict seq -o rates.csv)
+
+# 4. NaN and infinity where numbers enter.
+copy_with(inf_intrinsics cam0/sensor.yaml "intrinsics: [58.5515744680851" "intrinsics: [.inf")
+run(2 ${CLI} predict inf_intrinsics)
+expect_match("inf_intrinsics/mav0/cam0/sensor.yaml: intrinsics\\[0\\] is inf")
+copy_with(nan_distortion cam0/sensor.yaml "distortion_coefficients: [0.0" "distortion_coefficients: [.nan")
+run(2 ${CLI} predict nan_distortion)
+expect_match("nan_distortion/mav0/cam0/sensor.yaml: distortion_coefficients\\[0\\] is nan")
+copy_with(nan_gyro imu0/data.csv "1403715273262142976,0.0851979807676885" "1403715273262142976,nan")
+run(2 ${CLI} eval rates.csv nan_gyro)
+expect_match("nan_gyro/mav0/imu0/data.csv line 2: w_RS_S_x is \"nan\", expected a finite number")
+file(WRITE "${WORK}/nan_rates.csv" "timestamp_ns,wx,wy,wz\n1403715273312142976,nan,0,0\n")
+run(2 ${CLI} eval nan_rates.csv seq)
+expect_match("nan_rates.csv line 2: wx is \"nan\", expected a finite number")
+
+# 5. A lens model that does not invert (k1 = 1e6) is refused naming the file and coefficients.
+copy_with(k1_huge cam0/sensor.yaml "distortion_coefficients: [0.0" "distortion_coefficients: [1e6")
+run(2 ${CLI} predict k1_huge)
+expect_match("cam0/sensor.yaml: the radial-tangential distortion coefficients \\[1e\\+06, 0, 0, 0\\] do not invert")
+copy_with(k1_fold cam0/sensor.yaml "distortion_coefficients: [0.0" "distortion_coefficients: [-3.0")
+run(2 ${CLI} predict k1_fold)
+expect_match("cam0/sensor.yaml: the radial-tangential distortion coefficients \\[-3, 0, 0, 0\\] do not invert")
+
+# 6. Timestamps at the ends of int64: no overflow, a message naming the rows.
+copy_with(ts_overflow cam0/data.csv "1403715273312142976,1403715273312142976.png"
+          "99999999999999999999,1403715273312142976.png")
+run(2 ${CLI} predict ts_overflow)
+expect_match("ts_overflow/mav0/cam0/data.csv line 3")
+copy_with(ts_limits cam0/data.csv "1403715273262142976,1403715273262142976.png"
+          "-9223372036854775807,1403715273262142976.png")
+run(2 ${CLI} predict ts_limits)
+expect_match("ts_limits/mav0/cam0/data.csv: the timestamps run from -9223372036854775807 \\(line 2\\).*the span must fit in a signed 64-bit count")
+
+# 7. 1×1 frames (the fuzz corpus's smallest PNG): refused before OpenCV's DIS.
+file(MAKE_DIRECTORY "${WORK}/one_pixel")
+foreach(i 1 2 3)
+  file(COPY_FILE "${CMAKE_CURRENT_LIST_DIR}/../fuzz/corpus/image/1x1.png" "${WORK}/one_pixel/frame${i}.png")
+endforeach()
+run(2 ${CLI} predict one_pixel --fx 50)
+expect_match("camera size 1×1 is too small")
+expect_no_match("Assertion failed")
+
+# 8. A resolution of zero pixels.
+copy_with(zero_resolution cam0/sensor.yaml "resolution: [96, 64]" "resolution: [0, 0]")
+run(2 ${CLI} predict zero_resolution)
+expect_match("zero_resolution/mav0/cam0/sensor.yaml: resolution should be \\[width, height\\] in pixels")
+
+# 9. A program cache folder of another user is refused, never loaded from (root only: chown).
+running_as_root(root)
+if(root)
+  file(MAKE_DIRECTORY "${WORK}/their_cache")
+  execute_process(COMMAND chown 65534:65534 "${WORK}/their_cache" RESULT_VARIABLE chown_code)
+  if(NOT chown_code EQUAL 0)
+    message(FATAL_ERROR "chown failed")
+  endif()
+  run(2 ${CMAKE_COMMAND} -E env INERTIALNET_CACHE_DIR=${WORK}/their_cache ${CLI} predict seq)
+  expect_match("their_cache belongs to user 65534, not to this user \\(0\\)")
+  run(0 ${CMAKE_COMMAND} -E env INERTIALNET_CACHE_DIR=${WORK}/their_cache ${CLI} predict seq --no-cache)
+else()
+  message("skipped: a cache folder of another user (needs root to chown)")
+endif()
+file(WRITE "${WORK}/cache_file" "")
+run(2 ${CMAKE_COMMAND} -E env INERTIALNET_CACHE_DIR=${WORK}/cache_file ${CLI} predict seq)
+expect_match("cache_file exists and is not a folder")
+
+# 10. A symbolic-link loop as an image: a message, never raw filesystem_error text.
+file(REMOVE_RECURSE "${WORK}/loop")
+file(COPY "${WORK}/seq/" DESTINATION "${WORK}/loop")
+file(GLOB loop_frames "${WORK}/loop/mav0/cam0/data/*.png")
+list(SORT loop_frames)
+list(GET loop_frames 1 loop_frame)
+file(REMOVE "${loop_frame}")
+# Two links naming each other (CMake refuses to make a link to itself).
+file(CREATE_LINK "${loop_frame}.other" "${loop_frame}" SYMBOLIC)
+file(CREATE_LINK "${loop_frame}" "${loop_frame}.other" SYMBOLIC)
+run(2 ${CLI} predict loop)
+expect_match("loop/mav0/cam0/data.csv line 3: the image .* cannot be accessed: Too many levels of symbolic links")
+expect_no_match("filesystem error")
+file(MAKE_DIRECTORY "${WORK}/loop_folder")
+file(COPY_FILE "${frame_a}" "${WORK}/loop_folder/frame1.png")
+file(COPY_FILE "${frame_b}" "${WORK}/loop_folder/frame2.png")
+file(CREATE_LINK "${WORK}/loop_folder/frame4.png" "${WORK}/loop_folder/frame3.png" SYMBOLIC)
+file(CREATE_LINK "${WORK}/loop_folder/frame3.png" "${WORK}/loop_folder/frame4.png" SYMBOLIC)
+run(2 ${CLI} predict loop_folder --fx 50)
+expect_match("Image folder loop_folder: frame[34].png cannot be accessed: Too many levels of symbolic links")
+expect_no_match("filesystem error")
+
+# 10. An IMU that covers a minority of the rated frames: refused, not metrics over 1 of 5 rows.
+run(0 ${CLI} synth seq5 --frames 6 --size 96x64 --seed 7)
+run(0 ${CLI} predict seq5 -o rates5.csv)
+file(STRINGS "${WORK}/seq5/mav0/imu0/data.csv" imu_lines)
+list(SUBLIST imu_lines 0 14 imu_head)  # the header and 65 ms of samples: frames 0 and 1
+list(JOIN imu_head "\n" imu_text)
+file(WRITE "${WORK}/seq5/mav0/imu0/data.csv" "${imu_text}\n")
+run(2 ${CLI} eval rates5.csv seq5)
+expect_match("covers only 1 of the 5 rates rows")
+
+# 10. Sizes: the documented × works, a stray byte of it does not, six digits get a range.
+run(0 ${CLI} synth times --frames 2 --size 64×48 --seed 1)
+expect_match("64x48")
+string(ASCII 195 stray)
+run(2 ${CLI} synth stray --frames 2 --size 64${stray}48)
+expect_match("is not of the form WIDTHxHEIGHT")
+run(2 ${CLI} bench --size 123456x96)
+expect_match("width and height must be from 1 to 99999 pixels")
+run(2 ${CLI} synth zero --frames 2 --size 0x48)
+expect_match("width and height must be from 1 to 99999 pixels")
+
+# 10. Numbers out of range, named with their value.
+run(2 ${CLI} predict mixed --fx 1e308)
+expect_match("--fx: must be at most 1e\\+06 pixels, got 1e308")
+run(2 ${CLI} predict mixed --fx 50 --fy -1)
+expect_match("--fy: must be a finite positive number, got -1")
+run(2 ${CLI} predict mixed --fx 50 --cy 1e300)
+expect_match("--cy: must be at most 1e\\+06 pixels from the origin, got 1e300")
+run(2 ${CLI} predict mixed --rate 1e300)
+expect_match("--rate: must be at most 1e\\+06 Hz, got 1e300")
+copy_with(huge_gyro imu0/data.csv "1403715273267142976,0.09197330478921553" "1403715273267142976,1e308")
+run(2 ${CLI} eval rates.csv huge_gyro)
+expect_match("huge_gyro/mav0/imu0/data.csv line 3: w_RS_S_x is \"1e308\", beyond ±1000 rad/s")
+file(WRITE "${WORK}/huge_rates.csv" "timestamp_ns,wx,wy,wz\n1403715273312142976,0,1e300,0\n")
+run(2 ${CLI} eval huge_rates.csv seq)
+expect_match("huge_rates.csv line 2: wy is \"1e300\", beyond ±1000 rad/s")
+
+# 10. An inherited ignored SIGINT stays ignored: a background job must not die of the terminal's
+# Ctrl-C. SIGINT is sent every 50 ms for the whole run; the run must finish every pair.
+run(0 ${CLI} synth long --frames 30 --size 160x120 --seed 3)
+# (A script file: run() passes its arguments as a CMake list, which would split at semicolons.)
+file(WRITE "${WORK}/ignore_sigint.sh" [=[
+trap '' INT
+"$1" predict long -o ignored.csv &
+pid=$!
+while kill -0 $pid 2>/dev/null
+do
+  kill -INT $pid 2>/dev/null
+  sleep 0.05
+done
+wait $pid
+]=])
+run(0 bash ignore_sigint.sh ${CLI})
+file(STRINGS "${WORK}/ignored.csv" ignored_rows)
+list(LENGTH ignored_rows ignored_count)
+if(NOT ignored_count EQUAL 30)
+  message(FATAL_ERROR "ignored.csv has ${ignored_count} lines, expected a header and 29 rows")
+endif()
+
+# Usage and files that are simply wrong.
+run(2 ${CLI} predict nosuch)
+expect_match("sequence 'nosuch' does not exist")
+run(2 ${CLI} predict seq --lanes 0)
+expect_match("--lanes: Value 0 not in range 1 to 16")
+run(2 ${CLI} predict seq --head sideways)
+expect_match("unknown head 'sideways'")
+run(2 ${CLI} predict seq --flow farneback)
+expect_match("unknown flow method 'farneback'")
+run(2 ${CLI} predict seq --solver fast)
+expect_match("unknown solver 'fast'")
+run(2 ${CLI} predict seq --flow flownet2)
+expect_match("need weights")
+run(2 ${CLI} weights --info seq/mav0/cam0/data.csv)
+expect_match("not a safetensors file")
+run(2 ${CLI} weights --synthetic Nope -o nope.safetensors)
+expect_match("unknown model 'Nope'")
+run(2 ${CLI} synth spin --frames 3 --motion spin)
+expect_match("unknown motion \"spin\"")
+run(2 ${CLI} eval seq/mav0/cam0/data.csv seq)
+expect_match("expected the header timestamp_ns,wx,wy,wz")
+file(WRITE "${WORK}/backwards.csv" "timestamp_ns,wx,wy,wz\n1403715273362142976,0,0,0\n1403715273312142976,0,0,0\n")
+run(2 ${CLI} eval backwards.csv seq)
+expect_match("backwards.csv")
+file(WRITE "${WORK}/short_row.csv" "timestamp_ns,wx,wy,wz\n1403715273312142976,0,0\n")
+run(2 ${CLI} eval short_row.csv seq)
+expect_match("short_row.csv line 2")
+file(WRITE "${WORK}/empty_rates.csv" "")
+run(2 ${CLI} eval empty_rates.csv seq)
+expect_match("is empty")
+copy_with(imu_columns imu0/data.csv "1403715273262142976,0.0851979807676885," "1403715273262142976,")
+run(2 ${CLI} eval rates.csv imu_columns)
+expect_match("imu_columns/mav0/imu0/data.csv line 2")
+copy_with(no_filename cam0/data.csv "1403715273312142976,1403715273312142976.png" "1403715273312142976,")
+run(2 ${CLI} predict no_filename)
+expect_match("no_filename/mav0/cam0/data.csv line 3")
+file(MAKE_DIRECTORY "${WORK}/truncated_folder")
+file(COPY_FILE "${frame_a}" "${WORK}/truncated_folder/frame1.png")
+execute_process(COMMAND head -c 200 "${frame_b}" OUTPUT_FILE "${WORK}/truncated_folder/frame2.png")
+run(2 ${CLI} predict truncated_folder --fx 50)
+expect_match("frame2.png\" is truncated")

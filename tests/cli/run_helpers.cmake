@@ -26,3 +26,20 @@ function(expect_json document)
   endif()
   set(value "${value}" PARENT_SCOPE)
 endfunction()
+
+function(expect_no_match regex)
+  if(output MATCHES "${regex}")
+    message(FATAL_ERROR "output matches '${regex}', which it should not")
+  endif()
+endfunction()
+
+# running_as_root(<var>): TRUE when the tests run as root (device nodes and other users'
+# folders can then be made in the scratch folder; without root those cases are skipped).
+function(running_as_root var)
+  execute_process(COMMAND id -u OUTPUT_VARIABLE uid OUTPUT_STRIP_TRAILING_WHITESPACE)
+  if(uid STREQUAL "0")
+    set(${var} TRUE PARENT_SCOPE)
+  else()
+    set(${var} FALSE PARENT_SCOPE)
+  endif()
+endfunction()

@@ -237,6 +237,15 @@ TEST(Euroc, SensorYamlErrors) {
 
   std::ofstream(p) << "%YAML:1.0\nT_BS: [1, 0\n  broken: [\n";
   EXPECT_TRUE(contains(invalid_input_message([&] { read_camera_yaml(p); }), "not valid YAML"));
+
+  // A fuzzing finding: OpenCV's parser threw std::length_error (not cv::Exception) on a mangled
+  // key, which escaped as a raw "basic_string::_M_create".
+  std::ofstream(p) << "%YAML:1.0\nsensor%YAML:1.0\nsensor_type: camera\nT_type: camera\nT_BS_BS:\n  cols: 4\n  :\n"
+                      "  rowscol";
+  EXPECT_TRUE(contains(invalid_input_message([&] { read_camera_yaml(p); }), "not valid YAML"));
+  // Another: a document that is a scalar, not a mapping, made OpenCV assert in operator[].
+  std::ofstream(p) << "-YAML:%YA";
+  EXPECT_TRUE(contains(invalid_input_message([&] { read_camera_yaml(p); }), "is not a YAML mapping of keys"));
 }
 
 // A NaN compares false with everything, so "error > tolerance" lets it through: every number of

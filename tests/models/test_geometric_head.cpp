@@ -100,7 +100,8 @@ TEST(NormalizedCoordinateMap, IsThePinholeInverseWithoutDistortion) {
   }
 }
 
-TEST(CameraIntrinsics, FromEurocCalibration) {
+// EuRoC cam0's calibration as its sensor.yaml gives it.
+CameraCalibration euroc_calibration() {
   CameraCalibration c;
   c.width = 752;
   c.height = 480;
@@ -108,6 +109,11 @@ TEST(CameraIntrinsics, FromEurocCalibration) {
   c.intrinsics = {458.654, 457.296, 367.215, 248.375};
   c.distortion_model = "radial-tangential";
   c.distortion = {-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05};
+  return c;
+}
+
+TEST(CameraIntrinsics, FromEurocCalibration) {
+  CameraCalibration c = euroc_calibration();
   const CameraIntrinsics k = CameraIntrinsics::from_calibration(c);
   EXPECT_EQ(k.distortion, LensDistortion::RadialTangential);
   EXPECT_EQ(k.width, 752);
@@ -129,6 +135,41 @@ TEST(CameraIntrinsics, FromEurocCalibration) {
 }
 
 // --- ω from exact flow ---------------------------------------------------------------------------
+
+// A lens model that OpenCV's fixed-point undistortion cannot invert used to give the k1 = 0 answer
+// silently; it is refused naming the coefficients.
+TEST(CameraIntrinsics, RefusesALensModelThatDoesNotInvert) {
+  CameraCalibration c = euroc_calibration();
+  c.distortion = {1e6, 0, 0, 0};
+  testing::expect_invalid_input([&] { CameraIntrinsics::from_calibration(c); },
+                                "radial-tangential distortion coefficients [1e+06, 0, 0, 0] do not invert over the "
+                                "752x480 image");
+  // Strong barrel distortion folds over inside the image: two radii reach the same pixel.
+  c.distortion = {-0.9, 0, 0, 0};
+  testing::expect_invalid_input([&] { CameraIntrinsics::from_calibration(c); }, "[-0.9, 0, 0, 0] do not invert");
+  c.distortion_model = "equidistant";
+  c.distortion = {-5, 0, 0, 0};
+  testing::expect_invalid_input([&] { CameraIntrinsics::from_calibration(c); },
+                                "equidistant distortion coefficients [-5, 0, 0, 0] do not invert");
+  // TUM-VI's fisheye and EuRoC's lens pass (FromEurocCalibration, InvertsTheEquidistantModel).
+  c.distortion = {0.0034823894, 0.0007150348, -0.0020532361, 0.0002029367};
+  EXPECT_NO_THROW(CameraIntrinsics::from_calibration(c));
+}
+
+TEST(GeometricHead, StopsWhenTheStopFlagIsSet) {
+  Queue& queue = testing::test_queue();
+  const CameraIntrinsics k = quarter_euroc();
+  GeometricHead head(testing::test_device(), k, quarter_options());
+  const Tensor flow = Tensor::empty(testing::test_device(), {1, 2, 120, 188});
+  const std::atomic<bool> stop{true};
+  try {
+    head.estimate(queue, flow, 0.05, &stop);
+    FAIL() << "the estimate ran with the stop flag set";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Runtime);
+    EXPECT_NE(std::string(e.what()).find("cancelled in the geometric head"), std::string::npos) << e.what();
+  }
+}
 
 TEST(GeometricHead, UniformRightwardFlowIsANegativeYawRate) {
   // docs/data_conventions.md: ẋ = −(1 + x²)·ωy + …, so image content moving right (+x) means ωy < 0.

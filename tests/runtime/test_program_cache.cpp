@@ -1,4 +1,7 @@
 // The on-disk program cache, observed through its statistics (never through timing).
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <filesystem>
 #include <fstream>
 
@@ -183,6 +186,80 @@ TEST(CacheDirectory, FollowsTheEnvironment) {
   ::unsetenv("XDG_CACHE_HOME");
   ::setenv("HOME", "/home/someone", 1);
   EXPECT_EQ(default_cache_directory(), fs::path("/home/someone/.cache/inertialnet"));
+}
+
+// Without a home the folder is per user, never one shared name another user could create first.
+TEST(CacheDirectory, FallsBackToAPerUserFolder) {
+  const char* home = std::getenv("HOME");
+  const std::string saved_home = home ? home : "";
+  ::unsetenv(kCacheDirEnvironmentVariable);
+  ::unsetenv("XDG_CACHE_HOME");
+  ::unsetenv("HOME");
+  ::setenv("XDG_RUNTIME_DIR", "/run/user/4242", 1);
+  EXPECT_EQ(default_cache_directory(), fs::path("/run/user/4242/inertialnet-cache"));
+  ::unsetenv("XDG_RUNTIME_DIR");
+  EXPECT_EQ(default_cache_directory(),
+            fs::temp_directory_path() / ("inertialnet-cache-" + std::to_string(::geteuid())));
+  if (home) ::setenv("HOME", saved_home.c_str(), 1);
+}
+
+mode_t mode_of(const fs::path& path) {
+  struct stat info {};
+  EXPECT_EQ(::stat(path.c_str(), &info), 0);
+  return info.st_mode & 07777;
+}
+
+TEST_F(ProgramCacheTest, CreatesAPrivateFolder) {
+  const fs::path folder = directory_ / "new" / "cache";
+  auto device = open_with_cache(folder);
+  EXPECT_TRUE(device->programs().disk_cache_enabled());
+  EXPECT_EQ(mode_of(folder), 0700u);
+}
+
+TEST_F(ProgramCacheTest, TakesWriteAccessAwayFromOthers) {
+  const fs::path folder = directory_ / "open";
+  ASSERT_EQ(::mkdir(folder.c_str(), 0700), 0);
+  ASSERT_EQ(::chmod(folder.c_str(), 0777), 0);
+  auto device = open_with_cache(folder);
+  EXPECT_TRUE(device->programs().disk_cache_enabled());
+  EXPECT_EQ(mode_of(folder), 0700u);
+}
+
+TEST_F(ProgramCacheTest, RefusesAFolderOfAnotherUser) {
+  if (::geteuid() != 0) GTEST_SKIP() << "needs root to give a folder to another user";
+  const fs::path folder = directory_ / "theirs";
+  ASSERT_EQ(::mkdir(folder.c_str(), 0755), 0);
+  ASSERT_EQ(::chown(folder.c_str(), 65534, 65534), 0);
+  try {
+    open_with_cache(folder);
+    FAIL() << "a cache folder of another user was used";
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    EXPECT_EQ(e.kind(), ErrorKind::InvalidInput);
+    EXPECT_NE(message.find(folder.string() + " belongs to user 65534, not to this user (0)"), std::string::npos)
+        << message;
+    EXPECT_NE(message.find("INERTIALNET_CACHE_DIR"), std::string::npos) << message;
+  }
+  // --no-cache never looks at the folder.
+  DeviceOptions options;
+  options.program_cache = DiskCacheMode::Off;
+  options.cache_directory = folder;
+  EXPECT_NO_THROW(Device(testing::test_device().info(), options));
+}
+
+TEST_F(ProgramCacheTest, RemovesStaleTemporaries) {
+  const fs::path stale = directory_ / "0123456789abcdef.clbin.tmp.999.0";
+  const fs::path fresh = directory_ / "0123456789abcdef.clbin.tmp.999.1";
+  const fs::path nested = directory_ / "gemm-plans" / "x.json.tmp.999.0";
+  fs::create_directories(nested.parent_path());
+  for (const auto& path : {stale, fresh, nested}) std::ofstream(path) << "partial";
+  const auto old = fs::file_time_type::clock::now() - std::chrono::hours(1);
+  fs::last_write_time(stale, old);
+  fs::last_write_time(nested, old);
+  auto device = open_with_cache(directory_);
+  EXPECT_FALSE(fs::exists(stale));
+  EXPECT_FALSE(fs::exists(nested));
+  EXPECT_TRUE(fs::exists(fresh)) << "a temporary of a write that may still be running was removed";
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <sstream>
 
 #include "commands.hpp"
 #include "common.hpp"
@@ -26,6 +27,31 @@ namespace {
 
 std::atomic<bool> interrupted{false};
 extern "C" void on_interrupt(int) { interrupted = true; }
+
+// Catches `signal` for the run's length and puts back what was there before. A signal that was
+// ignored when the program started stays ignored: a shell starts background jobs with SIGINT
+// ignored so that the terminal's Ctrl-C does not reach them.
+class InterruptHandler {
+ public:
+  explicit InterruptHandler(int signal) : signal_(signal) {
+    struct sigaction handler {};
+    handler.sa_handler = on_interrupt;
+    sigemptyset(&handler.sa_mask);
+    if (::sigaction(signal_, nullptr, &previous_) == 0 && previous_.sa_handler != SIG_IGN) {
+      installed_ = ::sigaction(signal_, &handler, nullptr) == 0;
+    }
+  }
+  ~InterruptHandler() {
+    if (installed_) ::sigaction(signal_, &previous_, nullptr);
+  }
+  InterruptHandler(const InterruptHandler&) = delete;
+  InterruptHandler& operator=(const InterruptHandler&) = delete;
+
+ private:
+  int signal_;
+  struct sigaction previous_ {};
+  bool installed_ = false;
+};
 
 struct PredictOptions {
   std::string sequence;
@@ -64,22 +90,32 @@ void save_flow(const std::filesystem::path& folder, const std::string& format, s
 Command register_predict(CLI::App& app, const GlobalOptions& global) {
   auto o = std::make_shared<PredictOptions>();
   // NaN passes "> 0" tests as false and was then taken for "not given": refuse it where it is read.
-  const CLI::Validator finite_positive(
-      [](std::string& text) {
-        double value = 0;
-        if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || !(value > 0)) {
-          return "must be a finite positive number, got " + text;
-        }
-        return std::string();
-      },
-      "POSITIVE");
+  // The upper bounds are far beyond any camera yet keep later products (fx·dt, 1/rate) finite.
+  const auto finite_positive_up_to = [](double limit, const char* unit) {
+    return CLI::Validator(
+        [limit, unit](std::string& text) {
+          double value = 0;
+          if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || !(value > 0)) {
+            return "must be a finite positive number, got " + text;
+          }
+          if (value > limit) {
+            std::ostringstream s;
+            s << "must be at most " << limit << " " << unit << ", got " << text;
+            return s.str();
+          }
+          return std::string();
+        },
+        "POSITIVE");
+  };
   const CLI::Validator finite(
       [](std::string& text) {
         double value = 0;
         if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value)) return "must be a finite number, got " + text;
+        if (std::abs(value) > 1e6) return "must be at most 1e+06 pixels from the origin, got " + text;
         return std::string();
       },
       "NUMBER");
+  const CLI::Validator focal = finite_positive_up_to(1e6, "pixels");
   app.add_option("sequence", o->sequence, "EuRoC folder, image folder or video")->required();
   app.add_option("-w,--weights", o->weights,
                  "weights (safetensors) holding FlowNet2 and/or the InertialNet head; repeat for several files");
@@ -91,8 +127,8 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
   app.add_option("--solver", o->solver, "geometric head's solver")
       ->capture_default_str()
       ->transform(choice("solver", {"motion-field", "opengv"}));
-  app.add_option("--fx", o->fx, "focal length x (px), when the sequence has no sensor.yaml")->check(finite_positive);
-  app.add_option("--fy", o->fy, "focal length y (px)")->check(finite_positive);
+  app.add_option("--fx", o->fx, "focal length x (px), when the sequence has no sensor.yaml")->check(focal);
+  app.add_option("--fy", o->fy, "focal length y (px)")->check(focal);
   app.add_option("--cx", o->cx, "principal point x (px)")->check(finite);
   app.add_option("--cy", o->cy, "principal point y (px)")->check(finite);
   app.add_option("-o,--output", o->output, "rates CSV to write, folders created as needed (default: standard output)");
@@ -104,7 +140,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
       ->transform(choice("flow format", {"flo", "png", "kitti"}))
       ->needs(save_flow_option);
   app.add_option("--rate", o->rate_hz, "frame rate for image folders and videos without timestamps (Hz)")
-      ->check(finite_positive);
+      ->check(finite_positive_up_to(1e6, "Hz"));
   app.add_option("--time-offset", o->time_offset,
                  "camera-IMU time offset in seconds (t_imu = t_cam + offset), stated in the CSV for eval");
   app.add_option("--readout-time", o->readout_time,
@@ -204,11 +240,10 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
     options.decode_threads = o->decode_threads;
     options.max_pairs = o->max_pairs;
     options.cancel = &interrupted;
-    std::signal(SIGINT, on_interrupt);
-    std::signal(SIGTERM, on_interrupt);
-    const PipelineStats stats = prediction.run(sink, options);
-    std::signal(SIGINT, SIG_DFL);
-    std::signal(SIGTERM, SIG_DFL);
+    const PipelineStats stats = [&] {
+      const InterruptHandler on_sigint(SIGINT), on_sigterm(SIGTERM);
+      return prediction.run(sink, options);
+    }();
     progress.finish();  // the summary below starts on a line of its own
 
     if (o->stats) {
@@ -232,6 +267,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
                         std::to_string(options.lanes_per_device) + " lanes in flight per device, after a warm-up pair",
                     per_pair);
     }
+    if (file_writer) file_writer->close();  // a failed write or rename is exit 1, not a silent loss
     if (stats.cancelled) {
       std::cerr << "inertialnet: interrupted after " << stats.pairs << " of " << pairs
                 << " pairs; the rates written so far are complete rows\n";

@@ -23,12 +23,21 @@ std::unique_ptr<Device> open_device(const GlobalOptions& global) {
 }
 
 std::pair<std::int64_t, std::int64_t> parse_size(const std::string& text) {
-  static const std::regex pattern("^([0-9]{1,5})[xX×]([0-9]{1,5})$");
+  // The separator is x, X or the two UTF-8 bytes of ×, matched as one unit: a bracket
+  // expression would take either byte of × alone and so accept a stray invalid byte.
+  static const std::regex pattern("^([0-9]+)(?:x|X|\xC3\x97)([0-9]+)$");
   std::smatch m;
-  if (!std::regex_match(text, m, pattern) || std::stoll(m[1]) == 0 || std::stoll(m[2]) == 0) {
+  if (!std::regex_match(text, m, pattern)) {
     throw invalid_input("size '" + text + "' is not of the form WIDTHxHEIGHT (e.g. 752x480)");
   }
-  return {std::stoll(m[1]), std::stoll(m[2])};
+  auto dimension = [&](const std::string& digits) -> std::int64_t {
+    const auto first = digits.find_first_not_of('0');
+    if (first == std::string::npos || digits.size() - first > 5) {
+      throw invalid_input("size '" + text + "': width and height must be from 1 to 99999 pixels");
+    }
+    return std::stoll(digits);
+  };
+  return {dimension(m[1]), dimension(m[2])};
 }
 
 void warn_if_synthetic(const WeightSet& weights) {

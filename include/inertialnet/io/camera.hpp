@@ -30,6 +30,11 @@ struct CameraIntrinsics {
   // Throws invalid_input unless sizes and focal lengths are positive, everything is finite and
   // the coefficient count fits the distortion model.
   void validate() const;
+  // Throws invalid_input naming the coefficients unless the lens model is invertible over the
+  // image: undistorting a grid of pixel positions and distorting them again returns each pixel
+  // (within 0.01 px), and the radial model grows monotonically out to the image's largest radius.
+  // from_calibration() checks it; call it after setting coefficients by hand.
+  void check_invertible() const;
   // Undistorted normalised coordinates of one pixel position (through OpenCV's undistortPoints).
   std::array<double, 2> normalize(double u, double v) const;
   // The mean focal length (fx + fy)/2, pixels: converts pixels of flow to normalised units.

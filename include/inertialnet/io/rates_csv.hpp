@@ -60,8 +60,12 @@ struct RatesTable {
 
 RatesTable read_rates_csv(const std::filesystem::path& path);
 
-// Writes rows as they come, each flushed, so a file cut short (Ctrl-C, an error) is still a
-// valid CSV of the rows so far. Refuses non-finite values and timestamps that do not increase.
+// Writes rows as they come. A regular file is written through the library's atomic writer
+// (runtime/atomic_file.hpp) and appears, or replaces the old one, when the writer closes: by
+// close(), which reports write errors, or by the destructor, so that a run cut short (Ctrl-C,
+// an error) still leaves a valid CSV of the rows so far. A FIFO or character device the caller
+// names (/dev/stdout, a pipe) is written in place, one whole row per write; any other non-regular
+// target is refused. Refuses non-finite values and timestamps that do not increase.
 class RatesCsvWriter {
  public:
   RatesCsvWriter(const std::filesystem::path& path, const std::vector<std::string>& extra_names = {},
@@ -70,6 +74,8 @@ class RatesCsvWriter {
   RatesCsvWriter(const RatesCsvWriter&) = delete;
   RatesCsvWriter& operator=(const RatesCsvWriter&) = delete;
   void write(std::int64_t t_ns, const Vec3& w, const std::vector<double>& extra = {});
+  // Puts the file in place (flushed to the disk); throws when that fails. Call once, at the end.
+  void close();
   std::size_t rows() const { return rows_; }
 
  private:

@@ -26,6 +26,8 @@
 //    five-point essential matrix), ω = log(R)/dt.
 #pragma once
 
+#include <atomic>
+
 #include <string>
 
 #include "inertialnet/core/vec3.hpp"
@@ -112,8 +114,9 @@ class GeometricHead {
   // ω from the flow [1, 2, H, W] on this device (H, W: the camera's size; a channel slice of a
   // larger tensor is fine). The motion-field solver never downloads the dense flow: only the
   // work-group partial sums come back, one small read per IRLS pass; the OpenGV solver reads
-  // back the sampled correspondences only. dt in seconds, positive and finite.
-  RotationEstimate estimate(Queue& queue, const Tensor& flow, double dt);
+  // back the sampled correspondences only. dt in seconds, positive and finite. With `stop`, the
+  // estimate is abandoned (by throwing runtime_error) at the next pass once the flag is set.
+  RotationEstimate estimate(Queue& queue, const Tensor& flow, double dt, const std::atomic<bool>* stop = nullptr);
   // The same for a host flow (uploaded first).
   RotationEstimate estimate(Queue& queue, const FlowField& flow, double dt);
 

@@ -40,7 +40,10 @@ inline constexpr const char* kNoCacheEnvironmentVariable = "INERTIALNET_NO_CACHE
 // Environment variable that moves the cache directory.
 inline constexpr const char* kCacheDirEnvironmentVariable = "INERTIALNET_CACHE_DIR";
 
-// Where the disk cache lives when no directory is given explicitly.
+// Where the disk cache lives when no directory is given explicitly: $INERTIALNET_CACHE_DIR, else
+// $XDG_CACHE_HOME/inertialnet, else ~/.cache/inertialnet, else (no home) the per-user
+// $XDG_RUNTIME_DIR/inertialnet-cache or <temp>/inertialnet-cache-<uid>. The program cache checks
+// it with prepare_cache_directory() (runtime/cache_directory.hpp) before use.
 std::filesystem::path default_cache_directory();
 
 struct ProgramCacheStats {

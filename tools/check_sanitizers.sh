@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# The sanitizer pass, meant for CI (not yet in .ci/run; see docs/architecture.md): a second build (build-asan/, clang) with AddressSanitizer, LeakSanitizer
+# and UBSan on the project's own targets (INERTIALNET_SANITIZE; not CMAKE_CXX_FLAGS), running the
+# unit and OpenCL suites and replaying the fuzz corpora, then each libFuzzer target for
+# FUZZ_SECONDS (default 30) through tools/fuzz.sh.
+#
+# Left out here, and why:
+#  - the CLI scripts (label cli): the same code is reached by the unit suites and the fuzzers,
+#    and their subprocess runs would triple this pass;
+#  - install_consumer: it installs the library and builds a consumer project against it; the
+#    sanitizer flags stay out of the installed package by design, so that consumer would not
+#    link against an instrumented archive;
+#  - test_flownet_fixtures (all plans): whole-network runs whose work is the OpenCL kernels
+#    (PoCL, uninstrumented); the host code they reach is covered by the per-op suites, and they
+#    are the slowest suites (about 4 × 30 s plain, more under ASan).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+build=build-asan
+jobs=$(nproc 2>/dev/null || echo 2)
+CC=clang CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DINERTIALNET_BUILD_BENCHMARKS=OFF \
+  -DINERTIALNET_SANITIZE=address,undefined -DINERTIALNET_BUILD_FUZZERS=ON
+cmake --build "$build" -j "$jobs"
+
+# Pinned cache state: PoCL compiles every kernel afresh in this pass (see the suppressions).
+export POCL_CACHE_DIR="$PWD/$build/pocl-cache"
+export INERTIALNET_CACHE_DIR="$PWD/$build/program-cache"
+rm -rf "$POCL_CACHE_DIR" "$INERTIALNET_CACHE_DIR"
+export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
+export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1"
+export LSAN_OPTIONS="suppressions=$PWD/tests/sanitizers/lsan_suppressions.txt:print_suppressions=0"
+ctest --test-dir "$build" --output-on-failure -j "$jobs" -L "unit|opencl|fuzz" -E "^test_flownet_fixtures"
+bash tools/fuzz.sh "${FUZZ_SECONDS:-30}"

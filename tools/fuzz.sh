@@ -1,0 +1,49 @@
+#!/usr/bin/env bash
+# Runs every libFuzzer target of tests/fuzz for a set time and prints each one's executions.
+#   bash tools/fuzz.sh [SECONDS_PER_TARGET] [TARGET...]     (default 30 s, every target)
+# Builds the targets in build-asan/ (clang, AddressSanitizer + UBSan, the same tree as CI's
+# sanitizer build; FUZZ_BUILD_DIR moves it). Each target starts from its seed corpus
+# (tests/fuzz/corpus/<target>/) and keeps what it learns in <build>/fuzz-corpus/<target>/;
+# a finding is written to <build>/fuzz-findings/<target>/ and fails the script. Copy it into
+# tests/fuzz/regressions/<target>/ with the fix: CTest replays that folder (fuzz_replay_<target>).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds="${1:-30}"
+shift || true
+build="${FUZZ_BUILD_DIR:-build-asan}"
+all_targets=(safetensors camera_csv imu_csv sensor_yaml rates_csv image device_spec flo)
+targets=("$@")
+[ ${#targets[@]} -eq 0 ] && targets=("${all_targets[@]}")
+
+if [ ! -f "$build/CMakeCache.txt" ]; then
+  CC=clang CXX=clang++ cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release -DINERTIALNET_BUILD_BENCHMARKS=OFF \
+    -DINERTIALNET_SANITIZE=address,undefined -DINERTIALNET_BUILD_FUZZERS=ON
+fi
+jobs=$(nproc 2>/dev/null || echo 2)
+cmake --build "$build" -j "$jobs" --target "${targets[@]/#/fuzz_}"
+
+# Leaks count as findings; the readers touch no OpenCL driver, so no suppressions are needed.
+export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1}"
+export UBSAN_OPTIONS="${UBSAN_OPTIONS:-halt_on_error=1:print_stacktrace=1}"
+failed=0
+summary=""
+for target in "${targets[@]}"; do
+  corpus="$build/fuzz-corpus/$target"
+  findings="$build/fuzz-findings/$target"
+  mkdir -p "$corpus" "$findings"
+  log="$build/fuzz-findings/$target.log"
+  set +e
+  "$build/tests/fuzz/fuzz_$target" -max_total_time="$seconds" -print_final_stats=1 -max_len=65536 \
+    -artifact_prefix="$findings/" "$corpus" "tests/fuzz/corpus/$target" >"$log" 2>&1
+  code=$?
+  set -e
+  runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
+  if [ "$code" -ne 0 ]; then
+    failed=1
+    summary+=$(printf '%-12s FAILED after %s executions (exit %d): see %s and %s\n' "$target" "${runs:-?}" "$code" "$log" "$findings")$'\n'
+  else
+    summary+=$(printf '%-12s %10s executions in %s s\n' "$target" "${runs:-?}" "$seconds")$'\n'
+  fi
+done
+printf '%s' "$summary"
+exit "$failed"
