@@ -162,9 +162,15 @@ run(2 ${CLI} weights --synthetic InertialNetHead --size 32x32 -o link_to_fifo.sa
 expect_match("it exists and is not a regular file")
 expect_fifo(fifo_target)
 
-# 2. eval --plot into a folder that does not exist: exit 2 naming it, nothing deleted.
-run(2 ${CLI} eval rates.csv seq --plot no/such/folder/plot.png)
-expect_match("no/such/folder")
+# 2. eval --plot where its folder cannot be made (a file is in the way): exit 2 naming the
+# folder, and the file in the way is left as it was (missing folders are created: section 4).
+file(WRITE "${WORK}/in_the_way" "keep me")
+run(2 ${CLI} eval rates.csv seq --plot in_the_way/folder/plot.png)
+expect_match("in_the_way")
+file(READ "${WORK}/in_the_way" kept)
+if(NOT kept STREQUAL "keep me")
+  message(FATAL_ERROR "eval --plot changed the file in the way")
+endif()
 
 # 3. Standard output that cannot be written, for the remaining commands that print.
 run_to_full(${CLI} synth full_seq --frames 2 --size 64x48 --seed 1)
@@ -179,10 +185,10 @@ run(0 ${CLI} predict seq -o rates_link.csv)
 if(NOT IS_SYMLINK "${WORK}/rates_link.csv")
   message(FATAL_ERROR "predict -o replaced the symbolic link")
 endif()
-file(STRINGS "${WORK}/rates_target.csv" linked_rows)
+file(STRINGS "${WORK}/rates_target.csv" linked_rows REGEX "^[^#]")  # the `# key: value` lines aside
 list(LENGTH linked_rows linked_count)
 if(NOT linked_count EQUAL 3)
-  message(FATAL_ERROR "rates_target.csv has ${linked_count} lines, expected a header and 2 rows")
+  message(FATAL_ERROR "rates_target.csv has ${linked_count} lines besides its # lines, expected a header and 2 rows")
 endif()
 file(MAKE_DIRECTORY "${WORK}/rates_folder.csv")
 run(2 ${CLI} predict seq -o rates_folder.csv)

@@ -11,6 +11,7 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "console.hpp"
+#include "interrupt.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/runtime/layer_profiler.hpp"
 #include "inertialnet/io/flow_io.hpp"
@@ -24,34 +25,6 @@
 namespace inertialnet::cli {
 
 namespace {
-
-std::atomic<bool> interrupted{false};
-extern "C" void on_interrupt(int) { interrupted = true; }
-
-// Catches `signal` for the run's length and puts back what was there before. A signal that was
-// ignored when the program started stays ignored: a shell starts background jobs with SIGINT
-// ignored so that the terminal's Ctrl-C does not reach them.
-class InterruptHandler {
- public:
-  explicit InterruptHandler(int signal) : signal_(signal) {
-    struct sigaction handler {};
-    handler.sa_handler = on_interrupt;
-    sigemptyset(&handler.sa_mask);
-    if (::sigaction(signal_, nullptr, &previous_) == 0 && previous_.sa_handler != SIG_IGN) {
-      installed_ = ::sigaction(signal_, &handler, nullptr) == 0;
-    }
-  }
-  ~InterruptHandler() {
-    if (installed_) ::sigaction(signal_, &previous_, nullptr);
-  }
-  InterruptHandler(const InterruptHandler&) = delete;
-  InterruptHandler& operator=(const InterruptHandler&) = delete;
-
- private:
-  int signal_;
-  struct sigaction previous_ {};
-  bool installed_ = false;
-};
 
 struct PredictOptions {
   std::string sequence;
@@ -239,9 +212,9 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
     options.lanes_per_device = o->lanes > 0 ? o->lanes : default_lanes_per_device(infos);
     options.decode_threads = o->decode_threads;
     options.max_pairs = o->max_pairs;
-    options.cancel = &interrupted;
+    options.cancel = &interrupt_requested();
     const PipelineStats stats = [&] {
-      const InterruptHandler on_sigint(SIGINT), on_sigterm(SIGTERM);
+      const InterruptGuard guard;
       return prediction.run(sink, options);
     }();
     progress.finish();  // the summary below starts on a line of its own

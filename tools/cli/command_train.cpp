@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
+#include "interrupt.hpp"
 #include "common.hpp"
 #include "progress.hpp"
 #include "inertialnet/eval/plots.hpp"
@@ -26,8 +27,6 @@ namespace inertialnet::cli {
 
 namespace {
 
-std::atomic<bool> train_interrupted{false};
-extern "C" void on_train_interrupt(int) { train_interrupted = true; }
 
 struct TrainCliOptions {
   std::vector<std::string> train, val, weights;
@@ -175,7 +174,7 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
     Progress* bar = nullptr;
     std::unique_ptr<Progress> epoch_bar;
     TrainerCallbacks callbacks;
-    callbacks.stop = &train_interrupted;
+    callbacks.stop = &interrupt_requested();
     callbacks.on_batch = [&](int epoch, std::size_t b, std::size_t batches, double) {
       if (b == 1) {
         epoch_bar = std::make_unique<Progress>("epoch " + std::to_string(epoch) + "/" + std::to_string(options.epochs), batches);
@@ -220,11 +219,10 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
       trainer.save_state(state_path);
     };
 
-    std::signal(SIGINT, on_train_interrupt);
-    std::signal(SIGTERM, on_train_interrupt);
-    const bool finished = trainer.train(train_set, val_set, callbacks, on_best, on_last);
-    std::signal(SIGINT, SIG_DFL);
-    std::signal(SIGTERM, SIG_DFL);
+    const bool finished = [&] {
+      const InterruptGuard guard;
+      return trainer.train(train_set, val_set, callbacks, on_best, on_last);
+    }();
     epoch_bar.reset();
     if (!finished) {
       // The interrupted epoch does not count; its partial updates are in the last head.

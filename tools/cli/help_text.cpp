@@ -46,6 +46,10 @@ std::string help_examples(const std::string& subcommand) {
       {"bench",
        "  inertialnet bench --model FlowNet2-C --size 256x192 --pairs 3\n"
        "  inertialnet bench --device all --json > bench.json\n"},
+      {"tune",
+       "  inertialnet tune --quick                              # the packed kernel's search, seconds\n"
+       "  inertialnet tune --model FlowNet2-C --size 512x384 --json > tune.json\n"
+       "  inertialnet tune --show                               # what is stored and in force\n"},
       {"weights",
        "  inertialnet weights --synthetic FlowNet2 -o flownet2.safetensors\n"
        "  inertialnet weights --synthetic InertialNetHead --size 752x480 -o head.safetensors\n"
