@@ -36,7 +36,7 @@ rates = inertialnet.predict(sequence)
 print("predict() agrees with the loop:", np.allclose([rates[c][-1] for c in ("wx", "wy", "wz")], w))
 
 report = inertialnet.evaluate(rates, sequence, target="mean")
-print("RMSE against gyro − bias (deg/s):", report["bias_corrected"]["rmse_deg_s"])
+print("RMSE against gyro − bias (deg/s):", report["estimators"][0]["bias_corrected"]["rmse_deg_s"])
 
 inertialnet.write_flo(out / "last.flo", flow)
 inertialnet.write_kitti_flow(out / "last_kitti.png", flow)

@@ -192,7 +192,7 @@ def evaluate(
     rates: Union[PathLike, np.ndarray],
     sequence: PathLike,
     *,
-    target: str = "spline",
+    target: Optional[str] = None,
     head: Optional[str] = None,
     gyro_bias: Optional[_Seq[float]] = None,
     camera_frame: bool = False,
@@ -201,8 +201,10 @@ def evaluate(
 ) -> dict:
     """The paper's metrics, as ``inertialnet eval --json``: ``rates`` is a rates CSV or the array
     from :func:`predict`, ``sequence`` a EuRoC folder with ``imu0``. ``head="geometric"`` compares
-    the ``wx_geometric, …`` columns. Returns the JSON report as a dict (``series=True`` adds the
-    per-frame values)."""
+    the ``wx_geometric, …`` columns. ``target`` is "spline" or "mean"; ``None`` picks the one that
+    fits the estimator the CSV states, as the CLI does (an array states none: spline). Returns the
+    ``inertialnet.eval/1`` document as a dict: its ``estimators`` list holds one report
+    (``series=True`` adds the per-frame values)."""
     import json
     import tempfile
 
@@ -212,7 +214,7 @@ def evaluate(
             write_rates_csv(path, rates)
             return evaluate(path, sequence, target=target, head=head, gyro_bias=gyro_bias,
                             camera_frame=camera_frame, plot=plot, series=series)
-    text = _native._evaluate_json(os.fspath(rates), os.fspath(sequence), target, head or "",
+    text = _native._evaluate_json(os.fspath(rates), os.fspath(sequence), target or "", head or "",
                                   None if gyro_bias is None else list(gyro_bias), camera_frame,
                                   "" if plot is None else os.fspath(plot), series)
     return json.loads(text)

@@ -473,7 +473,9 @@ std::string evaluate_json(const std::filesystem::path& rates, const std::filesys
                           const std::string& target, const std::string& head, const py::object& gyro_bias,
                           bool camera_frame, const std::string& plot, bool series) {
   EvalOptions options;
-  options.sync.target = parse_sync_target(target);
+  // No target: the one that fits the estimator the rates file states, as `inertialnet eval` picks.
+  options.choose_target = target.empty();
+  options.sync.target = parse_sync_target(target.empty() ? "spline" : target);
   options.sync.camera_frame = camera_frame;
   if (!gyro_bias.is_none()) {
     const auto b = gyro_bias.cast<std::vector<double>>();
@@ -484,7 +486,7 @@ std::string evaluate_json(const std::filesystem::path& rates, const std::filesys
   options.head_suffix = head.empty() ? "" : "_" + head;
   options.plot = plot;
   py::gil_scoped_release release;
-  return evaluate(rates, sequence, options).json(series);
+  return format_eval_json({evaluate(rates, sequence, options)}, series);
 }
 
 }  // namespace

@@ -41,6 +41,6 @@ def sequence(tmp_path_factory):
 
 def read_rates_csv(path):
     with open(path) as f:
-        rows = list(csv.reader(f))
+        rows = [r for r in csv.reader(f) if r and not r[0].startswith("#")]  # `# key: value` lines aside
     header, body = rows[0], rows[1:]
     return header, np.array([[int(r[0])] + [float(v) for v in r[1:]] for r in body], dtype=object)
