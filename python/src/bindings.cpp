@@ -132,24 +132,11 @@ FlowField flow_from_array(const py::array& array) {
 
 // --- devices -----------------------------------------------------------------------------------
 
+// The fields of `inertialnet devices --json` (inertialnet.devices/1), from the one function that
+// describes a device, so Python and the CLI name them alike.
 py::dict device_dict(const DeviceInfo& d) {
-  py::dict out;
-  out["index"] = d.index;
-  out["platform_index"] = d.platform_index;
-  out["device_index"] = d.device_index;
-  out["platform"] = d.platform_name;
-  out["platform_vendor"] = d.platform_vendor;
-  out["name"] = d.name;
-  out["vendor"] = d.vendor;
-  out["type"] = to_string(d.type);
-  out["driver_version"] = d.driver_version;
-  out["device_version"] = d.device_version;
-  out["opencl_c_version"] = d.opencl_c_version;
-  out["compute_units"] = d.compute_units;
-  out["global_memory_bytes"] = d.global_memory_bytes;
-  out["max_alloc_bytes"] = d.max_alloc_bytes;
-  out["fp16"] = d.fp16;
-  return out;
+  const py::object parsed = py::module_::import("json").attr("loads")(format_device_json({d}));
+  return parsed["devices"].cast<py::list>()[0].cast<py::dict>();
 }
 
 // An opened device, shared by the models made on it.

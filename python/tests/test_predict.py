@@ -96,6 +96,6 @@ def test_errors_map_to_python_exceptions_with_the_cli_messages(cli, sequence, tm
 
 def test_devices_and_selection():
     devices = inertialnet.devices()
-    assert devices and {"index", "name", "platform", "type"} <= set(devices[0])
+    assert devices and {"index", "address", "name", "platform", "type"} <= set(devices[0])
     assert inertialnet.select_devices("0")[0]["index"] == 0
     assert inertialnet.Device("0").name == devices[0]["name"]
