@@ -8,10 +8,9 @@
 #include "commands.hpp"
 #include "console.hpp"
 #include "inertialnet/eval/evaluate.hpp"
-#include "inertialnet/io/frame_source.hpp"
-#include "inertialnet/pipeline/pipeline.hpp"
-#include "inertialnet/pipeline/rates_processor.hpp"
-#include "inertialnet/runtime/device_selection.hpp"
+#include "inertialnet/io/euroc.hpp"
+#include "inertialnet/io/rates_csv.hpp"
+#include "inertialnet/pipeline/predict.hpp"
 #include "inertialnet/runtime/error.hpp"
 
 namespace inertialnet::cli {
@@ -22,25 +21,19 @@ struct CalibrateTimeOptions {
   double range = 0.2;
 };
 
-// Weight-free rates of every frame pair, in the body frame (the sequence has cam0's T_BS).
-RatesTable predict_weight_free(const std::string& sequence, const GlobalOptions& global) {
-  auto source = open_frame_source(sequence);
-  const auto calibration = source->calibration();
-  if (!calibration) throw invalid_input("calibrate-time: " + source->description() + " has no cam0/sensor.yaml.");
-  RatesProcessorOptions processor;
-  processor.flow = FlowMethod::DIS;
-  processor.inertialnet_head = false;
-  processor.geometric_head = true;
-  processor.camera = CameraIntrinsics::from_calibration(*calibration);
-  processor.camera_to_body = calibration->rotation_BS();
-  DeviceOptions device_options;
-  if (global.no_cache) device_options.program_cache = DiskCacheMode::Off;
-  Device device(select_device(device_spec_or_environment(global.device), discover_devices()), device_options);
+// Weight-free rates of every frame pair, set up as `inertialnet predict SEQ` sets them up (the
+// library's Prediction: DIS flow + geometric head, in the body frame when cam0 gives T_BS).
+RatesTable predict_weight_free(const std::string& sequence, const EurocSequence& seq, const GlobalOptions& global) {
+  if (!seq.camera) throw invalid_input("calibrate-time: " + sequence + " has no cam0/sensor.yaml to predict with.");
+  PredictSettings settings;
+  settings.sequence = sequence;
+  settings.device = global.device;
+  settings.no_cache = global.no_cache;
+  Prediction prediction(settings);
   RatesTable table;
-  table.metadata = {{"frame", "body"}, {"estimator", "inter_frame"}};
-  info("no rates file given: predicting " + std::to_string(source->size() - 1) +
-       " pairs with DIS flow + the geometric head");
-  run_pipeline(*source, {&device}, rates_processor({}, processor), [&](const PairResult& r) {
+  table.metadata = prediction.csv_metadata();
+  info("no rates file given: predicting " + std::to_string(prediction.pairs()) + " pairs with " + prediction.method());
+  prediction.run([&](const PairResult& r) {
     const auto& w = r.rates.front().second;
     table.t_ns.push_back(r.t1_ns);
     table.w.push_back({w[0], w[1], w[2]});
@@ -65,7 +58,7 @@ Command register_calibrate_time(CLI::App& app, const GlobalOptions& global) {
     EurocReadOptions read;
     read.check_images = false;
     const EurocSequence seq = read_euroc(o->sequence, read);
-    const RatesTable rates = o->rates.empty() ? predict_weight_free(o->sequence, global) : read_rates_csv(o->rates);
+    const RatesTable rates = o->rates.empty() ? predict_weight_free(o->sequence, seq, global) : read_rates_csv(o->rates);
     const EvalReport report = evaluate(rates, seq, options);
     const TimeOffsetEstimate& e = *report.time_offset_estimate;
     std::cout << e.summary() << "\n";
