@@ -9,7 +9,8 @@ medians and the ratio ours / PyTorch. Needs no torch itself: torch runs in the r
 environment (see README.md here for how to create it).
 
     tools/compare/compare.py [--venv DIR] [--inertialnet build/inertialnet] \
-        [--models FlowNet2,FlowNet2-C] [--size 512x384] [--threads 2] [--pairs 3] [--rounds 2] [--json]
+        [--models FlowNet2,FlowNet2-C] [--size 512x384] [--threads 2] [--pairs 3] [--rounds 2] [--json] \
+        [--device gpu --torch-device cuda]
 """
 
 from __future__ import annotations
@@ -44,6 +45,8 @@ def main() -> int:
     parser.add_argument("--pairs", type=int, default=3, help="timed pairs per run")
     parser.add_argument("--rounds", type=int, default=2, help="alternations ours/PyTorch per model")
     parser.add_argument("--device", default="", help="--device for inertialnet (default: its default)")
+    parser.add_argument("--torch-device", default="cpu",
+                        help="PyTorch's device (cpu, cuda): compare an OpenCL GPU run with PyTorch on the same GPU")
     parser.add_argument("--correlation", choices=("bmm", "shift"), default="bmm", help="PyTorch's correlation")
     parser.add_argument("--json", action="store_true", help="print the results as JSON")
     args = parser.parse_args()
@@ -61,16 +64,17 @@ def main() -> int:
     if args.device:
         ours_command += ["--device", args.device]
     torch_command = [python, os.path.join(HERE, "torch_bench.py"), "--size", args.size, "--threads", str(args.threads),
-                     "--pairs", str(args.pairs), "--correlation", args.correlation]
+                     "--pairs", str(args.pairs), "--correlation", args.correlation,
+                     "--torch-device", args.torch_device]
 
     models = [m for m in args.models.split(",") if m]
     runs = {m: {"ours": [], "ours_total": [], "torch": []} for m in models}
-    device = torch_version = ""
+    device = torch_version = torch_device = ""
     for round_index in range(args.rounds):
         for model in models:
             ours = run_json(ours_command + ["--model", model], env)["results"][0]
             torch_run = run_json(torch_command + ["--model", model], env)
-            device, torch_version = ours["device"], torch_run["torch"]
+            device, torch_version, torch_device = ours["device"], torch_run["torch"], torch_run["torch_device"]
             runs[model]["ours"].append(ours["stages"]["flow"])
             runs[model]["ours_total"].append(ours["seconds_per_pair"])
             runs[model]["torch"].append(torch_run["seconds_per_pair"])
@@ -86,11 +90,12 @@ def main() -> int:
                         "ours_total_seconds_per_pair": statistics.median(runs[model]["ours_total"]),
                         "torch_seconds_per_pair": theirs, "ratio": ours / theirs, "runs": runs[model]})
     if args.json:
-        print(json.dumps({"device": device, "torch": torch_version, "correlation": args.correlation,
+        print(json.dumps({"device": device, "torch": torch_version, "torch_device": torch_device,
+                          "correlation": args.correlation,
                           "results": summary}, indent=2))
         return 0
     print(f"{args.size}, {args.threads} threads, float32; ours on {device}, PyTorch {torch_version} "
-          f"(correlation: {args.correlation}); medians of {args.rounds} interleaved rounds of {args.pairs} pairs")
+          f"on {torch_device} (correlation: {args.correlation}); medians of {args.rounds} interleaved rounds of {args.pairs} pairs")
     print(f"{'model':<14} {'ours s/pair':>12} {'PyTorch s/pair':>15} {'ours/PyTorch':>13}")
     for s in summary:
         print(f"{s['model']:<14} {s['ours_seconds_per_pair']:>12.3f} {s['torch_seconds_per_pair']:>15.3f} {s['ratio']:>13.2f}")

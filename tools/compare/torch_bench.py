@@ -3,7 +3,7 @@ float32 with a given thread count, on the frames `inertialnet bench` uses, with 
 synthetic weights. Correlation: `bmm` (correlation_bmm.py, default) or `shift` (the reference's).
 Run by compare.py inside the reference's virtual environment; prints one JSON object.
 
-    python torch_bench.py --model FlowNet2 --size 512x384 --threads 2 --pairs 3
+    python torch_bench.py --model FlowNet2 --size 512x384 --threads 2 --pairs 3 [--torch-device cuda]
 """
 
 from __future__ import annotations
@@ -49,6 +49,7 @@ def main() -> int:
     parser.add_argument("--threads", type=int, default=os.cpu_count())
     parser.add_argument("--pairs", type=int, default=3)
     parser.add_argument("--correlation", choices=("bmm", "shift"), default="bmm")
+    parser.add_argument("--torch-device", default="cpu", help="PyTorch's device: cpu, cuda, cuda:1 ...")
     args = parser.parse_args()
     width, height = (int(v) for v in args.size.lower().split("x"))
 
@@ -62,20 +63,30 @@ def main() -> int:
 
     model = flownet2.build(args.model)
     synthetic.fill_synthetic(model, 1)
-    model = model.float()
-    f1 = torch.from_numpy(frame_pixels(width, height, 0)).unsqueeze(0)
-    f2 = torch.from_numpy(frame_pixels(width, height, 3)).unsqueeze(0)
+    device = torch.device(args.torch_device)
+    model = model.float().to(device)
+    f1 = torch.from_numpy(frame_pixels(width, height, 0)).unsqueeze(0).to(device)
+    f2 = torch.from_numpy(frame_pixels(width, height, 3)).unsqueeze(0).to(device)
+
+    def finish() -> None:
+        # CUDA runs asynchronously: a pair is done when its kernels are, not when the call returns.
+        if device.type == "cuda":
+            torch.cuda.synchronize(device)
+
     with torch.inference_mode():
         start = time.perf_counter()
-        flownet2.run_any_size(model, f1, f2)  # warm-up: allocator, oneDNN primitives
+        flownet2.run_any_size(model, f1, f2)  # warm-up: allocator, oneDNN primitives / cuDNN plans
+        finish()
         warmup = time.perf_counter() - start
         times = []
         for _ in range(args.pairs):
             start = time.perf_counter()
             flownet2.run_any_size(model, f1, f2)
+            finish()
             times.append(time.perf_counter() - start)
     print(json.dumps({
         "model": args.model, "width": width, "height": height, "threads": torch.get_num_threads(),
+        "torch_device": str(device) + (f" ({torch.cuda.get_device_name(device)})" if device.type == "cuda" else ""),
         "correlation": args.correlation, "torch": torch.__version__, "pairs": args.pairs,
         "warmup_seconds": warmup, "seconds": times, "seconds_per_pair": sum(times) / len(times),
     }))
