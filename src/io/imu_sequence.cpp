@@ -26,10 +26,17 @@ EurocSequence read_euroc_with_imu(const fs::path& path, const ImuSequenceOptions
   }
   EurocReadOptions read;
   read.check_images = false;
-  if (options.imu_csv.empty()) return read_euroc(path, read);
+  // As open_frame_source says it to predict: the listed stamps are the frame times.
+  const std::string rate_note = "--rate is ignored: the EuRoC sequence's cam0/data.csv gives every frame's timestamp.";
+  if (options.imu_csv.empty()) {
+    EurocSequence seq = read_euroc(path, read);
+    if (options.rate_hz) seq.notes.push_back(rate_note);
+    return seq;
+  }
   read.read_imu = false;
   read.read_ground_truth = false;
   EurocSequence seq = read_euroc(path, read);
+  if (options.rate_hz) seq.notes.push_back(rate_note);
   seq.imu = read_imu_csv(options.imu_csv, &seq.warnings);
   const fs::path imu0 = seq.mav0 / "imu0";
   if (fs::exists(imu0 / "sensor.yaml")) seq.imu_rotation_BS = rotation_of(read_sensor_T_BS(imu0 / "sensor.yaml"));
