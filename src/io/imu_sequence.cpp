@@ -55,7 +55,8 @@ EurocSequence read_sequence_with_imu(const fs::path& path, const ImuSequenceOpti
   const bool folder = fs::is_directory(path, error);
   const std::string kind = folder ? "an image folder" : "a video";
   if (options.imu_csv.empty()) {
-    throw invalid_input(path.string() + " is " + kind + ", which holds no gyro: give the IMU with --imu FILE (an "
+    throw invalid_input(path.string() + " is not a EuRoC sequence (no mav0/cam0/data.csv); as " + kind +
+                        " it holds no gyro: give the IMU with --imu FILE (an "
                         "EuRoC-format CSV: timestamp [ns], w_RS_S_x, w_RS_S_y, w_RS_S_z [rad/s], a_RS_S_x, "
                         "a_RS_S_y, a_RS_S_z [m/s^2]), and its rotation to the camera with --T-cam-imu or --camchain.");
   }

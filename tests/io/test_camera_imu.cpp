@@ -185,7 +185,9 @@ TEST(ImuSequence, ImageFolderWithAnImuFile) {
   EXPECT_EQ(read_sequence_with_imu(folder, options).frames[3].t_ns, 300'000'000);
 
   const std::string missing = invalid_input_message([&] { read_sequence_with_imu(folder); });
-  EXPECT_TRUE(contains(missing, "is an image folder, which holds no gyro: give the IMU with --imu FILE")) << missing;
+  EXPECT_TRUE(contains(missing, "is not a EuRoC sequence (no mav0/cam0/data.csv); as an image folder it holds no "
+                                "gyro: give the IMU with --imu FILE"))
+      << missing;
 }
 
 TEST(ImuSequence, EurocInputTakesTheImuFileInImu0sFrame) {
