@@ -66,10 +66,12 @@
 
 // io
 #include "inertialnet/io/camera.hpp"
+#include "inertialnet/io/camera_imu.hpp"
 #include "inertialnet/io/euroc.hpp"
 #include "inertialnet/io/flow_io.hpp"
 #include "inertialnet/io/frame_source.hpp"
 #include "inertialnet/io/image_io.hpp"
+#include "inertialnet/io/imu_sequence.hpp"
 #include "inertialnet/io/rates_csv.hpp"
 #include "inertialnet/io/safetensors.hpp"
 #include "inertialnet/io/safetensors_writer.hpp"

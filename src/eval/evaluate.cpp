@@ -76,14 +76,26 @@ EvalReport evaluate(const RatesTable& rates, const EurocSequence& seq, const Eva
       for (auto& w : predicted) w = compare_in_camera ? mul(r_cs, w) : mul_transposed(r_cs, w);
       r.predictions_rotated = true;
       notes.push_back(std::string("Predictions rotated from the ") + *frame + " frame (as the rates file states) into the " +
-                      (compare_in_camera ? "camera" : "body") + " frame with cam0's T_BS.");
+                      (compare_in_camera ? "camera" : "body") + " frame with " +
+                      (seq.imu_to_camera ? "the IMU-camera rotation given" : "cam0's T_BS") + ".");
     }
   } else {
     notes.push_back(std::string("The rates file does not state its frame; its rates are taken to be in the ") +
                     (compare_in_camera ? "camera" : "body (IMU)") + " frame of the comparison.");
   }
 
-  const double offset = options.time_offset_s ? *options.time_offset_s : rates.meta_number("time_offset_s").value_or(0.0);
+  const auto& calibration = options.input.camera_imu;
+  const bool calibrated_shift = !options.time_offset_s && calibration && calibration->timeshift_cam_imu_s;
+  const double offset = options.time_offset_s ? *options.time_offset_s
+                        : calibrated_shift    ? *calibration->timeshift_cam_imu_s
+                                              : rates.meta_number("time_offset_s").value_or(0.0);
+  if (calibrated_shift && !options.estimate_time_offset) {
+    char ms[32];
+    std::snprintf(ms, sizeof ms, "%+.3f", offset * 1e3);
+    notes.push_back(std::string("Time offset ") + ms + " ms from " + calibration->source +
+                    "'s timeshift_cam_imu (t_imu = t_cam + shift)" +
+                    (rates.meta("time_offset_s") ? ", over the rates file's time_offset_s" : "") + "; --time-offset overrides it.");
+  }
   const double readout = options.readout_time_s ? *options.readout_time_s : rates.meta_number("readout_time_s").value_or(0.0);
   if (!(readout >= 0) || readout > 1) {
     throw invalid_input("The readout time should be between 0 and 1 s, found " + std::to_string(readout) + " s.");
@@ -163,7 +175,8 @@ EvalReport evaluate(const RatesTable& rates, const EurocSequence& seq, const Eva
   r.bias_source = truth.bias_source;
   r.bias_imu_frame = truth.bias_imu_frame;
   r.imu_samples_in_span = truth.imu_samples_in_span;
-  r.notes = notes;
+  r.notes = seq.notes;
+  r.notes.insert(r.notes.end(), notes.begin(), notes.end());
   r.notes.insert(r.notes.end(), truth.notes.begin(), truth.notes.end());
   const std::vector<Vec3> corrected = truth.corrected();
 
@@ -252,9 +265,7 @@ EvalReport evaluate(const RatesTable& rates, const EurocSequence& seq, const Eva
 EvalReport evaluate(const std::filesystem::path& rates_csv, const std::filesystem::path& sequence,
                     const EvalOptions& options) {
   const RatesTable rates = read_rates_csv(rates_csv);
-  EurocReadOptions read;
-  read.check_images = false;
-  const EurocSequence seq = read_euroc(sequence, read);
+  const EurocSequence seq = read_sequence_with_imu(sequence, options.input);
   EvalReport r = evaluate(rates, seq, options);
   r.rates_file = rates_csv.string();
   return r;

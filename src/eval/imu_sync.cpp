@@ -364,7 +364,7 @@ GyroTruth sync_gyro(const std::vector<std::int64_t>& camera_t_ns, const std::vec
   if (options.camera_frame) {
     for (auto& v : out.raw) v = mul(*imu_to_camera, v);
     for (auto& v : bias) v = mul(*imu_to_camera, v);
-    out.notes.push_back("Rates rotated into the camera frame: w_C = R_BS^T * w_B.");
+    out.notes.push_back("Rates rotated into the camera frame: w_C = R_CS * w_B, R_CS the IMU-to-camera rotation.");
   } else {
     out.notes.push_back("Rates in the IMU (body) frame.");
   }
@@ -373,6 +373,7 @@ GyroTruth sync_gyro(const std::vector<std::int64_t>& camera_t_ns, const std::vec
 }
 
 Mat3 imu_to_camera_rotation(const EurocSequence& sequence) {
+  if (sequence.imu_to_camera) return *sequence.imu_to_camera;
   if (!sequence.camera) {
     throw invalid_input("Rates in the camera frame need the camera calibration " +
                         (sequence.mav0 / "cam0" / "sensor.yaml").string() + ", which was not found.");

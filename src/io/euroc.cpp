@@ -9,10 +9,10 @@
 #include <sstream>
 #include <system_error>
 
-#include <opencv2/core.hpp>
 
 #include "inertialnet/runtime/error.hpp"
 #include "io/csv_util.hpp"
+#include "io/yaml_util.hpp"
 
 namespace fs = std::filesystem;
 
@@ -65,108 +65,10 @@ void check_order(const fs::path& path, const std::vector<Row>& rows,
   csv::check_timestamps(path, t, lines, warnings);
 }
 
-// --- YAML through cv::FileStorage (it reads the originals' "%YAML:1.0" header) ---------------
-
-cv::FileStorage open_yaml(const fs::path& path) {
-  if (!fs::exists(path)) throw invalid_input("Calibration file " + path.string() + " does not exist.");
-  if (!fs::is_regular_file(path)) throw invalid_input("Calibration file " + path.string() + " is not a regular file.");
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  std::string text = buffer.str();
-  // OpenCV's parser insists on its own directive; Kalibr and hand-written files often omit it
-  // or write the YAML 1.x spelling.
-  if (text.rfind("%YAML", 0) != 0) {
-    text = "%YAML:1.0\n" + text;
-  } else if (text.rfind("%YAML:", 0) != 0) {
-    text.replace(0, text.find('\n'), "%YAML:1.0");
-  }
-  cv::FileStorage storage;
-  try {
-    storage.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);
-  } catch (const cv::Exception& e) {
-    // OpenCV 4 puts the parser's message in `func` and the parser function's name in `err`.
-    throw invalid_input("Calibration file " + path.string() + " is not valid YAML (OpenCV: " +
-                        e.err + " " + e.func + ").");
-  } catch (const std::exception& e) {
-    // The parser also lets standard exceptions through: a mangled key made it ask std::string
-    // for an impossible length (found by fuzzing, tests/fuzz/regressions/sensor_yaml/).
-    throw invalid_input("Calibration file " + path.string() + " is not valid YAML (OpenCV's parser failed: " +
-                        e.what() + ").");
-  }
-  if (!storage.isOpened()) throw invalid_input("Calibration file " + path.string() + " is not valid YAML.");
-  // Keys are looked up with operator[], which asserts (cv::Exception) on anything but a mapping
-  // (found by fuzzing, tests/fuzz/regressions/sensor_yaml/root_not_a_map.yaml).
-  if (!storage.root().isMap()) {
-    throw invalid_input("Calibration file " + path.string() + " is not a YAML mapping of keys (T_BS, intrinsics, …).");
-  }
-  return storage;
-}
-
-double read_number(const cv::FileNode& node, const fs::path& path, const std::string& key) {
-  if (!node.isInt() && !node.isReal()) {
-    throw invalid_input(path.string() + ": " + key + " should be a number.");
-  }
-  const double value = node.real();
-  if (!std::isfinite(value)) {
-    const std::string text = std::isnan(value) ? "nan" : value > 0 ? "inf" : "-inf";  // to_string may print "-nan"
-    throw invalid_input(path.string() + ": " + key + " is " + text + "; it should be a finite number.");
-  }
-  return value;
-}
-
-std::vector<double> read_numbers(const cv::FileNode& node, const fs::path& path,
-                                 const std::string& key) {
-  if (!node.isSeq()) throw invalid_input(path.string() + ": " + key + " should be a list of numbers.");
-  std::vector<double> values;
-  for (auto it = node.begin(); it != node.end(); ++it) {
-    values.push_back(read_number(*it, path, key + "[" + std::to_string(values.size()) + "]"));
-  }
-  return values;
-}
-
 std::array<double, 16> read_T_BS(const cv::FileStorage& storage, const fs::path& path) {
   const cv::FileNode node = storage["T_BS"];
   if (node.empty()) throw invalid_input(path.string() + " has no T_BS entry.");
-  // EuRoC writes {cols: 4, rows: 4, data: [...]}; a bare 16-element list is accepted too.
-  std::vector<double> data;
-  if (node.isMap()) {
-    const cv::FileNode rows = node["rows"], cols = node["cols"];
-    if ((!rows.empty() && read_number(rows, path, "T_BS.rows") != 4) ||
-        (!cols.empty() && read_number(cols, path, "T_BS.cols") != 4)) {
-      throw invalid_input(path.string() + ": T_BS should be 4×4.");
-    }
-    data = read_numbers(node["data"], path, "T_BS.data");
-  } else {
-    data = read_numbers(node, path, "T_BS");
-  }
-  if (data.size() != 16) {
-    throw invalid_input(path.string() + ": T_BS should hold 16 numbers (4×4 row-major), found " +
-                        std::to_string(data.size()) + ".");
-  }
-  std::array<double, 16> T{};
-  std::copy(data.begin(), data.end(), T.begin());
-  // A transform that is not rigid would silently mix the gyro axes: reject it.
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) {
-      double dot = 0;
-      for (int k = 0; k < 3; ++k) dot += T[4 * i + k] * T[4 * j + k];
-      // Written as "not within" so that a NaN fails the check instead of passing it.
-      if (!(std::abs(dot - (i == j ? 1.0 : 0.0)) <= 1e-3)) {
-        throw invalid_input(path.string() + ": the top-left 3×3 of T_BS is not a rotation matrix "
-                            "(rows are not orthonormal within 1e-3).");
-      }
-    }
-  }
-  if (!(std::abs(T[12]) <= 1e-9 && std::abs(T[13]) <= 1e-9 && std::abs(T[14]) <= 1e-9 &&
-        std::abs(T[15] - 1) <= 1e-9)) {
-    throw invalid_input(path.string() + ": the last row of T_BS should be [0, 0, 0, 1].");
-  }
-  return T;
-}
-
-std::string read_string(const cv::FileNode& node) {
-  return node.isString() ? node.string() : std::string();
+  return yaml::transform(node, path, "T_BS");
 }
 
 fs::path find_mav0(const fs::path& root) {
@@ -253,51 +155,51 @@ std::vector<CameraFrame> read_camera_csv(const fs::path& csv, const fs::path& im
   return frames;
 }
 
-CameraCalibration read_camera_yaml(const fs::path& yaml) {
-  const cv::FileStorage storage = open_yaml(yaml);
+CameraCalibration read_camera_yaml(const fs::path& path) {
+  const cv::FileStorage storage = yaml::open(path);
   CameraCalibration c;
-  c.T_BS = read_T_BS(storage, yaml);
+  c.T_BS = read_T_BS(storage, path);
 
-  const auto intrinsics = read_numbers(storage["intrinsics"], yaml, "intrinsics");
-  c.camera_model = read_string(storage["camera_model"]);
+  const auto intrinsics = yaml::numbers(storage["intrinsics"], path, "intrinsics");
+  c.camera_model = yaml::string(storage["camera_model"]);
   if (intrinsics.size() != 4) {
-    throw invalid_input(yaml.string() + ": intrinsics should be [fu, fv, cu, cv], found " +
+    throw invalid_input(path.string() + ": intrinsics should be [fu, fv, cu, cv], found " +
                         std::to_string(intrinsics.size()) + " numbers.");
   }
   std::copy(intrinsics.begin(), intrinsics.end(), c.intrinsics.begin());
   if (c.intrinsics[0] <= 0 || c.intrinsics[1] <= 0) {
-    throw invalid_input(yaml.string() + ": the focal lengths fu, fv should be positive.");
+    throw invalid_input(path.string() + ": the focal lengths fu, fv should be positive.");
   }
 
-  const auto resolution = read_numbers(storage["resolution"], yaml, "resolution");
+  const auto resolution = yaml::numbers(storage["resolution"], path, "resolution");
   // The bound keeps the conversion to int defined; real sensors are far below it.
   if (resolution.size() != 2 || resolution[0] < 1 || resolution[1] < 1 || resolution[0] > 1e6 || resolution[1] > 1e6 ||
       resolution[0] != std::floor(resolution[0]) || resolution[1] != std::floor(resolution[1])) {
-    throw invalid_input(yaml.string() + ": resolution should be [width, height] in pixels.");
+    throw invalid_input(path.string() + ": resolution should be [width, height] in pixels.");
   }
   c.width = static_cast<int>(resolution[0]);
   c.height = static_cast<int>(resolution[1]);
 
   if (!storage["rate_hz"].empty()) {
-    c.rate_hz = read_number(storage["rate_hz"], yaml, "rate_hz");
-    if (!(c.rate_hz > 0)) throw invalid_input(yaml.string() + ": rate_hz should be positive.");
+    c.rate_hz = yaml::number(storage["rate_hz"], path, "rate_hz");
+    if (!(c.rate_hz > 0)) throw invalid_input(path.string() + ": rate_hz should be positive.");
   }
-  c.distortion_model = read_string(storage["distortion_model"]);
+  c.distortion_model = yaml::string(storage["distortion_model"]);
   if (!storage["distortion_coefficients"].empty()) {
-    c.distortion = read_numbers(storage["distortion_coefficients"], yaml, "distortion_coefficients");
+    c.distortion = yaml::numbers(storage["distortion_coefficients"], path, "distortion_coefficients");
   }
   const std::size_t expected = (c.distortion_model == "radial-tangential" ||
                                 c.distortion_model == "equidistant") ? 4 : 0;
   if (expected != 0 && c.distortion.size() != expected) {
-    throw invalid_input(yaml.string() + ": the " + c.distortion_model + " model takes " +
+    throw invalid_input(path.string() + ": the " + c.distortion_model + " model takes " +
                         std::to_string(expected) + " distortion coefficients, found " +
                         std::to_string(c.distortion.size()) + ".");
   }
   return c;
 }
 
-std::array<double, 16> read_sensor_T_BS(const fs::path& yaml) {
-  return read_T_BS(open_yaml(yaml), yaml);
+std::array<double, 16> read_sensor_T_BS(const fs::path& path) {
+  return read_T_BS(yaml::open(path), path);
 }
 
 std::vector<ImuSample> read_imu_csv(const fs::path& csv, std::vector<std::string>* warnings) {

@@ -3,6 +3,8 @@
 // the rates its frames give as a folder of images.
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -11,6 +13,7 @@
 
 #include "inertialnet/eval/evaluate.hpp"
 #include "inertialnet/io/frame_source.hpp"
+#include "inertialnet/io/imu_sequence.hpp"
 #include "inertialnet/pipeline/rates_processor.hpp"
 #include "inertialnet/synth/synthetic_sequence.hpp"
 #include "support/testing.hpp"
@@ -134,52 +137,50 @@ TEST(RealCameras, CloseRangeHandHeldMotion) {
   EXPECT_LT(after, 0.8 * before);
 }
 
-// A video written here (MP4 when this OpenCV can write one, else Motion-JPEG AVI) and the same
-// decoded frames as a folder of images give the same rates at the same times; the video's times
-// come from the container, and predict's look at frame 0 before the run no longer breaks it.
-TEST(RealCameras, VideoGivesTheRatesOfItsFramesAsAFolder) {
-  const fs::path root = testing::temporary_directory("video");
-  SynthOptions o = small_rotation(7);
-  o.frames = 10;
-  const SynthReport synth = write_synthetic_sequence(root / "seq", o);
-  std::vector<cv::Mat> frames;
-  for (const auto t : synth.camera_t_ns) {
-    frames.push_back(cv::imread((synth.mav0 / "cam0" / "data" / (std::to_string(t) + ".png")).string(), cv::IMREAD_COLOR));
-    ASSERT_FALSE(frames.back().empty());
+// A synthetic sequence of `frames` frames, written as a video (MP4 when this OpenCV can write
+// one, else Motion-JPEG AVI) and, as the video decodes them (the codec is lossy), as a folder of
+// images whose names are not timestamps, so that the folder is taken at 20 Hz, as the video was
+// written.
+struct Clip {
+  SynthReport synth;
+  fs::path video, folder;
+  std::size_t frames = 0;
+};
+
+Clip write_clip(const fs::path& root, int frames, std::uint64_t seed) {
+  Clip clip;
+  SynthOptions o = small_rotation(seed);
+  o.frames = frames;
+  clip.synth = write_synthetic_sequence(root / "seq", o);
+  std::vector<cv::Mat> images;
+  for (const auto t : clip.synth.camera_t_ns) {
+    images.push_back(cv::imread((clip.synth.mav0 / "cam0" / "data" / (std::to_string(t) + ".png")).string(), cv::IMREAD_COLOR));
+    if (images.back().empty()) throw std::runtime_error("synth wrote an unreadable frame");
   }
-  fs::path video = root / "clip.mp4";
+  clip.frames = images.size();
+  clip.video = root / "clip.mp4";
   {
-    cv::VideoWriter writer(video.string(), cv::VideoWriter::fourcc('m', 'p', '4', 'v'), 20.0, frames[0].size());
+    cv::VideoWriter writer(clip.video.string(), cv::VideoWriter::fourcc('m', 'p', '4', 'v'), 20.0, images[0].size());
     if (!writer.isOpened()) {
-      video = root / "clip.avi";
-      writer.open(video.string(), cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 20.0, frames[0].size());
+      clip.video = root / "clip.avi";
+      writer.open(clip.video.string(), cv::VideoWriter::fourcc('M', 'J', 'P', 'G'), 20.0, images[0].size());
     }
-    ASSERT_TRUE(writer.isOpened()) << "this OpenCV writes neither MP4 nor MJPG AVI";
-    for (const auto& f : frames) writer.write(f);
+    if (!writer.isOpened()) throw std::runtime_error("this OpenCV writes neither MP4 nor MJPG AVI");
+    for (const auto& f : images) writer.write(f);
   }
-  // The folder holds the frames as the video decodes them (the codec is lossy): names without
-  // timestamps, so the folder is taken at 20 Hz, as the video was written.
-  fs::create_directories(root / "folder");
-  {
-    cv::VideoCapture capture(video.string());
-    cv::Mat f;
-    for (int i = 0; capture.read(f); ++i) {
-      char name[32];
-      std::snprintf(name, sizeof name, "frame%03d.png", i);
-      ASSERT_TRUE(cv::imwrite((root / "folder" / name).string(), f));
-    }
+  clip.folder = root / "folder";
+  fs::create_directories(clip.folder);
+  cv::VideoCapture capture(clip.video.string());
+  cv::Mat f;
+  for (int i = 0; capture.read(f); ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "frame%03d.png", i);
+    if (!cv::imwrite((clip.folder / name).string(), f)) throw std::runtime_error("could not write " + std::string(name));
   }
+  return clip;
+}
 
-  auto from_video = open_frame_source(video);
-  auto from_folder = open_frame_source(root / "folder");
-  ASSERT_EQ(from_video->size(), frames.size());
-  ASSERT_EQ(from_folder->size(), frames.size());
-  EXPECT_TRUE(from_video->notes().empty());  // the container's own times
-  ASSERT_EQ(from_folder->notes().size(), 1u);
-  EXPECT_NE(from_folder->notes()[0].find("not nanosecond timestamps"), std::string::npos) << from_folder->notes()[0];
-  for (std::size_t i = 0; i < frames.size(); ++i) EXPECT_EQ(from_video->timestamp_ns(i), static_cast<std::int64_t>(i) * 50'000'000);
-  EXPECT_EQ(from_video->decode(0).width, 188);  // as predict --fx does, to learn the size
-
+CameraIntrinsics intrinsics_of(const SynthReport& synth) {
   CameraIntrinsics camera;
   camera.width = 188;
   camera.height = 120;
@@ -187,9 +188,32 @@ TEST(RealCameras, VideoGivesTheRatesOfItsFramesAsAFolder) {
   camera.fy = synth.intrinsics[1];
   camera.cx = synth.intrinsics[2];
   camera.cy = synth.intrinsics[3];
+  return camera;
+}
+
+// A video and the same decoded frames as a folder of images give the same rates at the same
+// times; the video's times come from the container, and predict's look at frame 0 before the run
+// no longer breaks it.
+TEST(RealCameras, VideoGivesTheRatesOfItsFramesAsAFolder) {
+  const Clip clip = write_clip(testing::temporary_directory("video"), 10, 7);
+  const SynthReport& synth = clip.synth;
+  const fs::path& video = clip.video;
+  const std::size_t frames = clip.frames;
+
+  auto from_video = open_frame_source(video);
+  auto from_folder = open_frame_source(clip.folder);
+  ASSERT_EQ(from_video->size(), frames);
+  ASSERT_EQ(from_folder->size(), frames);
+  EXPECT_TRUE(from_video->notes().empty());  // the container's own times
+  ASSERT_EQ(from_folder->notes().size(), 1u);
+  EXPECT_NE(from_folder->notes()[0].find("not nanosecond timestamps"), std::string::npos) << from_folder->notes()[0];
+  for (std::size_t i = 0; i < frames; ++i) EXPECT_EQ(from_video->timestamp_ns(i), static_cast<std::int64_t>(i) * 50'000'000);
+  EXPECT_EQ(from_video->decode(0).width, 188);  // as predict --fx does, to learn the size
+
+  const CameraIntrinsics camera = intrinsics_of(synth);
   const RatesTable a = predict(*from_video, camera, std::nullopt);
   const RatesTable b = predict(*from_folder, camera, std::nullopt);
-  ASSERT_EQ(a.size(), frames.size() - 1);
+  ASSERT_EQ(a.size(), frames - 1);
   ASSERT_EQ(b.size(), a.size());
   for (std::size_t i = 0; i < a.size(); ++i) {
     EXPECT_EQ(a.t_ns[i], b.t_ns[i]);
@@ -204,6 +228,49 @@ TEST(RealCameras, VideoGivesTheRatesOfItsFramesAsAFolder) {
   ASSERT_EQ(overridden->notes().size(), 1u);
   EXPECT_NE(overridden->notes()[0].find("overrides"), std::string::npos);
   EXPECT_EQ(overridden->timestamp_ns(1), 40'000'000);
+}
+
+// `eval --imu FILE` on a video and on its frames as a folder: the IMU file on the video's clock
+// (the synthetic IMU shifted to start with the first frame at 0), its rotation to the camera
+// from the synthetic cam0/sensor.yaml's T_BS (inverted). The two give the same errors, in the body
+// and in the camera frame, and they are errors of a few deg/s, as the codec allows.
+TEST(RealCameras, VideoWithAnImuFileEvaluatesAsItsFolder) {
+  const Clip clip = write_clip(testing::temporary_directory("video_imu"), 12, 11);
+  const fs::path imu_csv = clip.folder.parent_path() / "imu.csv";
+  {
+    const auto imu = read_imu_csv(clip.synth.mav0 / "imu0" / "data.csv");
+    std::ofstream out(imu_csv);
+    out.precision(17);
+    out << "#timestamp [ns],w_RS_S_x [rad s^-1],w_RS_S_y [rad s^-1],w_RS_S_z [rad s^-1],a_RS_S_x [m s^-2],"
+           "a_RS_S_y [m s^-2],a_RS_S_z [m s^-2]\n";
+    for (const auto& s : imu) {
+      out << s.t_ns - clip.synth.camera_t_ns.front() << "," << s.gyro[0] << "," << s.gyro[1] << "," << s.gyro[2] << ","
+          << s.accel[0] << "," << s.accel[1] << "," << s.accel[2] << "\n";
+    }
+  }
+  ImuSequenceOptions input;
+  input.imu_csv = imu_csv;
+  input.camera_imu = parse_camera_imu((clip.synth.mav0 / "cam0" / "sensor.yaml").string());
+  const CameraIntrinsics camera = intrinsics_of(clip.synth);
+  auto video = open_frame_source(clip.video);
+  auto folder = open_frame_source(clip.folder);
+  const RatesTable from_video = predict(*video, camera, std::nullopt);
+  const RatesTable from_folder = predict(*folder, camera, std::nullopt);
+  for (const bool camera_frame : {false, true}) {
+    EvalOptions options;
+    options.choose_target = true;
+    options.sync.camera_frame = camera_frame;
+    options.sync.bias = BiasSource::None;
+    const EvalReport a = evaluate(from_video, read_sequence_with_imu(clip.video, input), options);
+    const EvalReport b = evaluate(from_folder, read_sequence_with_imu(clip.folder, input), options);
+    ASSERT_EQ(a.frames_evaluated(), clip.frames - 1);
+    ASSERT_EQ(b.frames_evaluated(), a.frames_evaluated());
+    EXPECT_TRUE(a.predictions_rotated != camera_frame);  // camera-frame rates turned for a body-frame comparison
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_NEAR(a.raw.rmse[k], b.raw.rmse[k], 1e-4) << "axis " << k << (camera_frame ? ", camera frame" : "");
+      EXPECT_LT(a.raw.rmse[k], 3.0) << "axis " << k << (camera_frame ? ", camera frame" : "");
+    }
+  }
 }
 
 }  // namespace

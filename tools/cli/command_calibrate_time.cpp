@@ -1,12 +1,13 @@
 // `inertialnet calibrate-time SEQ [RATES.csv]`: the camera–IMU time offset of a EuRoC-layout
-// sequence, estimated by aligning predicted rates with its gyro (include/inertialnet/eval/
-// time_offset.hpp). Without a rates file the weight-free path (DIS flow + geometric head)
-// predicts them first.
+// sequence, or of an image folder or a video with --imu FILE, estimated by aligning predicted
+// rates with its gyro (include/inertialnet/eval/time_offset.hpp). Without a rates file the
+// weight-free path (DIS flow + geometric head) predicts them first.
 #include <iostream>
 #include <memory>
 
 #include "commands.hpp"
 #include "console.hpp"
+#include "input_options.hpp"
 #include "inertialnet/eval/evaluate.hpp"
 #include "inertialnet/io/euroc.hpp"
 #include "inertialnet/io/rates_csv.hpp"
@@ -19,14 +20,25 @@ namespace {
 struct CalibrateTimeOptions {
   std::string sequence, rates, head;
   double range = 0.2;
+  IntrinsicsCliOptions camera;
+  ImuCliOptions input;
 };
 
 // Weight-free rates of every frame pair, set up as `inertialnet predict SEQ` sets them up (the
 // library's Prediction: DIS flow + geometric head, in the body frame when cam0 gives T_BS).
-RatesTable predict_weight_free(const std::string& sequence, const EurocSequence& seq, const GlobalOptions& global) {
-  if (!seq.camera) throw invalid_input("calibrate-time: " + sequence + " has no cam0/sensor.yaml to predict with.");
+RatesTable predict_weight_free(const CalibrateTimeOptions& o, const EurocSequence& seq, const GlobalOptions& global) {
+  const bool given = o.camera.fx > 0 || o.camera.fy > 0;
+  if (!seq.camera && !given) {
+    throw invalid_input("calibrate-time: " + o.sequence + (seq.mav0.empty() ? " has no camera calibration" : " has no cam0/sensor.yaml") +
+                        " to predict with; give --fx (and --fy --cx --cy), or a rates file.");
+  }
   PredictSettings settings;
-  settings.sequence = sequence;
+  settings.sequence = o.sequence;
+  settings.fx = o.camera.fx;
+  settings.fy = o.camera.fy;
+  settings.cx = o.camera.cx;
+  settings.cy = o.camera.cy;
+  settings.rate_hz = o.input.rate_hz;
   settings.device = global.device;
   settings.no_cache = global.no_cache;
   Prediction prediction(settings);
@@ -44,26 +56,39 @@ RatesTable predict_weight_free(const std::string& sequence, const EurocSequence&
 
 Command register_calibrate_time(CLI::App& app, const GlobalOptions& global) {
   auto o = std::make_shared<CalibrateTimeOptions>();
-  app.add_option("sequence", o->sequence, "EuRoC-layout sequence with mav0/imu0")->required()->check(CLI::ExistingDirectory);
+  app.add_option("sequence", o->sequence, "EuRoC-layout sequence with mav0/imu0, or an image folder or video with --imu")
+      ->required()
+      ->check(CLI::ExistingPath);
   app.add_option("rates", o->rates, "rates CSV written by predict (default: predict weight-free now)")
       ->check(CLI::ExistingFile);
   app.add_option("--range", o->range, "search +-this many seconds")->capture_default_str();
   app.add_option("--head", o->head, "use columns wx<_HEAD>…, e.g. --head geometric");
+  add_imu_options(app, o->input);
+  add_intrinsics_options(app, o->camera);
   return [o, &global]() {
     EvalOptions options;
     options.choose_target = true;
     options.estimate_time_offset = true;
     options.time_offset_search.range_s = o->range;
     if (!o->head.empty()) options.head_suffix = "_" + o->head;
-    EurocReadOptions read;
-    read.check_images = false;
-    const EurocSequence seq = read_euroc(o->sequence, read);
-    const RatesTable rates = o->rates.empty() ? predict_weight_free(o->sequence, seq, global) : read_rates_csv(o->rates);
+    options.input = imu_sequence_options(o->input);
+    const EurocSequence seq = read_sequence_with_imu(o->sequence, options.input);
+    for (const auto& note : seq.notes) info(note);
+    const RatesTable rates = o->rates.empty() ? predict_weight_free(*o, seq, global) : read_rates_csv(o->rates);
     const EvalReport report = evaluate(rates, seq, options);
     const TimeOffsetEstimate& e = *report.time_offset_estimate;
     std::cout << e.summary() << "\n";
+    if (options.input.camera_imu && options.input.camera_imu->timeshift_cam_imu_s) {
+      std::printf("the camchain states timeshift_cam_imu %+.3f ms (same sign: t_imu = t_cam + shift)\n",
+                  *options.input.camera_imu->timeshift_cam_imu_s * 1e3);
+    }
     std::printf("time_offset_s %.6f\nstd_error_s %.6f\nconfidence %s\n", e.offset_s, e.std_error_s, e.confidence().c_str());
-    std::cout << "apply it with: inertialnet eval RATES.csv " << o->sequence << " --time-offset " << e.offset_s << "\n";
+    std::string input;
+    if (!o->input.imu.empty()) input += " --imu " + o->input.imu;
+    if (!o->input.T_cam_imu.empty()) input += " --T-cam-imu '" + o->input.T_cam_imu + "'";
+    if (!o->input.camchain.empty()) input += " --camchain " + o->input.camchain;
+    std::cout << "apply it with: inertialnet eval RATES.csv " << o->sequence << input << " --time-offset " << e.offset_s
+              << "\n";
     for (const auto& w : report.warnings) warning(w);
     return 0;
   };

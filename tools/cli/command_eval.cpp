@@ -7,6 +7,7 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "console.hpp"
+#include "input_options.hpp"
 #include "inertialnet/eval/evaluate.hpp"
 #include "inertialnet/io/rates_csv.hpp"
 
@@ -17,13 +18,16 @@ struct EvalCliOptions {
   std::string rates, sequence, plot, target, gyro_bias, head, time_offset, readout_time;
   double offset_range = 0.2;
   bool json = false, series = false, camera_frame = false;
+  ImuCliOptions input;
 };
 }  // namespace
 
 Command register_eval(CLI::App& app, const GlobalOptions&) {
   auto o = std::make_shared<EvalCliOptions>();
   app.add_option("rates", o->rates, "rates CSV written by predict")->required()->check(CLI::ExistingFile);
-  app.add_option("sequence", o->sequence, "EuRoC sequence with mav0/imu0")->required()->check(CLI::ExistingDirectory);
+  app.add_option("sequence", o->sequence, "EuRoC sequence with mav0/imu0, or an image folder or video with --imu")
+      ->required()
+      ->check(CLI::ExistingPath);
   app.add_option("--plot", o->plot,
                  "write time-series plots to this PNG (and histograms beside it, *_hist.png; folders created as "
                  "needed)");
@@ -40,7 +44,9 @@ Command register_eval(CLI::App& app, const GlobalOptions&) {
                  "rolling-shutter readout time in seconds (rates belong to mid-exposure); default: the rates file's");
   app.add_option("--gyro-bias", o->gyro_bias, "gyro bias x,y,z in rad/s (IMU frame), or auto: a constant fitted against the predictions by least squares; "
                  "default: ground truth, else a static start (vibration allowed when the images show no rotation)");
-  app.add_flag("--camera-frame", o->camera_frame, "rotate the gyro into the camera frame with cam0's T_BS");
+  app.add_flag("--camera-frame", o->camera_frame,
+               "rotate the gyro into the camera frame with cam0's T_BS (or --T-cam-imu / --camchain)");
+  add_imu_options(app, o->input);
   app.add_option("--head", o->head, "compare columns wx<_HEAD>…, e.g. --head geometric");
   auto* json = app.add_flag("--json", o->json, "machine-readable report (schema inertialnet.eval/1, docs/cli.md)");
   app.add_flag("--series", o->series, "include the per-frame values in the --json report")->needs(json);
@@ -62,6 +68,7 @@ Command register_eval(CLI::App& app, const GlobalOptions&) {
       options.sync.bias = BiasSource::Given;
       options.sync.gyro_bias = parse_vec3(o->gyro_bias, "--gyro-bias");
     }
+    options.input = imu_sequence_options(o->input);
     options.plot = o->plot;
     if (!o->plot.empty()) prepare_output_file(o->plot, "--plot");
     // A CSV from `predict --head both` holds two estimators: without --head, report both.

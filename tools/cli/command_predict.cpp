@@ -6,11 +6,11 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
-#include <sstream>
 
 #include "commands.hpp"
 #include "common.hpp"
 #include "console.hpp"
+#include "input_options.hpp"
 #include "interrupt.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/runtime/layer_profiler.hpp"
@@ -33,7 +33,7 @@ struct PredictOptions {
   std::string flow;   // "" = flownet2 with weights, dis without
   std::string head;   // "" = inertialnet with weights, geometric without
   std::string solver = "motion-field";
-  double fx = 0, fy = 0, cx = 0, cy = 0;
+  IntrinsicsCliOptions camera;
   std::string output;
   std::string save_flow;
   std::string flow_format = "flo";
@@ -62,33 +62,6 @@ void save_flow(const std::filesystem::path& folder, const std::string& format, s
 
 Command register_predict(CLI::App& app, const GlobalOptions& global) {
   auto o = std::make_shared<PredictOptions>();
-  // NaN passes "> 0" tests as false and was then taken for "not given": refuse it where it is read.
-  // The upper bounds are far beyond any camera yet keep later products (fx·dt, 1/rate) finite.
-  const auto finite_positive_up_to = [](double limit, const char* unit) {
-    return CLI::Validator(
-        [limit, unit](std::string& text) {
-          double value = 0;
-          if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || !(value > 0)) {
-            return "must be a finite positive number, got " + text;
-          }
-          if (value > limit) {
-            std::ostringstream s;
-            s << "must be at most " << limit << " " << unit << ", got " << text;
-            return s.str();
-          }
-          return std::string();
-        },
-        "POSITIVE");
-  };
-  const CLI::Validator finite(
-      [](std::string& text) {
-        double value = 0;
-        if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value)) return "must be a finite number, got " + text;
-        if (std::abs(value) > 1e6) return "must be at most 1e+06 pixels from the origin, got " + text;
-        return std::string();
-      },
-      "NUMBER");
-  const CLI::Validator focal = finite_positive_up_to(1e6, "pixels");
   app.add_option("sequence", o->sequence, "EuRoC folder, image folder or video")->required();
   app.add_option("-w,--weights", o->weights,
                  "weights (safetensors) holding FlowNet2 and/or the InertialNet head; repeat for several files");
@@ -100,10 +73,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
   app.add_option("--solver", o->solver, "geometric head's solver")
       ->capture_default_str()
       ->transform(choice("solver", {"motion-field", "opengv"}));
-  app.add_option("--fx", o->fx, "focal length x (px), when the sequence has no sensor.yaml")->check(focal);
-  app.add_option("--fy", o->fy, "focal length y (px)")->check(focal);
-  app.add_option("--cx", o->cx, "principal point x (px)")->check(finite);
-  app.add_option("--cy", o->cy, "principal point y (px)")->check(finite);
+  add_intrinsics_options(app, o->camera);
   app.add_option("-o,--output", o->output, "rates CSV to write, folders created as needed (default: standard output)");
   auto* save_flow_option = app.add_option(
       "--save-flow", o->save_flow, "write each pair's flow as <timestamp>.flo (or .png) into this folder (created as needed)");
@@ -143,10 +113,10 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
     settings.flow = o->flow;
     settings.head = o->head;
     settings.solver = o->solver;
-    settings.fx = o->fx;
-    settings.fy = o->fy;
-    settings.cx = o->cx;
-    settings.cy = o->cy;
+    settings.fx = o->camera.fx;
+    settings.fy = o->camera.fy;
+    settings.cx = o->camera.cx;
+    settings.cy = o->camera.cy;
     settings.rate_hz = o->rate_hz;
     if (!o->readout_time.empty()) settings.readout_time_s = parse_seconds(o->readout_time, "--readout-time");
     if (!o->time_offset.empty()) settings.time_offset_s = parse_seconds(o->time_offset, "--time-offset");

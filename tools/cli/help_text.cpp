@@ -28,10 +28,13 @@ std::string help_examples(const std::string& subcommand) {
        "  inertialnet eval rates.csv data/seq\n"
        "  inertialnet eval rates.csv data/seq --plot out/rates.png --target mean\n"
        "  inertialnet eval rates.csv data/seq --json --series > report.json\n"
-       "  inertialnet eval rates.csv data/seq --time-offset auto --gyro-bias auto\n"},
+       "  inertialnet eval rates.csv data/seq --time-offset auto --gyro-bias auto\n"
+       "  inertialnet eval rates.csv clip.mp4 --imu imu.csv --camchain camchain-imucam.yaml  # Kalibr's calibration\n"
+       "  inertialnet eval rates.csv frames/ --imu imu.csv --T-cam-imu '0 -1 0 0  1 0 0 0  0 0 1 0  0 0 0 1'\n"},
       {"calibrate-time",
        "  inertialnet calibrate-time data/seq                  # predicts weight-free, then estimates\n"
-       "  inertialnet calibrate-time data/seq rates.csv --range 0.3\n"},
+       "  inertialnet calibrate-time data/seq rates.csv --range 0.3\n"
+       "  inertialnet calibrate-time clip.mp4 --imu imu.csv --camchain camchain-imucam.yaml --fx 458\n"},
       {"viz",
        "  inertialnet viz out/flows/*.flo -o out/pictures --shared-scale   # one scale for a sequence\n"
        "  inertialnet viz ab.flo --legend --max-magnitude 20\n"},

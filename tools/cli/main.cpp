@@ -54,7 +54,7 @@ int main(int argc, char** argv) {
       {"devices", "list the OpenCL platforms and devices", cli::register_devices},
       {"flow", "optical flow between two images (FlowNet2 family, or DIS without weights)", cli::register_flow},
       {"predict", "angular rates for every frame pair of a sequence", cli::register_predict},
-      {"eval", "the paper's metrics for a rates CSV against a EuRoC sequence", cli::register_eval},
+      {"eval", "the paper's metrics for a rates CSV against a sequence's gyro (EuRoC, or --imu FILE)", cli::register_eval},
       {"calibrate-time", "estimate the camera-IMU time offset of a sequence from its images and gyro",
        cli::register_calibrate_time},
       {"viz", "flow files (.flo, KITTI PNG) as colour-wheel pictures", cli::register_viz},

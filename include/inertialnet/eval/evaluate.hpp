@@ -13,7 +13,8 @@
 //   estimator  — with `choose_target`, an inter-frame estimator is compared with the gyro's mean
 //                over the frame interval and a network with the spline at t_k;
 //   time_offset_s, readout_time_s — the camera–IMU offset plus half the readout time shift the
-//                targets onto the IMU clock (time_offset.hpp), unless the options override them.
+//                targets onto the IMU clock (time_offset.hpp), unless the options override them
+//                (a camera–IMU calibration's timeshift_cam_imu counts as an option's offset).
 // With `estimate_time_offset` the offset is estimated from the data first (time_offset.hpp) and
 // then applied; the estimate is reported.
 #pragma once
@@ -27,6 +28,7 @@
 #include <vector>
 
 #include "inertialnet/io/euroc.hpp"
+#include "inertialnet/io/imu_sequence.hpp"
 #include "inertialnet/eval/imu_sync.hpp"
 #include "inertialnet/eval/metrics.hpp"
 #include "inertialnet/eval/plots.hpp"
@@ -51,6 +53,10 @@ struct EvalOptions {
   std::optional<double> readout_time_s;
   bool estimate_time_offset = false;
   TimeOffsetOptions time_offset_search;
+  // How the overload taking paths reads the sequence (an IMU file, the camera–IMU calibration,
+  // the frame rate of a folder or a video: imu_sequence.hpp). In both overloads a calibration's
+  // timeshift_cam_imu is the time offset unless time_offset_s is given (over the rates file's).
+  ImuSequenceOptions input;
 };
 
 struct EvalReport {
@@ -121,7 +127,8 @@ std::string format_eval_json(const std::vector<EvalReport>& reports, bool includ
 
 // Throws invalid_input when no rates row matches a frame with ground truth.
 EvalReport evaluate(const RatesTable& rates, const EurocSequence& sequence, const EvalOptions& options = {});
-// Reads both; the images themselves are not needed and not checked.
+// Reads both (the sequence with read_sequence_with_imu and options.input); the images themselves
+// are not needed and not checked.
 EvalReport evaluate(const std::filesystem::path& rates_csv, const std::filesystem::path& sequence,
                     const EvalOptions& options = {});
 

@@ -111,8 +111,9 @@ GyroTruth sync_gyro(const std::vector<std::int64_t>& camera_t_ns, const std::vec
 // A EuRoC sequence's camera frames, IMU, ground truth and calibration.
 GyroTruth sync_gyro(const EurocSequence& sequence, const SyncOptions& options);
 
-// Rotation from the IMU frame to the camera frame of a sequence, R_BS,camᵀ · R_BS,imu. Throws
-// invalid_input when the camera's sensor.yaml was not found.
+// Rotation from the IMU frame to the camera frame of a sequence: the one given with an IMU file
+// (sequence.imu_to_camera, imu_sequence.hpp), else R_BS,camᵀ · R_BS,imu. Throws invalid_input
+// when neither it nor the camera's sensor.yaml is there.
 Mat3 imu_to_camera_rotation(const EurocSequence& sequence);
 
 }  // namespace inertialnet

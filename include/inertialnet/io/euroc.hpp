@@ -74,6 +74,10 @@ struct EurocSequence {
   std::optional<Mat3> imu_rotation_BS;                // imu0/sensor.yaml's R_BS when present (identity in EuRoC)
   std::optional<std::vector<GroundTruthSample>> ground_truth;
   std::vector<std::string> warnings;                  // timestamp gaps and the like, one sentence each
+  // For an input with an IMU file (imu_sequence.hpp): R_cam_imu, IMU → camera, which then stands
+  // for the sensor.yaml pair in imu_to_camera_rotation(); the body frame is the IMU frame.
+  std::optional<Mat3> imu_to_camera;
+  std::vector<std::string> notes;                     // what was assumed in reading it, one sentence each
 };
 
 // True when `root` is a mav0 folder or contains one (`root/mav0/`).

@@ -1,0 +1,35 @@
+// A sequence with its gyro for evaluation, whatever the input: a EuRoC folder as read_euroc reads
+// it, or a folder of images or a video with an IMU file beside it (`eval --imu FILE`).
+//
+// The IMU file is an EuRoC-format CSV (`#timestamp [ns],w_RS_S_x [rad s^-1],…,a_RS_S_z [m s^-2]`),
+// read and checked by read_imu_csv as mav0/imu0/data.csv is. Its timestamps must be on the frames'
+// clock: a folder's nanosecond file names (or i·1e9/rate), a video's frame times (from its first
+// frame, usually 0) — a constant difference is the camera–IMU time offset.
+//
+// The IMU frame is the body frame. For a folder or a video, the rotation to the camera is the
+// calibration given (camera_imu.hpp) or, without one, the identity (a note says so); frame times
+// are the ones predict stamps (open_frame_source with the same rate). For a EuRoC folder the IMU
+// file replaces mav0/imu0/data.csv (a note says so) and is taken to be in imu0's frame: cam0's
+// T_BS keeps giving the rotation (a calibration given is refused, invalid_input), and the ground
+// truth's gyro bias, which belongs to imu0, is not used.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+
+#include "inertialnet/io/camera_imu.hpp"
+#include "inertialnet/io/euroc.hpp"
+
+namespace inertialnet {
+
+struct ImuSequenceOptions {
+  std::filesystem::path imu_csv;                   // empty: EuRoC's imu0 (required for other inputs)
+  std::optional<CameraImuCalibration> camera_imu;  // IMU → camera for a folder or a video
+  std::optional<double> rate_hz;                   // as predict's --rate, for a folder or a video
+};
+
+// Frames (timestamps only; images are not decoded, a video is read once for its frame times),
+// IMU samples, and what relates them; notes and warnings in the returned sequence.
+EurocSequence read_sequence_with_imu(const std::filesystem::path& sequence, const ImuSequenceOptions& options = {});
+
+}  // namespace inertialnet

@@ -1,0 +1,113 @@
+# An IMU file for any input (`eval --imu FILE`, `calibrate-time --imu FILE`): the frames of a
+# synthetic EuRoC sequence as a plain folder of images (mav0/cam0/data, nanosecond names), its
+# imu0/data.csv given with --imu and the rotation to the camera given three ways (16 numbers,
+# cam0/sensor.yaml's T_BS, a Kalibr camchain written here in Kalibr's layout), must give the
+# RMSE of the EuRoC path: the same rates, rotated by the same matrix, against the same gyro.
+#   cmake -DCLI=<inertialnet> -DWORK=<scratch dir> -P imu_file.cmake
+include(${CMAKE_CURRENT_LIST_DIR}/run_helpers.cmake)
+file(REMOVE_RECURSE "${WORK}")
+file(MAKE_DIRECTORY "${WORK}")
+
+run(0 ${CLI} synth seq --frames 20 --size 188x120 --seed 3)
+file(READ "${WORK}/seq/mav0/cam0/sensor.yaml" yaml)
+if(NOT yaml MATCHES "intrinsics: \\[([^,]+), ([^,]+), ([^,]+), ([^]]+)\\]")
+  message(FATAL_ERROR "no intrinsics in the synthetic sensor.yaml")
+endif()
+set(intrinsics --fx ${CMAKE_MATCH_1} --fy ${CMAKE_MATCH_2} --cx ${CMAKE_MATCH_3} --cy ${CMAKE_MATCH_4})
+set(imu --imu seq/mav0/imu0/data.csv)
+# The inverse of synth's (EuRoC's) cam0 T_BS: IMU → camera.
+set(row0 "0.0148655429818, 0.999557249008, -0.0257744366974, 0.06522290953550845")
+set(row1 "-0.999880929698, 0.0149672133247, 0.00375618835797, -0.020706385492708257")
+set(row2 "0.00414029679422, 0.025715529948, 0.999660727178, -0.008054602460028365")
+set(row3 "0.0, 0.0, 0.0, 1.0")
+function(write_camchain name shift)
+  file(WRITE "${WORK}/${name}"
+       "cam0:\n  T_cam_imu:\n  - [${row0}]\n  - [${row1}]\n  - [${row2}]\n  - [${row3}]\n  cam_overlaps: []\n"
+       "  camera_model: pinhole\n  distortion_coeffs: [0.0, 0.0, 0.0, 0.0]\n  distortion_model: radtan\n"
+       "  intrinsics: [114.6635, 114.324, 91.42875, 61.71875]\n  resolution: [188, 120]\n"
+       "  rostopic: /cam0/image_raw\n  timeshift_cam_imu: ${shift}\n")
+endfunction()
+write_camchain(camchain.yaml 0.0)
+write_camchain(camchain_shift.yaml 0.004)
+
+run(0 ${CLI} predict seq -o euroc.csv)
+run(0 ${CLI} predict seq/mav0/cam0/data ${intrinsics} -o folder.csv)
+
+# rmse_of(<var> <json>): "x y z" of the raw RMSE of the document's first estimator.
+function(rmse_of var document)
+  set(values "")
+  foreach(axis x y z)
+    expect_json("${document}" estimators 0 raw rmse_deg_s ${axis})
+    list(APPEND values "${value}")
+  endforeach()
+  set(${var} "${values}" PARENT_SCOPE)
+endfunction()
+function(expect_same_rmse expected actual what)
+  foreach(k 0 1 2)
+    list(GET expected ${k} e)
+    list(GET actual ${k} a)
+    # CMake has no floating-point arithmetic: the values agree to five decimals, compared as text.
+    string(REGEX MATCH "^-?[0-9]+\\.[0-9][0-9][0-9][0-9][0-9]" e6 "${e}")
+    string(REGEX MATCH "^-?[0-9]+\\.[0-9][0-9][0-9][0-9][0-9]" a6 "${a}")
+    if(NOT e6 STREQUAL a6)
+      message(FATAL_ERROR "${what}: RMSE ${actual} deg/s, the EuRoC path gives ${expected}")
+    endif()
+  endforeach()
+endfunction()
+
+foreach(frame "" "--camera-frame")
+  run(0 ${CLI} eval euroc.csv seq --json ${frame})
+  rmse_of(reference "${output}")
+  run(0 ${CLI} eval folder.csv seq/mav0/cam0/data ${imu} --T-cam-imu "${row0}, ${row1}, ${row2}, ${row3}" --json ${frame})
+  rmse_of(numbers "${output}")
+  expect_same_rmse("${reference}" "${numbers}" "--T-cam-imu NUMBERS ${frame}")
+  expect_json("${output}" estimators 0 rates_frame)
+  if(NOT value STREQUAL "camera")
+    message(FATAL_ERROR "the folder's rates should state the camera frame, not ${value}")
+  endif()
+  run(0 ${CLI} eval folder.csv seq/mav0/cam0/data ${imu} --T-cam-imu seq/mav0/cam0/sensor.yaml --json ${frame})
+  rmse_of(sensor_yaml "${output}")
+  expect_same_rmse("${reference}" "${sensor_yaml}" "--T-cam-imu sensor.yaml ${frame}")
+  run(0 ${CLI} eval folder.csv seq/mav0/cam0/data ${imu} --camchain camchain.yaml --json ${frame})
+  rmse_of(camchain "${output}")
+  expect_same_rmse("${reference}" "${camchain}" "--camchain ${frame}")
+endforeach()
+
+# The text report says where the rotation came from; without one, the IMU frame is the camera's.
+run(0 ${CLI} eval folder.csv seq/mav0/cam0/data ${imu} --camchain camchain.yaml)
+expect_match("note: IMU to camera rotation from camchain.yaml \\(cam0\\)")
+expect_match("Predictions rotated from the camera frame \\(as the rates file states\\) into the body frame with the IMU-camera rotation given")
+run(0 ${CLI} eval folder.csv seq/mav0/cam0/data ${imu})
+expect_match("the IMU frame is taken to be the camera frame")
+
+# The camchain's timeshift_cam_imu is the time offset (t_imu = t_cam + shift) unless --time-offset.
+run(0 ${CLI} eval folder.csv seq/mav0/cam0/data ${imu} --camchain camchain_shift.yaml --json)
+expect_json("${output}" estimators 0 time_offset_s)
+if(NOT value EQUAL 0.004)
+  message(FATAL_ERROR "time_offset_s ${value}, expected the camchain's 0.004")
+endif()
+run(0 ${CLI} eval folder.csv seq/mav0/cam0/data ${imu} --camchain camchain_shift.yaml --time-offset 0 --json)
+expect_json("${output}" estimators 0 time_offset_s)
+if(NOT value EQUAL 0)
+  message(FATAL_ERROR "time_offset_s ${value}: --time-offset 0 should win over the camchain")
+endif()
+
+# A EuRoC sequence takes --imu in place of imu0/data.csv (the same file here: the same raw RMSE).
+run(0 ${CLI} eval euroc.csv seq --json)
+rmse_of(reference "${output}")
+run(0 ${CLI} eval euroc.csv seq ${imu} --json)
+rmse_of(replaced "${output}")
+expect_same_rmse("${reference}" "${replaced}" "EuRoC with --imu")
+expect_match("instead of [^\n]*imu0/data.csv, taken to be in imu0's frame")
+
+# calibrate-time on the folder: predicts with --fx …, and finds a 40 ms offset as on EuRoC input.
+run(0 ${CLI} synth late --frames 60 --size 188x120 --seed 5 --time-offset 0.04)
+run(0 ${CLI} calibrate-time late/mav0/cam0/data --imu late/mav0/imu0/data.csv --T-cam-imu seq/mav0/cam0/sensor.yaml ${intrinsics})
+expect_match("no rates file given: predicting 59 pairs")
+if(NOT output MATCHES "time_offset_s (-?[0-9.]+)")
+  message(FATAL_ERROR "no time_offset_s line")
+endif()
+if(CMAKE_MATCH_1 LESS 0.035 OR CMAKE_MATCH_1 GREATER 0.045)
+  message(FATAL_ERROR "time_offset_s ${CMAKE_MATCH_1}, expected 0.040 within 0.005")
+endif()
+expect_match("apply it with: inertialnet eval RATES.csv late/mav0/cam0/data --imu late/mav0/imu0/data.csv --T-cam-imu")

@@ -1,0 +1,74 @@
+#include "input_options.hpp"
+
+#include <cmath>
+#include <sstream>
+
+#include "inertialnet/io/camera_imu.hpp"
+#include "inertialnet/runtime/error.hpp"
+
+namespace inertialnet::cli {
+
+CLI::Validator finite_positive_up_to(double limit, const char* unit) {
+  return CLI::Validator(
+      [limit, unit](std::string& text) {
+        double value = 0;
+        if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || !(value > 0)) {
+          return "must be a finite positive number, got " + text;
+        }
+        if (value > limit) {
+          std::ostringstream s;
+          s << "must be at most " << limit << " " << unit << ", got " << text;
+          return s.str();
+        }
+        return std::string();
+      },
+      "POSITIVE");
+}
+
+CLI::Validator finite_pixel_coordinate() {
+  return CLI::Validator(
+      [](std::string& text) {
+        double value = 0;
+        if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value)) return "must be a finite number, got " + text;
+        if (std::abs(value) > 1e6) return "must be at most 1e+06 pixels from the origin, got " + text;
+        return std::string();
+      },
+      "NUMBER");
+}
+
+void add_intrinsics_options(CLI::App& app, IntrinsicsCliOptions& o) {
+  const CLI::Validator focal = finite_positive_up_to(1e6, "pixels");
+  app.add_option("--fx", o.fx, "focal length x (px), when the sequence has no sensor.yaml")->check(focal);
+  app.add_option("--fy", o.fy, "focal length y (px)")->check(focal);
+  app.add_option("--cx", o.cx, "principal point x (px)")->check(finite_pixel_coordinate());
+  app.add_option("--cy", o.cy, "principal point y (px)")->check(finite_pixel_coordinate());
+}
+
+void add_imu_options(CLI::App& app, ImuCliOptions& o) {
+  app.add_option("--imu", o.imu,
+                 "IMU CSV in EuRoC's format (timestamp [ns], gyro x y z [rad/s], accel x y z [m/s^2]) on the frames' "
+                 "clock, for an image folder or a video; for a EuRoC folder it replaces mav0/imu0/data.csv")
+      ->check(CLI::ExistingFile);
+  auto* t = app.add_option("--T-cam-imu", o.T_cam_imu,
+                           "with --imu: IMU-to-camera transform, 16 numbers (4x4 row-major, Kalibr's T_cam_imu) or a "
+                           "YAML file with T_cam_imu (or T_BS as cam0/sensor.yaml writes it); default: identity");
+  auto* c = app.add_option("--camchain", o.camchain,
+                           "with --imu: a Kalibr camchain YAML; cam0's T_cam_imu, and its timeshift_cam_imu as the time "
+                           "offset (t_imu = t_cam + shift) unless --time-offset is given")
+                ->check(CLI::ExistingFile);
+  t->excludes(c);
+  app.add_option("--rate", o.rate_hz,
+                 "frame rate for image folders and videos without timestamps (Hz), as given to predict")
+      ->check(finite_positive_up_to(1e6, "Hz"));
+}
+
+ImuSequenceOptions imu_sequence_options(const ImuCliOptions& o) {
+  ImuSequenceOptions options;
+  options.imu_csv = o.imu;
+  if (o.rate_hz > 0) options.rate_hz = o.rate_hz;
+  if (!o.T_cam_imu.empty()) options.camera_imu = parse_camera_imu(o.T_cam_imu, "--T-cam-imu");
+  if (!o.camchain.empty()) options.camera_imu = read_kalibr_camchain(o.camchain);
+  return options;
+}
+
+}  // namespace inertialnet::cli

@@ -1,0 +1,35 @@
+// Options that say how to read an input that is not a EuRoC folder, shared by the commands that
+// take one: the checks of numbers a camera is described with, the camera intrinsics (--fx …) for
+// the weight-free path, and the IMU beside a folder of images or a video (--imu, --T-cam-imu,
+// --camchain, --rate; include/inertialnet/io/imu_sequence.hpp).
+#pragma once
+
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "inertialnet/io/imu_sequence.hpp"
+
+namespace inertialnet::cli {
+
+// NaN passes "> 0" tests as false and was then taken for "not given": refuse it where it is read.
+// The upper bounds are far beyond any camera yet keep later products (fx·dt, 1/rate) finite.
+CLI::Validator finite_positive_up_to(double limit, const char* unit);  // "must be a finite positive number, got …"
+CLI::Validator finite_pixel_coordinate();                              // within 1e6 pixels of the origin
+
+// --fx --fy --cx --cy (0: not given).
+struct IntrinsicsCliOptions {
+  double fx = 0, fy = 0, cx = 0, cy = 0;
+};
+void add_intrinsics_options(CLI::App& app, IntrinsicsCliOptions& o);
+
+// --imu FILE, --T-cam-imu M|FILE, --camchain FILE, --rate HZ.
+struct ImuCliOptions {
+  std::string imu, T_cam_imu, camchain;
+  double rate_hz = 0;
+};
+void add_imu_options(CLI::App& app, ImuCliOptions& o);
+// Reads the calibration given (invalid_input naming the option or file when it is bad).
+ImuSequenceOptions imu_sequence_options(const ImuCliOptions& o);
+
+}  // namespace inertialnet::cli
