@@ -80,12 +80,25 @@ void gemm(Queue& queue, GemmBackend backend, Transpose transpose_a, Transpose tr
     return;
   }
   cl_command_queue handle = queue.handle();
+  const ClSite site = queue.device().site("clblast/Xgemm");
   std::lock_guard<std::mutex> lock(clblast_mutex());
+  // CLBlast's indirect GEMM (sizes off its tiles) pads and transposes the operands into a
+  // temporary buffer; given none, it creates and releases one on every call: a driver allocation
+  // and free per layer per pair, churn in the host allocator on CPU devices. The queue's pool
+  // lends it instead, the same buffer every time a shape repeats. The in-order queue runs the
+  // kernels that use it before any later user of the recycled buffer.
+  std::size_t temp_bytes = 0;
+  check_clblast(static_cast<int>(clblast::GemmTempBufferSize<float>(
+                    clblast::Layout::kRowMajor, to_clblast(transpose_a), to_clblast(transpose_b), m, n, k, a.offset,
+                    a.leading_dimension, b.offset, b.leading_dimension, c.offset, c.leading_dimension, &handle,
+                    temp_bytes)),
+                "clblast::GemmTempBufferSize", site);
+  const std::shared_ptr<Buffer> temp = temp_bytes > 0 ? queue.buffers().acquire(temp_bytes) : nullptr;
   const auto status = clblast::Gemm<float>(clblast::Layout::kRowMajor, to_clblast(transpose_a), to_clblast(transpose_b),
                                            m, n, k, alpha, a.buffer, a.offset, a.leading_dimension, b.buffer, b.offset,
                                            b.leading_dimension, beta, c.buffer, c.offset, c.leading_dimension, &handle,
-                                           nullptr);
-  check_clblast(static_cast<int>(status), "clblast::Gemm", queue.device().site("clblast/Xgemm"));
+                                           nullptr, temp ? temp->handle() : nullptr);
+  check_clblast(static_cast<int>(status), "clblast::Gemm", site);
 }
 
 void gemm_strided_batched(Queue& queue, Transpose transpose_a, Transpose transpose_b, std::size_t m, std::size_t n,

@@ -70,8 +70,16 @@ void decode_loop(Schedule& s, FrameSource& source) {
   }
 }
 
-void lane_loop(Schedule& s, Device& device, int lane, const ProcessorFactory& factory) {
-  std::unique_ptr<PairProcessor> processor = factory(device, lane);
+// Peaks are summed too: the lanes may peak at the same moment.
+void add(BufferPoolStats& sum, const BufferPoolStats& lane) {
+  sum.bytes_in_use += lane.bytes_in_use;
+  sum.bytes_cached += lane.bytes_cached;
+  sum.peak_bytes_in_use += lane.peak_bytes_in_use;
+  sum.allocations += lane.allocations;
+  sum.reuses += lane.reuses;
+}
+
+void process_pairs(Schedule& s, Device& device, PairProcessor& processor) {
   std::unique_lock<std::mutex> lock(s.mutex);
   while (true) {
     s.changed.wait(lock, [&] { return s.stop || s.next_pair > s.last_pair || s.pair_in_window(s.next_pair); });
@@ -92,7 +100,7 @@ void lane_loop(Schedule& s, Device& device, int lane, const ProcessorFactory& fa
     result.t0_ns = previous->t_ns;
     result.t1_ns = current->t_ns;
     result.device = device.info().name;
-    processor->process(*previous, *current, result, s.stop);
+    processor.process(*previous, *current, result, s.stop);
 
     lock.lock();
     for (const auto& [stage, seconds] : result.seconds) s.stats.stage_seconds[stage] += seconds;
@@ -100,6 +108,14 @@ void lane_loop(Schedule& s, Device& device, int lane, const ProcessorFactory& fa
     s.finished.emplace(pair, std::move(result));
     s.changed.notify_all();
   }
+}
+
+// Lane `lane` of `device`: its processor, the pairs it takes, and its pool figures at the end.
+void lane_loop(Schedule& s, Device& device, int lane, const ProcessorFactory& factory) {
+  const std::unique_ptr<PairProcessor> processor = factory(device, lane);
+  process_pairs(s, device, *processor);
+  std::lock_guard<std::mutex> lock(s.mutex);
+  add(s.stats.temporaries, processor->temporaries());
 }
 
 }  // namespace
@@ -180,6 +196,7 @@ PipelineStats run_pipeline(FrameSource& source, const std::vector<Device*>& devi
     s.changed.notify_all();
   }
   for (auto& t : threads) t.join();
+  for (Device* device : devices) s.stats.device_buffers[device->info().summary()] = device->buffers().stats();
   s.stats.seconds = since(start);
   if (s.error && !s.stats.cancelled) std::rethrow_exception(s.error);
   return s.stats;

@@ -72,6 +72,8 @@ class RatesProcessor : public PairProcessor {
     }
   }
 
+  BufferPoolStats temporaries() const override { return queue_->buffers().stats(); }
+
  private:
   // Before OpenCV or the device sees the frames, whose own checks end in assertion text.
   void check_sizes(const Frame& previous, const Frame& current) const {

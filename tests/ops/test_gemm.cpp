@@ -45,6 +45,44 @@ INSTANTIATE_TEST_SUITE_P(
                       // FlowNetC conv1 at 64×64: 64 filters, 3·7·7 taps, 32·32 outputs.
                       GemmCase{64, 1024, 147, false, false, 0, 0}, GemmCase{3, 1000, 128, false, true, 0, 0}));
 
+// CLBlast's indirect GEMM (large products, here 1100³: above every device's direct-kernel limit
+// in CLBlast's database) needs a temporary buffer; it comes from the queue's pool, allocated on
+// the first call of a shape and reused by every later one (CLBlast would otherwise create and
+// release one per call), and it is back in the pool when the call returns.
+TEST(GemmClblast, TemporaryBufferComesFromTheQueuesPool) {
+  const auto queue = testing::test_device().create_queue();  // a pool of its own
+  const std::size_t m = 1100, n = 1100, k = 1100;
+  const auto a = testing::random_vector(m * k, 31);
+  const auto b = testing::random_vector(k * n, 32);
+  auto c = testing::random_vector(m * n, 33);
+  Tensor ta = Tensor::from_host(*queue, {static_cast<std::int64_t>(a.size())}, a);
+  Tensor tb = Tensor::from_host(*queue, {static_cast<std::int64_t>(b.size())}, b);
+  Tensor tc = Tensor::from_host(*queue, {static_cast<std::int64_t>(c.size())}, c);
+  auto run = [&] {
+    gemm(*queue, GemmBackend::CLBlast, Transpose::No, Transpose::No, m, n, k, 1.0f, MatrixView::of(ta, k),
+         MatrixView::of(tb, n), 0.0f, MatrixView::of(tc, n));
+    queue->finish();
+    return queue->buffers().stats();
+  };
+  const BufferPoolStats before = queue->buffers().stats();
+  const BufferPoolStats first = run();
+  EXPECT_EQ(first.allocations, before.allocations + 1);
+  EXPECT_EQ(first.bytes_in_use, before.bytes_in_use);
+  EXPECT_GT(first.bytes_cached, before.bytes_cached);
+  for (std::size_t i = 1; i <= 3; ++i) {
+    const BufferPoolStats again = run();
+    EXPECT_EQ(again.allocations, first.allocations);
+    EXPECT_EQ(again.reuses, first.reuses + i);
+    EXPECT_EQ(again.bytes_cached, first.bytes_cached);
+  }
+  // The result through the lent buffer, on the first rows (the reference loop is slow).
+  const std::size_t rows = 4;
+  reference::gemm(false, false, rows, n, k, 1.0f, a, 0, k, b, 0, n, 0.0f, c, 0, n);
+  const auto result = tc.to_host(*queue);
+  EXPECT_TRUE(testing::all_close(std::vector<float>(result.begin(), result.begin() + rows * n),
+                                 std::vector<float>(c.begin(), c.begin() + rows * n), 1e-5, std::sqrt(double(k))));
+}
+
 TEST(GemmBatched, StridedBatchesMatchTheReference) {
   Queue& queue = testing::test_queue();
   const std::size_t m = 13, n = 19, k = 21, batch = 3;

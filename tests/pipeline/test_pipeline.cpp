@@ -143,6 +143,32 @@ TEST(Pipeline, TwoDevicesShareTheWorkAndAgree) {
   EXPECT_EQ(run.stats.pairs_per_device.size(), devices.size()) << "a device got no pair";
 }
 
+// What keeps a long run's memory flat, without timing it: a lane's pool of temporaries takes
+// its last new buffer by the second pair (the first also prepares the weights) and reuses them
+// for every pair after; the stats report the pools at the end (predict --stats prints them).
+TEST(Pipeline, TemporariesStopGrowingAfterTheSecondPair) {
+  Device& device = testing::test_device();
+  PipelineOptions one_lane;
+  one_lane.lanes_per_device = 1;  // each lane has a pool of its own: one lane, one pool
+  one_lane.max_pairs = 2;
+  auto first = open_frame_source(fixture().sequence);
+  const PipelineStats two = pipelined({&device}, *first, one_lane).stats;
+  one_lane.max_pairs = 0;
+  auto second = open_frame_source(fixture().sequence);
+  const PipelineStats all = pipelined({&device}, *second, one_lane).stats;
+  ASSERT_EQ(all.pairs, static_cast<std::size_t>(kFrames - 1));
+
+  EXPECT_GT(two.temporaries.allocations, 0u);
+  EXPECT_EQ(all.temporaries.allocations, two.temporaries.allocations);
+  EXPECT_EQ(all.temporaries.peak_bytes_in_use, two.temporaries.peak_bytes_in_use);
+  // Held (the network keeps its last inputs bound until the next pair) or idle: the same buffers.
+  EXPECT_EQ(all.temporaries.bytes_in_use + all.temporaries.bytes_cached,
+            two.temporaries.bytes_in_use + two.temporaries.bytes_cached);
+  EXPECT_GT(all.temporaries.reuses, two.temporaries.reuses);
+  ASSERT_EQ(all.device_buffers.count(device.info().summary()), 1u);
+  EXPECT_GT(all.device_buffers.at(device.info().summary()).bytes_in_use, 0u);  // prepared weights, arena
+}
+
 TEST(Pipeline, CancellationLeavesAValidPartialCsv) {
   Device& device = testing::test_device();
   const WeightSet weights = WeightSet::load(device, fixture().weight_files);

@@ -218,5 +218,30 @@ TEST(BufferPool, ReusesReleasedBuffers) {
   EXPECT_THROW(pool.acquire(0), Error);
 }
 
+// What keeps a long run's memory flat: a pattern of acquisitions and releases repeated (one
+// frame pair after another) allocates only in its first round; later rounds reuse exactly those
+// buffers, and the idle ones total no more than the first round allocated.
+TEST(BufferPool, ARepeatedPatternAllocatesOnlyInItsFirstRound) {
+  BufferPool pool(test_device().context(), test_device().info().name, test_device().info().max_alloc_bytes);
+  // Sizes of a network's temporaries, some alive across others, some reusable by smaller ones.
+  const std::size_t sizes[] = {48 << 20, 12 << 20, 47 << 20, 3 << 20, 20 << 20, 9 << 20, 1 << 20, 25 << 20};
+  auto round = [&] {
+    std::vector<std::shared_ptr<Buffer>> alive;
+    for (std::size_t i = 0; i < std::size(sizes); ++i) {
+      alive.push_back(pool.acquire(sizes[i] / 64));  // scaled down: the pattern is what counts
+      if (i % 3 == 2) alive.erase(alive.begin());    // the oldest is released
+    }
+  };
+  round();
+  const BufferPoolStats first = pool.stats();
+  EXPECT_EQ(first.bytes_in_use, 0u);
+  for (int i = 0; i < 50; ++i) round();
+  const BufferPoolStats later = pool.stats();
+  EXPECT_EQ(later.allocations, first.allocations);
+  EXPECT_EQ(later.bytes_cached, first.bytes_cached);
+  EXPECT_EQ(later.peak_bytes_in_use, first.peak_bytes_in_use);
+  EXPECT_EQ(later.reuses, first.reuses + 50 * std::size(sizes));
+}
+
 }  // namespace
 }  // namespace inertialnet

@@ -3,6 +3,8 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
+#include "common.hpp"
+
 namespace inertialnet::cli {
 
 namespace {
@@ -12,8 +14,6 @@ std::string fixed(double value, int decimals) {
   std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
   return buffer;
 }
-
-std::string megabytes(std::size_t bytes) { return fixed(static_cast<double>(bytes) / 1e6, 1) + " MB"; }
 
 double profiled_seconds(const std::vector<LayerTime>& layers) {
   double total = 0;

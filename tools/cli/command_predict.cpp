@@ -4,6 +4,7 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <memory>
 
@@ -25,6 +26,29 @@
 namespace inertialnet::cli {
 
 namespace {
+
+// --stats' memory lines: the process's resident memory now and at its peak (Linux: VmRSS and
+// VmHWM; nothing elsewhere), and the buffer pools at the end of the run. A soak reads them to
+// tell a growing pool from growth outside it (docs/performance.md).
+void print_memory(const PipelineStats& stats) {
+  std::ifstream status("/proc/self/status");
+  std::string line, resident, peak;
+  while (std::getline(status, line)) {
+    const auto kib = [&line] { return megabytes(static_cast<std::size_t>(std::stoull(line.substr(6))) << 10); };
+    if (line.rfind("VmRSS:", 0) == 0) resident = kib();
+    if (line.rfind("VmHWM:", 0) == 0) peak = kib();
+  }
+  if (!resident.empty()) std::cerr << "memory: resident " << resident << ", peak " << peak << "\n";
+  for (const auto& [device, pool] : stats.device_buffers) {
+    if (pool.allocations == 0) continue;  // the weight-free path keeps nothing on the device
+    std::cerr << device << ": long-lived buffers (weights prepared for the GEMM backend, activation arenas) "
+              << megabytes(pool.bytes_in_use) << " in " << pool.allocations << " allocations\n";
+  }
+  const BufferPoolStats& t = stats.temporaries;
+  std::cerr << "temporaries (pooled per lane, summed over lanes): " << t.allocations << " allocations, " << t.reuses
+            << " reuses; at most " << megabytes(t.peak_bytes_in_use) << " in use, " << megabytes(t.bytes_cached)
+            << " idle at the end\n";
+}
 
 struct PredictOptions {
   std::string sequence;
@@ -198,6 +222,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
                   << " s per pair\n";
       }
       for (const auto& [device, count] : stats.pairs_per_device) std::cerr << device << ": " << count << " pairs\n";
+      print_memory(stats);
     }
     if (o->profile && stats.pairs > 0) {
       // Lanes run side by side, so a layer's time includes the other lanes' load on the device.

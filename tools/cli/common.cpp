@@ -110,4 +110,10 @@ void flush_standard_output() {
   }
 }
 
+std::string megabytes(std::size_t bytes) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f MB", static_cast<double>(bytes) / 1e6);
+  return text;
+}
+
 }  // namespace inertialnet::cli

@@ -45,4 +45,7 @@ void prepare_output_folder(const std::string& path, const std::string& option);
 // (a full disk, a closed pipe, /dev/full), so that no command reports success with its output lost.
 void flush_standard_output();
 
+// A byte count as people read it: "12.3 MB" (10⁶ bytes, one decimal).
+std::string megabytes(std::size_t bytes);
+
 }  // namespace inertialnet::cli

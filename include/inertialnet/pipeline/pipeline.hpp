@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "inertialnet/runtime/buffer_pool.hpp"
 #include "inertialnet/runtime/device.hpp"
 #include "inertialnet/io/flow_io.hpp"
 #include "inertialnet/io/frame_source.hpp"
@@ -55,6 +56,8 @@ class PairProcessor {
   virtual ~PairProcessor() = default;
   virtual void process(const Frame& previous, const Frame& current, PairResult& result,
                        const std::atomic<bool>& stop) = 0;
+  // The buffer pool of the processor's own queue (the ops' temporaries), for PipelineStats.
+  virtual BufferPoolStats temporaries() const { return {}; }
 };
 
 // Makes the processor of lane `lane` on `device` (called on the lane's thread).
@@ -81,6 +84,10 @@ struct PipelineStats {
   double decode_seconds = 0;                // summed over decode threads
   std::map<std::string, double> stage_seconds;  // summed over lanes
   std::map<std::string, std::size_t> pairs_per_device;
+  // Memory at the end of the run: the lanes' pools of temporaries (summed over lanes), and each
+  // device's pool of long-lived buffers (prepared weights, activation arenas), by device.
+  BufferPoolStats temporaries;
+  std::map<std::string, BufferPoolStats> device_buffers;
   bool cancelled = false;
   double pairs_per_second() const { return seconds > 0 ? static_cast<double>(pairs) / seconds : 0; }
 };
