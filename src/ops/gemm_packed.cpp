@@ -193,7 +193,7 @@ void gemm_packed(Queue& queue, const PackedPanels& a, const PackedPanels& b, con
 }
 
 void gemv(Queue& queue, std::size_t rows, std::size_t depth, const MatrixView& w, const Tensor& x, const Tensor& y,
-          const Tensor& bias, const ActivationSpec& activation) {
+          const Tensor& bias, const ActivationSpec& activation, GemvLayout layout) {
   if (rows == 0 || depth == 0) throw invalid_input("GEMV with an empty dimension");
   detail::check_gemm_operand("W", w, rows, depth);
   if (static_cast<std::size_t>(x.numel()) != depth || !x.contiguous()) {
@@ -207,11 +207,23 @@ void gemv(Queue& queue, std::size_t rows, std::size_t depth, const MatrixView& w
     throw invalid_input("GEMV: the bias has " + std::to_string(bias.numel()) + " values for " + std::to_string(rows) +
                         " rows");
   }
-  Kernel& kernel =
-      queue.kernel("gemv", "gemv", KernelDefines().add("HAS_BIAS", has_bias).add(activation_defines(activation)));
+  if (layout == GemvLayout::Default) {
+    layout = queue.device().info().type == DeviceType::CPU ? GemvLayout::RowPerWorkItem : GemvLayout::RowPerWorkGroup;
+  }
+  // 256 work-items per row: a few warps' worth, enough to keep a row's loads in flight; the
+  // head's fc1 (hundreds of rows) still gives every compute unit several groups.
+  constexpr std::size_t kRowGroup = 256;
+  const bool grouped = layout == GemvLayout::RowPerWorkGroup;
+  KernelDefines defines = KernelDefines().add("HAS_BIAS", has_bias).add(activation_defines(activation));
+  if (grouped) defines.add("GROUP", static_cast<int>(kRowGroup));
+  Kernel& kernel = queue.kernel("gemv", grouped ? "gemv_rows" : "gemv", defines);
   kernel.set_args(w.buffer, to_int(w.offset, "offset of W"), to_int(w.leading_dimension, "ldw"), x, y,
                   has_bias ? bias : y, to_int(rows, "rows"), to_int(depth, "depth"));
-  queue.launch(kernel, Range(rows), Range(1));
+  if (grouped) {
+    queue.launch(kernel, Range(rows * kRowGroup), Range(kRowGroup));
+  } else {
+    queue.launch(kernel, Range(rows), Range(1));
+  }
 }
 
 }  // namespace inertialnet

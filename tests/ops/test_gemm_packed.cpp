@@ -175,8 +175,12 @@ TEST(Gemv, MatchesTheReference) {
     Tensor tx = Tensor::from_host(queue, {static_cast<std::int64_t>(g.depth)}, x);
     Tensor ty = Tensor::empty(queue, {static_cast<std::int64_t>(g.rows)});
     Tensor tb = g.bias ? Tensor::from_host(queue, {static_cast<std::int64_t>(g.rows)}, bias) : Tensor();
-    gemv(queue, g.rows, g.depth, MatrixView::of(tw, ld), tx, ty, tb, g.activation);
-    EXPECT_TRUE(testing::all_close(ty.to_host(queue), expected, 1e-5, std::sqrt(static_cast<double>(g.depth))));
+    // Both layouts on whatever device runs the suite: the default picks one by device type.
+    for (const GemvLayout layout : {GemvLayout::RowPerWorkItem, GemvLayout::RowPerWorkGroup}) {
+      SCOPED_TRACE(layout == GemvLayout::RowPerWorkItem ? "row per work-item" : "row per work-group");
+      gemv(queue, g.rows, g.depth, MatrixView::of(tw, ld), tx, ty, tb, g.activation, layout);
+      EXPECT_TRUE(testing::all_close(ty.to_host(queue), expected, 1e-5, std::sqrt(static_cast<double>(g.depth))));
+    }
   }
 }
 

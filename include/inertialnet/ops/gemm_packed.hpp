@@ -95,9 +95,13 @@ struct GemmEpilogue {
 void gemm_packed(Queue& queue, const PackedPanels& a, const PackedPanels& b, const MatrixView& c,
                  const GemmEpilogue& epilogue = {}, int panels_first = -1);
 
+// How the rows of a matrix-vector product are spread: a row per work-item (CPUs), or a
+// work-group per row reading it coalesced (GPUs and accelerators). Default: by device type.
+enum class GemvLayout { Default, RowPerWorkItem, RowPerWorkGroup };
+
 // y[row] = activation(Σ W[row][q]·x[q] + bias[row]) for `rows` rows of a row-major W: one
 // matrix-vector product, reading W in place (a fully connected layer on one sample).
 void gemv(Queue& queue, std::size_t rows, std::size_t depth, const MatrixView& w, const Tensor& x, const Tensor& y,
-          const Tensor& bias, const ActivationSpec& activation);
+          const Tensor& bias, const ActivationSpec& activation, GemvLayout layout = GemvLayout::Default);
 
 }  // namespace inertialnet
