@@ -23,6 +23,7 @@
 #include "inertialnet/runtime/error.hpp"
 #include "models/motion_field_solver.hpp"
 #include "models/opengv_head.hpp"
+#include "models/rolling_shutter_solver.hpp"
 
 namespace inertialnet {
 
@@ -66,8 +67,8 @@ GeometricHead::GeometricHead(Device& device, const CameraIntrinsics& camera, Geo
   camera_.validate();
   options_.validate();
   resolve_scale();
-  const std::vector<float> map = normalized_coordinate_map(camera_);
-  map_ = Tensor::from_host(device_.queue(), {1, 2, camera_.height, camera_.width}, map);
+  host_map_ = normalized_coordinate_map(camera_);
+  map_ = Tensor::from_host(device_.queue(), {1, 2, camera_.height, camera_.width}, host_map_);
 }
 
 GeometricHead::~GeometricHead() = default;
@@ -137,7 +138,17 @@ RotationEstimate GeometricHead::estimate(Queue& queue, const Tensor& flow, doubl
     f[i] = static_cast<float>(f[i] * scale);
     f[plane + i] = static_cast<float>(f[plane + i] * scale);
   }
-  return solve(Tensor::from_host(queue, flow.shape(), f));
+  RotationEstimate est = solve(Tensor::from_host(queue, flow.shape(), f));
+  if (options_.solver != GeometricSolver::MotionField || options_.model != MotionModel::General ||
+      !options_.readout_rows) {
+    return est;
+  }
+  // What the stretch leaves, the motion's change across the rows, by the row-linear model
+  // (src/models/rolling_shutter_solver.cpp) from the general model's solution.
+  check_stop("rolling-shutter refinement");
+  const double sigma = options_.robust_scale_px / (camera_.mean_focal() * dt);
+  return detail::refine_rolling_shutter(
+      detail::row_samples(f, host_map_, camera_.width, camera_.height, options_.stride, dt), est, sigma);
 }
 
 RotationEstimate GeometricHead::estimate(Queue& queue, const FlowField& flow, double dt) {

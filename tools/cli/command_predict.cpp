@@ -117,8 +117,9 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
   app.add_option("--time-offset", o->time_offset,
                  "camera-IMU time offset in seconds (t_imu = t_cam + offset), stated in the CSV for eval");
   app.add_option("--readout-time", o->readout_time,
-                 "rolling-shutter readout time in seconds: the geometric head corrects each flow vector's interval, "
-                 "and the CSV states it for eval (rates belong to mid-exposure)");
+                 "rolling-shutter readout time in seconds: the geometric head corrects each flow vector's interval "
+                 "and the motion's change across the rows, and the CSV states it for eval (rates belong to "
+                 "mid-exposure)");
   app.add_option("--lanes", o->lanes, "frame pairs in flight per device (default: 1 on CPU devices, 2 on others)")
       ->check(CLI::Range(1, 16));
   app.add_option("--decode-threads", o->decode_threads, "image decoding threads")->capture_default_str()->check(CLI::Range(1, 64));
