@@ -20,6 +20,7 @@
 #include <utility>
 #include <vector>
 
+#include "inertialnet/io/flow_io.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "models/motion_field_solver.hpp"
 #include "models/opengv_head.hpp"
@@ -133,6 +134,7 @@ RotationEstimate GeometricHead::estimate(Queue& queue, const Tensor& flow, doubl
   const std::size_t plane = f.size() / 2;
   const double per_row = options_.readout_time_s / std::max(1, camera_.height - 1);
   for (std::size_t i = 0; i < plane; ++i) {
+    if (is_unknown_flow(f[i], f[plane + i])) continue;  // left out by the solvers: keep it unknown
     const double interval = dt + per_row * f[plane + i];
     const double scale = dt / std::max(interval, 0.1 * dt);  // a vector across most of the frame stays finite
     f[i] = static_cast<float>(f[i] * scale);
