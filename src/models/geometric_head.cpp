@@ -20,9 +20,11 @@
 #include <utility>
 #include <vector>
 
+#include "inertialnet/io/flow_io.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "models/motion_field_solver.hpp"
 #include "models/opengv_head.hpp"
+#include "models/rolling_shutter_solver.hpp"
 
 namespace inertialnet {
 
@@ -66,8 +68,8 @@ GeometricHead::GeometricHead(Device& device, const CameraIntrinsics& camera, Geo
   camera_.validate();
   options_.validate();
   resolve_scale();
-  const std::vector<float> map = normalized_coordinate_map(camera_);
-  map_ = Tensor::from_host(device_.queue(), {1, 2, camera_.height, camera_.width}, map);
+  host_map_ = normalized_coordinate_map(camera_);
+  map_ = Tensor::from_host(device_.queue(), {1, 2, camera_.height, camera_.width}, host_map_);
 }
 
 GeometricHead::~GeometricHead() = default;
@@ -132,12 +134,23 @@ RotationEstimate GeometricHead::estimate(Queue& queue, const Tensor& flow, doubl
   const std::size_t plane = f.size() / 2;
   const double per_row = options_.readout_time_s / std::max(1, camera_.height - 1);
   for (std::size_t i = 0; i < plane; ++i) {
+    if (is_unknown_flow(f[i], f[plane + i])) continue;  // left out by the solvers: keep it unknown
     const double interval = dt + per_row * f[plane + i];
     const double scale = dt / std::max(interval, 0.1 * dt);  // a vector across most of the frame stays finite
     f[i] = static_cast<float>(f[i] * scale);
     f[plane + i] = static_cast<float>(f[plane + i] * scale);
   }
-  return solve(Tensor::from_host(queue, flow.shape(), f));
+  RotationEstimate est = solve(Tensor::from_host(queue, flow.shape(), f));
+  if (options_.solver != GeometricSolver::MotionField || options_.model != MotionModel::General ||
+      !options_.readout_rows) {
+    return est;
+  }
+  // What the stretch leaves, the motion's change across the rows, by the row-linear model
+  // (src/models/rolling_shutter_solver.cpp) from the general model's solution.
+  check_stop("rolling-shutter refinement");
+  const double sigma = options_.robust_scale_px / (camera_.mean_focal() * dt);
+  return detail::refine_rolling_shutter(
+      detail::row_samples(f, host_map_, camera_.width, camera_.height, options_.stride, dt), est, sigma);
 }
 
 RotationEstimate GeometricHead::estimate(Queue& queue, const FlowField& flow, double dt) {

@@ -99,18 +99,20 @@ Eigen::Vector3d refine_translation(const GeneralQuadratic& q, const Eigen::Vecto
   return t;
 }
 
+std::vector<Eigen::Vector3d> half_sphere_lattice(int count) {
+  std::vector<Eigen::Vector3d> points;
+  const double golden = kPi * (3.0 - std::sqrt(5.0));
+  for (int i = 0; i < count; ++i) {
+    const double z = 1.0 - (i + 0.5) / count;  // (0, 1]: the upper half
+    const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+    points.emplace_back(r * std::cos(golden * i), r * std::sin(golden * i), z);
+  }
+  return points;
+}
+
 // The best T of the whole half sphere: the lattice's best point, refined.
 Eigen::Vector3d global_translation(const GeneralQuadratic& q) {
-  static const std::vector<Eigen::Vector3d> lattice = [] {
-    std::vector<Eigen::Vector3d> points;
-    const double golden = kPi * (3.0 - std::sqrt(5.0));
-    for (int i = 0; i < kTranslationCandidates; ++i) {
-      const double z = 1.0 - (i + 0.5) / kTranslationCandidates;  // (0, 1]: the upper half
-      const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
-      points.emplace_back(r * std::cos(golden * i), r * std::sin(golden * i), z);
-    }
-    return points;
-  }();
+  static const std::vector<Eigen::Vector3d> lattice = half_sphere_lattice(kTranslationCandidates);
   Eigen::Vector3d start = lattice[0];
   double start_cost = std::numeric_limits<double>::infinity();
   for (const auto& t : lattice) {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <vector>
 
 #include <Eigen/Dense>
 
@@ -46,6 +47,10 @@ class GeneralQuadratic {
 
 // Local pattern search for the best T in the tangent plane of `start`, within `radius` (rad).
 Eigen::Vector3d refine_translation(const GeneralQuadratic& q, const Eigen::Vector3d& start, double radius);
+
+// `count` directions spread evenly over the upper half sphere (a Fibonacci lattice; T and −T
+// give the same constraint).
+std::vector<Eigen::Vector3d> half_sphere_lattice(int count);
 
 // The best T of the whole half sphere: the best point of a lattice, refined.
 Eigen::Vector3d global_translation(const GeneralQuadratic& q);

@@ -3,6 +3,7 @@
 
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/models/dis_flow.hpp"
+#include "inertialnet/models/flow_consistency.hpp"
 #include "inertialnet/models/flownet.hpp"
 #include "inertialnet/models/inertialnet_head.hpp"
 #include "inertialnet/pipeline/rates_processor.hpp"
@@ -41,7 +42,11 @@ class RatesProcessor : public PairProcessor {
       flow = flownet_->compute(q, frame1, frame2, &stop);
       q.finish();
     } else {
-      const FlowField field = dis_->compute(previous.image, current.image);
+      FlowField field = dis_->compute(previous.image, current.image);
+      if (options_.flow_check_px > 0) {
+        const FlowField backward = dis_->compute(current.image, previous.image);
+        mark_inconsistent_flow(field, backward, options_.flow_check_px * width / 752.0);
+      }
       std::vector<float> data(2 * field.pixel_count());
       std::copy(field.u.begin(), field.u.end(), data.begin());
       std::copy(field.v.begin(), field.v.end(), data.begin() + static_cast<std::ptrdiff_t>(field.pixel_count()));

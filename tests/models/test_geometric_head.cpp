@@ -6,7 +6,9 @@
 // The recovery tests use rates whose axes all differ in size by ≥ 5 deg/s and are ≥ 10 deg/s,
 // and bounds of ≤ 1.5 deg/s: a sign flip (≥ 20 deg/s error), swapped axes (≥ 5 deg/s) or
 // degrees for radians (×57) cannot pass.
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <random>
 #include <sstream>
@@ -408,6 +410,64 @@ TEST(GeometricHead, RollingShutterIntervalIsCorrected) {
   GeometricHeadOptions bad = quarter_options();
   bad.readout_time_s = -0.01;
   EXPECT_THROW(bad.validate(), Error);
+}
+
+// Beyond the stretch, a rolling shutter sees the motion change across the rows: rotation and
+// translation linear in the row (src/models/rolling_shutter_solver.cpp). Exact flow of such a
+// motion (each vector rendered with the motion of its midpoint row, then stretched) is solved
+// to the middle row's rate by the default head told the readout, and missed by the stretch
+// alone.
+TEST(GeometricHead, RollingShutterRowLinearMotionIsSolved) {
+  Queue& queue = testing::test_queue();
+  const CameraIntrinsics k = quarter_euroc();
+  const std::vector<float> map = normalized_coordinate_map(k);
+  Motion mid;
+  mid.omega = kRates[1];
+  mid.velocity = {0.6, 0.2, 0.2};
+  mid.outliers = 0;
+  mid.noise_px = 0;
+  // Across the readout: 12 deg/s of rate change, and a third of the velocity.
+  const Vec3 alpha = {12 * kDeg, -8 * kDeg, 10 * kDeg}, accel = {-0.2, 0.1, 0.05};
+  std::vector<FlowField> rows;
+  for (int r = 0; r < k.height; ++r) {
+    const double s = static_cast<double>(r) / (k.height - 1) - 0.5;
+    Motion m = mid;
+    for (int a = 0; a < 3; ++a) {
+      m.omega[a] += alpha[a] * s;
+      m.velocity[a] += accel[a] * s;
+    }
+    rows.push_back(render(k, map, m));
+  }
+  FlowField flow(k.width, k.height);
+  const double readout = 0.03, per_row = readout / (k.height - 1);
+  for (int v = 0; v < k.height; ++v) {
+    for (int u = 0; u < k.width; ++u) {
+      const std::size_t i = flow.index(u, v);
+      int row = v;
+      for (int pass = 0; pass < 3; ++pass) {  // the midpoint row of the vector the row's motion gives
+        row = std::clamp(static_cast<int>(std::lround(v + 0.5 * rows[row].v[i])), 0, k.height - 1);
+      }
+      const double scale = mid.dt / (mid.dt - per_row * rows[row].v[i]);  // stretched, as in the test above
+      flow.u[i] = static_cast<float>(rows[row].u[i] * scale);
+      flow.v[i] = static_cast<float>(rows[row].v[i] * scale);
+    }
+  }
+  GeometricHeadOptions o = quarter_options();
+  o.readout_time_s = readout;
+  GeometricHead head(testing::test_device(), k, o);
+  const RotationEstimate rows_model = head.estimate(queue, flow, mid.dt);
+  o.readout_rows = false;
+  head.set_options(o);
+  const RotationEstimate stretch_only = head.estimate(queue, flow, mid.dt);
+  const auto worst = [&](const Vec3& w) {
+    double e = 0;
+    for (int a = 0; a < 3; ++a) e = std::max(e, std::fabs(w[a] - mid.omega[a]) / kDeg);
+    return e;
+  };
+  std::printf("[ rows    ] worst axis error: row-linear model %.3f deg/s, stretch only %.3f deg/s\n",
+              worst(rows_model.omega), worst(stretch_only.omega));
+  EXPECT_TRUE(near_rates(rows_model.omega, mid.omega, 0.1)) << rows_model.method;
+  EXPECT_FALSE(near_rates(stretch_only.omega, mid.omega, 0.5)) << stretch_only.method;
 }
 
 }  // namespace

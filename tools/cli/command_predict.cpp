@@ -63,6 +63,7 @@ struct PredictOptions {
   std::string flow_format = "flo";
   double rate_hz = 0;
   std::string time_offset, readout_time;
+  double flow_check_px = 0.5;  // PredictSettings' default
   int lanes = 0;  // 0: default_lanes_per_device()
   int decode_threads = 2;
   std::size_t max_pairs = 0;
@@ -111,8 +112,14 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
   app.add_option("--time-offset", o->time_offset,
                  "camera-IMU time offset in seconds (t_imu = t_cam + offset), stated in the CSV for eval");
   app.add_option("--readout-time", o->readout_time,
-                 "rolling-shutter readout time in seconds: the geometric head corrects each flow vector's interval, "
-                 "and the CSV states it for eval (rates belong to mid-exposure)");
+                 "rolling-shutter readout time in seconds: the geometric head corrects each flow vector's interval "
+                 "and the motion's change across the rows, and the CSV states it for eval (rates belong to "
+                 "mid-exposure)");
+  app.add_option("--flow-check", o->flow_check_px,
+                 "DIS: also compute the backward flow and leave out vectors whose round trip misses by more than "
+                 "this many pixels (at 752 columns, scaled with the width); 0: off")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e6));
   app.add_option("--lanes", o->lanes, "frame pairs in flight per device (default: 1 on CPU devices, 2 on others)")
       ->check(CLI::Range(1, 16));
   app.add_option("--decode-threads", o->decode_threads, "image decoding threads")->capture_default_str()->check(CLI::Range(1, 64));
@@ -142,6 +149,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
     settings.cx = o->camera.cx;
     settings.cy = o->camera.cy;
     settings.rate_hz = o->rate_hz;
+    settings.flow_check_px = o->flow_check_px;
     if (!o->readout_time.empty()) settings.readout_time_s = parse_seconds(o->readout_time, "--readout-time");
     if (!o->time_offset.empty()) settings.time_offset_s = parse_seconds(o->time_offset, "--time-offset");
     settings.device = global.device;

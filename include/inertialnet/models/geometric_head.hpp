@@ -29,6 +29,7 @@
 #include <atomic>
 
 #include <string>
+#include <vector>
 
 #include "inertialnet/core/vec3.hpp"
 #include "inertialnet/io/camera.hpp"
@@ -77,10 +78,15 @@ struct GeometricHeadOptions {
 
   // Rolling shutter (both solvers): rows are read out over this many seconds, top to bottom. A
   // point that moves v rows between frames was seen dt + readout·v/(height − 1) apart, not dt:
-  // each flow vector is scaled by dt / that interval before solving (first order in the readout;
-  // the rate's change across the rows is not modelled). The rates then belong to mid-exposure,
-  // readout/2 after the frame stamps. 0: a global shutter.
+  // each flow vector is scaled by dt / that interval before solving; the motion's change across
+  // the rows is then taken up by readout_rows (motion-field general model only). The rates
+  // belong to mid-exposure (the middle row), readout/2 after the frame stamps. 0: a global
+  // shutter.
   double readout_time_s = 0;
+  // With a readout, the motion-field solver's general model then takes both the rotation and
+  // the translation linear in the row (src/models/rolling_shutter_solver.cpp): the rates are
+  // those of the middle row. false: the interval stretch alone.
+  bool readout_rows = true;
 
   void validate() const;  // invalid_input for non-positive strides, scales or counts
 };
@@ -128,7 +134,8 @@ class GeometricHead {
   Device& device_;
   CameraIntrinsics camera_;
   GeometricHeadOptions options_;
-  Tensor map_;  // [1, 2, H, W] normalised coordinates of every pixel
+  std::vector<float> host_map_;  // [2, H, W] normalised coordinates of every pixel
+  Tensor map_;                   // the same on the device
 };
 
 }  // namespace inertialnet

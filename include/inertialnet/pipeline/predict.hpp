@@ -36,6 +36,8 @@ struct PredictSettings {
   // Rolling shutter: seconds from the first row's exposure to the last's (0: global shutter). The
   // geometric head corrects each flow vector's interval; the CSV states it for eval.
   double readout_time_s = 0;
+  // DIS forward-backward check (RatesProcessorOptions::flow_check_px); 0: off.
+  double flow_check_px = 0.5;
   // Camera-IMU time offset (t_imu = t_cam + offset) stated in the CSV for eval; not applied here.
   std::optional<double> time_offset_s;
   std::string device;                // a --device spec; "": $INERTIALNET_DEVICE, else the default

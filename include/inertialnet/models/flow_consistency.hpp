@@ -1,0 +1,18 @@
+// Forward-backward consistency of a dense flow: a vector whose round trip (forward to q = p + f(p),
+// then the backward flow at q) does not come back near p is marked unknown, so that the geometric
+// head (and anything else that skips unknown flow) leaves it out. Occlusions at depth edges and
+// blurred, weakly textured patches are where a one-way flow is confidently wrong.
+#pragma once
+
+#include "inertialnet/io/flow_io.hpp"
+
+namespace inertialnet {
+
+// Marks (as kUnknownFlowValue) each vector of `forward` whose round trip through `backward` (the
+// flow from the second frame to the first, bilinear at the forward end) misses by more than
+// `threshold_px` pixels. A vector that leaves the image, or lands where the backward flow is
+// unknown, is kept as it is (the solvers judge those themselves). Returns how many were marked.
+// Throws invalid_input when the fields differ in size or the threshold is not positive.
+int mark_inconsistent_flow(FlowField& forward, const FlowField& backward, double threshold_px);
+
+}  // namespace inertialnet

@@ -1,0 +1,55 @@
+#include "inertialnet/models/flow_consistency.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "inertialnet/runtime/error.hpp"
+
+namespace inertialnet {
+
+int mark_inconsistent_flow(FlowField& forward, const FlowField& backward, double threshold_px) {
+  if (forward.width != backward.width || forward.height != backward.height) {
+    throw invalid_input("flow consistency: the forward flow is " + std::to_string(forward.width) + "x" +
+                        std::to_string(forward.height) + " but the backward flow is " + std::to_string(backward.width) +
+                        "x" + std::to_string(backward.height));
+  }
+  if (!(threshold_px > 0) || !std::isfinite(threshold_px)) {
+    throw invalid_input("flow consistency: the threshold must be a positive number of pixels");
+  }
+  const int w = forward.width, h = forward.height;
+  if (w < 2 || h < 2) return 0;
+  const double limit = threshold_px * threshold_px;
+  int marked = 0;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * w + x;
+      const float u = forward.u[i], v = forward.v[i];
+      if (is_unknown_flow(u, v)) continue;
+      const float qx = static_cast<float>(x) + u, qy = static_cast<float>(y) + v;
+      if (!(qx >= 0 && qx <= static_cast<float>(w - 1) && qy >= 0 && qy <= static_cast<float>(h - 1))) continue;
+      const int x0 = std::min(static_cast<int>(qx), w - 2), y0 = std::min(static_cast<int>(qy), h - 2);
+      const double fx = qx - static_cast<float>(x0), fy = qy - static_cast<float>(y0);
+      const std::size_t j = static_cast<std::size_t>(y0) * w + x0;
+      double bu = 0, bv = 0;
+      bool known = true;
+      const std::size_t corner[4] = {j, j + 1, j + w, j + w + 1};
+      const double weight[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
+      for (int k = 0; k < 4; ++k) {
+        if (is_unknown_flow(backward.u[corner[k]], backward.v[corner[k]])) known = false;
+        bu += weight[k] * backward.u[corner[k]];
+        bv += weight[k] * backward.v[corner[k]];
+      }
+      if (!known) continue;
+      const double eu = u + bu, ev = v + bv;
+      if (eu * eu + ev * ev > limit) {
+        forward.u[i] = kUnknownFlowValue;
+        forward.v[i] = kUnknownFlowValue;
+        ++marked;
+      }
+    }
+  }
+  return marked;
+}
+
+}  // namespace inertialnet

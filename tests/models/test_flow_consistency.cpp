@@ -1,0 +1,64 @@
+// The forward-backward check (include/inertialnet/models/flow_consistency.hpp): a consistent
+// field is kept whole; a patch whose backward flow disagrees is marked unknown, and only it.
+#include "inertialnet/models/flow_consistency.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "inertialnet/runtime/error.hpp"
+
+namespace inertialnet {
+namespace {
+
+// A uniform shift (u, v) and its exact inverse.
+FlowField uniform(int w, int h, float u, float v) {
+  FlowField f(w, h);
+  std::fill(f.u.begin(), f.u.end(), u);
+  std::fill(f.v.begin(), f.v.end(), v);
+  return f;
+}
+
+TEST(FlowConsistency, KeepsAConsistentFieldAndMarksOnlyTheDisagreeingPatch) {
+  const int w = 40, h = 30;
+  FlowField forward = uniform(w, h, 2.5f, -1.25f);
+  FlowField backward = uniform(w, h, -2.5f, 1.25f);
+  FlowField copy = forward;
+  EXPECT_EQ(mark_inconsistent_flow(copy, backward, 0.5), 0);
+  EXPECT_EQ(copy.u, forward.u);
+  EXPECT_EQ(copy.v, forward.v);
+
+  // The backward flow is wrong by 3 px in a block: the forward vectors landing in it (one
+  // column and row fewer at its near edges, where the bilinear lookup mixes in a good cell)
+  // are marked; none elsewhere.
+  for (int y = 10; y < 20; ++y)
+    for (int x = 20; x < 30; ++x) backward.u[static_cast<std::size_t>(y) * w + x] += 3.0f;
+  const int marked = mark_inconsistent_flow(forward, backward, 1.0);
+  EXPECT_GT(marked, 0);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * w + x;
+      const double qx = x + 2.5, qy = y - 1.25;
+      const bool lands_inside = qx >= 20 && qx <= 29 && qy >= 10 && qy <= 19;
+      const bool lands_outside = qx < 19 || qx > 30 || qy < 9 || qy > 20;
+      if (lands_inside && qx <= w - 1 && qy >= 0) {
+        EXPECT_TRUE(is_unknown_flow(forward.u[i], forward.v[i])) << x << "," << y;
+      }
+      if (lands_outside) {
+        EXPECT_FALSE(is_unknown_flow(forward.u[i], forward.v[i])) << x << "," << y;
+      }
+    }
+  }
+}
+
+TEST(FlowConsistency, LeavesVectorsThatLeaveTheImageAndRejectsBadArguments) {
+  FlowField forward = uniform(20, 20, 30.0f, 0.0f);  // every vector leaves the frame
+  FlowField backward = uniform(20, 20, 5.0f, 5.0f);
+  EXPECT_EQ(mark_inconsistent_flow(forward, backward, 1.0), 0);
+  FlowField other = uniform(21, 20, 0.0f, 0.0f);
+  EXPECT_THROW(mark_inconsistent_flow(forward, other, 1.0), Error);
+  EXPECT_THROW(mark_inconsistent_flow(forward, backward, 0.0), Error);
+}
+
+}  // namespace
+}  // namespace inertialnet
