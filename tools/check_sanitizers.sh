@@ -38,5 +38,27 @@ rm -rf "$POCL_CACHE_DIR" "$INERTIALNET_CACHE_DIR"
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1"
 export LSAN_OPTIONS="suppressions=$PWD/tests/sanitizers/lsan_suppressions.txt:print_suppressions=0"
-ctest --test-dir "$build" --output-on-failure -j "$jobs" "${selection[@]}"
+status=0
+ctest --test-dir "$build" --output-on-failure -j "$jobs" "${selection[@]}" || status=$?
+if [ "$status" -ne 0 ]; then
+  # LeakSanitizer's tracer (the thread that stops the process at exit to scan its memory) once
+  # crashed with SIGSEGV after an OpenCL suite had passed, PoCL's worker threads still alive:
+  # "Tracer caught signal 11" and "LeakSanitizer has encountered a fatal error", no report. That
+  # is the checker failing, not a finding, and it did not recur when that suite ran again (its
+  # cause is not pinned down: it is rare and LSan prints nothing more). Such a suite runs
+  # once more, everything else as before; a suite that failed in any other way (a sanitizer
+  # report, a failed assertion, a timeout, a second tracer crash) fails the pass.
+  log="$build/Testing/Temporary/LastTest.log"
+  mapfile -t failed < <(sed 's/^[0-9]*://' "$build/Testing/Temporary/LastTestsFailed.log")
+  mapfile -t tracer < <(awk '
+    /^[0-9]+\/[0-9]+ Testing: / { name = $3 }
+    /Tracer caught signal/ { crashed[name] = 1 }
+    /ERROR: (AddressSanitizer|LeakSanitizer: detected)|runtime error:|\[  FAILED  \]/ { report[name] = 1 }
+    END { for (t in crashed) if (!(t in report)) print t }' "$log" | sort)
+  if [ "${#tracer[@]}" -eq 0 ] || [ "${#tracer[@]}" -ne "${#failed[@]}" ]; then
+    exit "$status"
+  fi
+  echo "check_sanitizers: LeakSanitizer's tracer crashed in ${tracer[*]}; running them once more"
+  ctest --test-dir "$build" --output-on-failure -j "$jobs" -R "^($(IFS='|'; echo "${tracer[*]}"))\$"
+fi
 bash tools/fuzz.sh "${FUZZ_SECONDS:-30}"
