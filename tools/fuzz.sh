@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Runs every libFuzzer target of tests/fuzz for a set time and prints each one's executions.
+# Runs every libFuzzer target of tests/fuzz for a set time and prints each one's executions, one
+# grep-able line per target: `fuzz <target>: N executions in S s` (or `fuzz <target>: FAILED ...`).
 #   bash tools/fuzz.sh [SECONDS_PER_TARGET] [TARGET...]     (default 30 s, every target)
 # Builds the targets in build-asan/ (clang, AddressSanitizer + UBSan, the same tree as CI's
 # sanitizer build; FUZZ_BUILD_DIR moves it). Each target starts from its seed corpus
@@ -40,9 +41,10 @@ for target in "${targets[@]}"; do
   runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
   if [ "$code" -ne 0 ]; then
     failed=1
-    summary+=$(printf '%-12s FAILED after %s executions (exit %d): see %s and %s\n' "$target" "${runs:-?}" "$code" "$log" "$findings")$'\n'
+    tail -n 60 "$log" >&2  # the report, for a CI log that outlives the build tree
+    summary+=$(printf 'fuzz %s: FAILED after %s executions (exit %d): see %s and %s\n' "$target" "${runs:-?}" "$code" "$log" "$findings")$'\n'
   else
-    summary+=$(printf '%-12s %10s executions in %s s\n' "$target" "${runs:-?}" "$seconds")$'\n'
+    summary+=$(printf 'fuzz %s: %s executions in %s s\n' "$target" "${runs:-?}" "$seconds")$'\n'
   fi
 done
 printf '%s' "$summary"

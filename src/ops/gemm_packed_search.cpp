@@ -80,7 +80,9 @@ PackedGemmSearch search_packed_gemm(Queue& queue, const std::vector<GemmShape>& 
       ShapeOperands& o = operands[i];
       const PackedPanels a = pack_a(queue, Transpose::No, s.m, s.k, MatrixView::of(o.a, s.k), mr);
       const MatrixView c = MatrixView::of(o.c, s.n);
-      trial.seconds += detail::median_seconds(queue, [&] { gemm_packed(queue, a, o.packed_b, c, {}, pf); }, runs);
+      // pf is copied into the lambda: capturing a structured binding is C++20 (clang rejects it).
+      trial.seconds +=
+          detail::median_seconds(queue, [&, pf = pf] { gemm_packed(queue, a, o.packed_b, c, {}, pf); }, runs);
       const std::vector<float> result = o.c.to_host(queue);
       if (o.reference.empty()) o.reference = result;
       else if (!agrees(result, o.reference, s.k)) trial.matches = false;
