@@ -164,6 +164,7 @@ std::size_t TrainingSet::add_sequence(const std::filesystem::path& root, const F
   sync.target = options_.target;
   sync.camera_frame = false;  // the body (IMU) frame, as the gyro measures and predict reports
   sync.bias = BiasSource::Automatic;
+  sync.time_offset_s = options_.time_offset_s;  // checked there: finite, within an hour
   const GyroTruth truth = sync_gyro(sequence, sync);
   for (const auto& note : truth.notes) notes_.push_back(sequence.name + ": " + note);
   notes_.push_back(sequence.name + ": targets bias-corrected from " + to_string(truth.bias_source));

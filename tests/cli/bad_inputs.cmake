@@ -309,3 +309,8 @@ run(2 ${CLI} eval rates.csv seq ${imu} --T-cam-imu "1 0 0 0 0 1 0 0 0 0 1 0 0 0 
 expect_match("seq is a EuRoC sequence, whose camera rotation comes from mav0/cam0/sensor.yaml's T_BS")
 run(2 ${CLI} calibrate-time ${folder} ${imu})
 expect_match("calibrate-time: seq/mav0/cam0/data has no camera calibration to predict with; give --fx")
+# train's camera-IMU offset: a number of seconds, finite, within an hour.
+run(2 ${CLI} train --train seq --val seq -o head.safetensors --time-offset nan)
+expect_match("--time-offset should be a number of seconds")
+run(2 ${CLI} train --train seq --val seq -o head.safetensors --time-offset 7200)
+expect_match("time offset should be finite and within an hour, found 7200 s")

@@ -17,6 +17,7 @@
 #include "common.hpp"
 #include "progress.hpp"
 #include "inertialnet/eval/plots.hpp"
+#include "inertialnet/eval/time_offset.hpp"
 #include "inertialnet/models/weights.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/runtime/program_cache.hpp"
@@ -31,7 +32,7 @@ namespace {
 struct TrainCliOptions {
   std::vector<std::string> train, val, weights;
   std::string flow = "dis", optimizer = "sgd", schedule = "constant", head_size = "752x480", target = "spline";
-  std::string out, log, plot, cache;
+  std::string out, log, plot, cache, time_offset;
   int epochs = 20, batch = 10;
   float lr = 1e-6f, momentum = 0.0f, weight_decay = 0.0f;
   std::uint64_t seed = 1;
@@ -63,6 +64,9 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
   app.add_option("--seed", o->seed, "seed of the initialisation, shuffles and dropout")->capture_default_str();
   app.add_option("--head-size", o->head_size, "the head's flow size WxH (flows are resized to it)")->capture_default_str();
   app.add_option("--target", o->target, "spline (the paper's) or mean")->capture_default_str();
+  app.add_option("--time-offset", o->time_offset,
+                 "camera-IMU time offset in seconds (t_imu = t_cam + offset) of every sequence: the targets are the "
+                 "gyro at the shifted times (as eval --time-offset; estimate it with calibrate-time)");
   app.add_option("-o,--output", o->out, "the best head (safetensors)")->required();
   app.add_flag("--augment-flips", o->augment_flips, "mirror training flows at random, with the matching sign changes of the rates");
   app.add_flag("--resume", o->resume, "continue from <stem>.state.safetensors beside -o");
@@ -93,6 +97,7 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
     set_options.height = static_cast<int>(height);
     set_options.flow = parse_flow_method(o->flow);
     set_options.target = parse_sync_target(o->target);
+    if (!o->time_offset.empty()) set_options.time_offset_s = parse_seconds(o->time_offset, "--time-offset");
     WeightSet flownet;
     if (set_options.flow == FlowMethod::FlowNet) {
       if (o->weights.empty()) throw invalid_input("--flow flownet2 needs FlowNet2 weights (--weights FILE)");
@@ -161,6 +166,7 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
       j["flow"] = to_string(set_options.flow);
       j["input_size"] = std::to_string(width) + "x" + std::to_string(height);
       j["target"] = to_string(set_options.target);
+      j["time_offset_s"] = set_options.time_offset_s;
       j["frame"] = "body";
       j["train_sequences"] = train_set.sequences();
       j["val_sequences"] = val_set.sequences();

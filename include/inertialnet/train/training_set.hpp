@@ -40,6 +40,9 @@ struct TrainingSetOptions {
   Device* device = nullptr;
   std::string weights_id;
   SyncTarget target = SyncTarget::Spline;
+  // Camera–IMU time offset of every sequence (t_imu = t_cam + offset, eval/time_offset.hpp): the
+  // targets are the gyro at the shifted times, as eval --time-offset compares them.
+  double time_offset_s = 0;
   std::filesystem::path cache_dir;  // empty: no disk cache
   std::uint64_t cache_budget_bytes = std::numeric_limits<std::uint64_t>::max();
 };
