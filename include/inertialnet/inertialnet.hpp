@@ -55,6 +55,7 @@
 
 // models
 #include "inertialnet/models/dis_flow.hpp"
+#include "inertialnet/models/flow_consistency.hpp"
 #include "inertialnet/models/flownet.hpp"
 #include "inertialnet/models/dis_flow.hpp"
 #include "inertialnet/models/geometric_head.hpp"

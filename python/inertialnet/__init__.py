@@ -160,19 +160,22 @@ def predict(
     lanes: int = 2,
     decode_threads: int = 2,
     keep_flow: bool = False,
+    flow_check: float = 0.5,
 ):
     """Angular rates of every frame pair of a sequence, as ``inertialnet predict`` computes them.
 
     Returns a NumPy structured array with the fields ``timestamp_ns`` (int64, the pair's second
     frame) and ``wx, wy, wz`` (float64, rad/s), plus ``wx_geometric, …`` with ``head="both"``. The
-    arguments are the CLI's options: without weights, DIS flow and the geometric head. With
-    ``keep_flow=True`` returns ``(rates, flows)``, flows a list of ``(H, W, 2)`` arrays."""
+    arguments are the CLI's options: without weights, DIS flow and the geometric head;
+    ``flow_check`` is ``--flow-check`` (the DIS forward-backward check for the geometric head,
+    pixels at 752 columns; 0: off). With ``keep_flow=True`` returns ``(rates, flows)``, flows a
+    list of ``(H, W, 2)`` arrays (as computed, without the check's marks)."""
     if isinstance(weights, (str, os.PathLike)):
         weights = [weights]
     columns, t_ns, values, flows = _native._predict(
         os.fspath(sequence), [os.fspath(w) for w in weights], model or "", flow or "", head or "", solver,
         float(fx), float(fy), float(cx), float(cy), float(rate_hz), device or "", keep_flow, int(max_pairs),
-        int(lanes), int(decode_threads))
+        int(lanes), int(decode_threads), float(flow_check))
     dtype = [("timestamp_ns", np.int64)] + [(name, np.float64) for name in columns]
     rates = np.zeros(len(t_ns), dtype=dtype)
     rates["timestamp_ns"] = t_ns

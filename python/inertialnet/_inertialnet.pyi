@@ -38,7 +38,8 @@ class _FlowNet:
     device: str
     synthetic: bool
 
-def dis_flow(img1: npt.NDArray[Any], img2: npt.NDArray[Any], order: str = "rgb") -> npt.NDArray[np.float32]: ...
+def dis_flow(img1: npt.NDArray[Any], img2: npt.NDArray[Any], order: str = "rgb",
+             flow_check: float = 0.0) -> npt.NDArray[np.float32]: ...
 
 class GeometricHead:
     def __init__(self, device: _DeviceArg = None, solver: str = "motion-field", stride: int = 4) -> None: ...

@@ -249,7 +249,11 @@ class PyFlowNet {
   std::unique_ptr<FlowNet> net_;
 };
 
-py::array_t<float> dis_flow(const py::array& first, const py::array& second, const std::string& order) {
+py::array_t<float> dis_flow(const py::array& first, const py::array& second, const std::string& order,
+                            double flow_check) {
+  if (!std::isfinite(flow_check) || flow_check < 0) {
+    throw invalid_input("flow_check should be a non-negative number of pixels, got " + std::to_string(flow_check));
+  }
   const auto a = images_of(first, order, "img1");
   const auto b = images_of(second, order, "img2");
   if (a.size() != b.size()) throw invalid_input("img1 and img2 hold different numbers of images.");
@@ -257,7 +261,13 @@ py::array_t<float> dis_flow(const py::array& first, const py::array& second, con
   {
     py::gil_scoped_release release;
     DisFlow dis;
-    for (std::size_t i = 0; i < a.size(); ++i) flows.push_back(dis.compute(a[i], b[i]));
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      flows.push_back(dis.compute(a[i], b[i]));
+      if (flow_check > 0) {
+        const FlowField backward = dis.compute(b[i], a[i]);
+        mark_inconsistent_flow(flows.back(), backward, flow_check_threshold_px(flow_check, flows.back().width));
+      }
+    }
   }
   if (first.ndim() != 4) return flow_to_array(flows.front());
   const auto n = static_cast<py::ssize_t>(flows.size());
@@ -551,8 +561,11 @@ PYBIND11_MODULE(_inertialnet, m) {
       .def_property_readonly("device", &PyFlowNet::device)
       .def_property_readonly("synthetic", &PyFlowNet::synthetic);
 
-  m.def("dis_flow", &dis_flow, py::arg("img1"), py::arg("img2"), py::arg("order") = "rgb",
-        "OpenCV DIS optical flow (no weights) from img1 to img2: float32 (H, W, 2), or (N, H, W, 2) for batches.");
+  m.def("dis_flow", &dis_flow, py::arg("img1"), py::arg("img2"), py::arg("order") = "rgb", py::arg("flow_check") = 0.0,
+        "OpenCV DIS optical flow (no weights) from img1 to img2: float32 (H, W, 2), or (N, H, W, 2) for batches.\n"
+        "flow_check > 0 also computes the flow back and marks each vector whose round trip misses by more than\n"
+        "that many pixels (at 752 columns, scaled with the width) as unknown (1e10), as predict does for the\n"
+        "geometric head (its default 0.5); GeometricHead.rates skips unknown vectors.");
 
   py::class_<PyGeometricHead>(m, "GeometricHead", "Angular velocity from flow by geometry alone (no weights).")
       .def(py::init<const py::object&, const std::string&, int>(), py::arg("device") = py::none(),
@@ -583,7 +596,7 @@ PYBIND11_MODULE(_inertialnet, m) {
         [](const std::filesystem::path& sequence, const std::vector<std::string>& weights, const std::string& model,
            const std::string& flow, const std::string& head, const std::string& solver, double fx, double fy, double cx,
            double cy, double rate_hz, const std::string& device, bool keep_flow, std::size_t max_pairs, int lanes,
-           int decode_threads) {
+           int decode_threads, double flow_check) {
           PredictSettings s;
           s.sequence = sequence;
           s.weights = weights;
@@ -598,6 +611,7 @@ PYBIND11_MODULE(_inertialnet, m) {
           s.rate_hz = rate_hz;
           s.device = device;
           s.keep_flow = keep_flow;
+          s.flow_check_px = flow_check;
           if (lanes < 1 || decode_threads < 1) throw invalid_input("lanes and decode_threads must be at least 1");
           return predict(s, max_pairs, lanes, decode_threads);
         });

@@ -37,7 +37,7 @@ def test_dis_flow_and_geometric_head_step_by_step_match_the_cli(cli, sequence, t
     assert camera.width == 128 and to_body.shape == (3, 3)
     head = inertialnet.GeometricHead()
     for k in range(1, len(seq)):
-        flow = inertialnet.dis_flow(seq[k - 1], seq[k])
+        flow = inertialnet.dis_flow(seq[k - 1], seq[k], flow_check=0.5)  # predict's default check
         assert flow.shape == (96, 128, 2) and flow.dtype == np.float32
         w = head.rates(flow, camera, dt=(t[k] - t[k - 1]) * 1e-9, camera_to_body=to_body)
         assert ["%.9g" % v for v in w] == ["%.9g" % v for v in expected[k - 1, 1:].astype(float)]

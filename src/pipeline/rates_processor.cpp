@@ -34,6 +34,7 @@ class RatesProcessor : public PairProcessor {
     const int width = current.image.width, height = current.image.height;
     auto t = Clock::now();
     Tensor flow;
+    Tensor checked;  // the DIS flow with its inconsistent vectors marked unknown: the geometric head's
     if (flownet_) {
       const Shape shape{1, 3, height, width};
       const Tensor frame1 = Tensor::from_host(q, shape, previous.image.data);
@@ -42,15 +43,22 @@ class RatesProcessor : public PairProcessor {
       flow = flownet_->compute(q, frame1, frame2, &stop);
       q.finish();
     } else {
-      FlowField field = dis_->compute(previous.image, current.image);
-      if (options_.flow_check_px > 0) {
+      const auto upload = [&](const FlowField& field) {
+        std::vector<float> data(2 * field.pixel_count());
+        std::copy(field.u.begin(), field.u.end(), data.begin());
+        std::copy(field.v.begin(), field.v.end(), data.begin() + static_cast<std::ptrdiff_t>(field.pixel_count()));
+        return Tensor::from_host(q, {1, 2, height, width}, data);
+      };
+      const FlowField field = dis_->compute(previous.image, current.image);
+      flow = upload(field);
+      // Only the geometric head's solvers skip unknown vectors; the learned head and the saved
+      // flow get the flow as computed (an unknown marker is no input for a network).
+      if (geometric_ && options_.flow_check_px > 0) {
+        FlowField marked = field;
         const FlowField backward = dis_->compute(current.image, previous.image);
-        mark_inconsistent_flow(field, backward, options_.flow_check_px * width / 752.0);
+        mark_inconsistent_flow(marked, backward, flow_check_threshold_px(options_.flow_check_px, width));
+        checked = upload(marked);
       }
-      std::vector<float> data(2 * field.pixel_count());
-      std::copy(field.u.begin(), field.u.end(), data.begin());
-      std::copy(field.v.begin(), field.v.end(), data.begin() + static_cast<std::ptrdiff_t>(field.pixel_count()));
-      flow = Tensor::from_host(q, {1, 2, height, width}, data);
     }
     t = lap(result, "flow", t);
     if (head_) {
@@ -66,7 +74,7 @@ class RatesProcessor : public PairProcessor {
                             "a signed 64-bit count of nanoseconds.");
       }
       const double dt = static_cast<double>(dt_ns) * 1e-9;
-      const RotationEstimate estimate = geometric_->estimate(q, flow, dt, &stop);
+      const RotationEstimate estimate = geometric_->estimate(q, checked.defined() ? checked : flow, dt, &stop);
       const Vec3 w = to_body(options_.camera_to_body, estimate.omega);
       result.rates.push_back({"geometric", {w[0], w[1], w[2]}});
       t = lap(result, "geometric_head", t);

@@ -15,4 +15,8 @@ namespace inertialnet {
 // Throws invalid_input when the fields differ in size or the threshold is not positive.
 int mark_inconsistent_flow(FlowField& forward, const FlowField& backward, double threshold_px);
 
+// The threshold for an image `width` pixels wide from one given in pixels at 752 columns (EuRoC's
+// width; predict --flow-check, Python's flow_check), so that one setting means the same at every size.
+inline double flow_check_threshold_px(double px_at_752_columns, int width) { return px_at_752_columns * width / 752.0; }
+
 }  // namespace inertialnet
