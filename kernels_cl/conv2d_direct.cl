@@ -4,9 +4,6 @@
 // output pixels of one row for all COUT channels, as float16 lanes (PoCL does not vectorise
 // across work-items through the kernel's loops, so the lanes are explicit); bias and
 // activation are fused. Launch with work-groups of one.
-// conv2d_direct_pixels is the GPU layout of the same work: one output pixel per work-item, so
-// neighbouring work-items read neighbouring input floats (coalesced) and a launch has a work-item
-// per pixel to spread over the compute units, where 16-pixel strips would leave most idle.
 // Build options: -DCOUT, -DKH, -DKW, -DSTRIDE, -DPAD, -DHAS_BIAS, -DACTIVATION, -DNEGATIVE_SLOPE.
 
 #include "common.cl"
@@ -69,44 +66,5 @@ __kernel void conv2d_direct(__global const float* restrict in, const int in_offs
       vstore16(v, 0, t);
       for (int q = 0; q < lanes; ++q) dst[q] = t[q];
     }
-  }
-}
-
-// One output pixel (x, y) per work-item for all COUT channels; the global size may exceed the
-// output (rounded up to the work-group), those work-items return.
-__kernel void conv2d_direct_pixels(__global const float* restrict in, const int in_offset,
-                                   __global const float* restrict w, const int w_offset,
-                                   __global const float* restrict bias, const int bias_offset,
-                                   __global float* restrict out, const int out_offset,
-                                   const int channels, const int height, const int width,
-                                   const int out_height, const int out_width) {
-  const int ox = get_global_id(0);
-  const int oy = get_global_id(1);
-  if (ox >= out_width || oy >= out_height) return;
-  const int y0 = oy * STRIDE - PAD, x0 = ox * STRIDE - PAD;
-  const int taps = KH * KW;
-  float acc[COUT];
-  for (int o = 0; o < COUT; ++o) acc[o] = 0.0f;
-  for (int c = 0; c < channels; ++c) {
-    const __global float* plane = in + in_offset + c * height * width;
-    const __global float* wc = w + w_offset + c * taps;
-    for (int ky = 0; ky < KH; ++ky) {
-      const int y = y0 + ky;
-      if (y < 0 || y >= height) continue;
-      for (int kx = 0; kx < KW; ++kx) {
-        const int x = x0 + kx;
-        if (x < 0 || x >= width) continue;
-        const float v = plane[y * width + x];
-        for (int o = 0; o < COUT; ++o) acc[o] = fma(wc[o * channels * taps + ky * KW + kx], v, acc[o]);
-      }
-    }
-  }
-  const int plane_out = out_height * out_width;
-  for (int o = 0; o < COUT; ++o) {
-    float v = acc[o];
-#if HAS_BIAS
-    v += bias[bias_offset + o];
-#endif
-    out[out_offset + o * plane_out + oy * out_width + ox] = ACTIVATE(v);
   }
 }

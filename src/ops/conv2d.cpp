@@ -45,14 +45,12 @@ void conv2d_packed(Queue& queue, const Tensor& input, const Tensor& weight, cons
   }
 }
 
-// Few output channels: each work-item computes all of them for 16 output pixels of a row
-// (Strips) or for one pixel (Pixels) from the input window, with bias and activation; no column
-// matrix.
+// Few output channels: each work-item computes 16 output pixels of a row for all of them from
+// the input window, with bias and activation; no column matrix.
 void conv2d_direct(Queue& queue, const Tensor& input, const Tensor& weight, const Tensor& bias, const Tensor& output,
-                   const Conv2dOptions& options, DirectConvLayout layout) {
+                   const Conv2dOptions& options) {
   const bool has_bias = bias.defined();
-  const bool pixels = layout == DirectConvLayout::Pixels;
-  Kernel& kernel = queue.kernel("conv2d_direct", pixels ? "conv2d_direct_pixels" : "conv2d_direct",
+  Kernel& kernel = queue.kernel("conv2d_direct", "conv2d_direct",
                                 KernelDefines()
                                     .add("COUT", weight.dim(0))
                                     .add("KH", weight.dim(2))
@@ -67,14 +65,7 @@ void conv2d_direct(Queue& queue, const Tensor& input, const Tensor& weight, cons
     // Without a bias the kernel never reads its bias argument; any valid buffer will do.
     kernel.set_args(input.sample(n), weight, has_bias ? bias : weight, output.sample(n), input.c(), input.h(),
                     input.w(), out_h, out_w);
-    if (pixels) {
-      // 32 × 4 work-items: a warp along a row, the global size rounded up to whole groups.
-      constexpr std::size_t kGroupX = 32, kGroupY = 4;
-      queue.launch(kernel, Range((out_w + kGroupX - 1) / kGroupX * kGroupX, (out_h + kGroupY - 1) / kGroupY * kGroupY),
-                   Range(kGroupX, kGroupY));
-    } else {
-      queue.launch(kernel, Range((out_w + kLanes - 1) / kLanes, out_h), Range(1, 1));
-    }
+    queue.launch(kernel, Range((out_w + kLanes - 1) / kLanes, out_h), Range(1, 1));
   }
 }
 
@@ -125,19 +116,14 @@ void conv2d(Queue& queue, const Tensor& input, const Tensor& weight, const Tenso
                             bias, output, options);
     return;
   }
-  const bool cpu = device.info().type == DeviceType::CPU;
-  const DirectConvLayout direct_layout = options.direct_layout != DirectConvLayout::Default ? options.direct_layout
-                                         : cpu                                             ? DirectConvLayout::Strips
-                                                                                           : DirectConvLayout::Pixels;
-  if (weight.dim(0) <= kDirectConvMaxChannels && (uses_packed_kernels(backend) || !cpu)) {
-    // Also under CLBlast on GPUs: a GEMM with two rows (predict_flow) ran at 0.1 TFLOP/s there.
-    detail::report_backend(queue, "direct");
-    conv2d_direct(queue, input, weight, bias, output, options, direct_layout);
-    return;
-  }
   if (uses_packed_kernels(backend)) {
-    detail::report_backend(queue, to_string(GemmBackend::Packed));
-    conv2d_packed(queue, input, weight, bias, output, options);
+    if (weight.dim(0) <= kDirectConvMaxChannels) {
+      detail::report_backend(queue, "direct");
+      conv2d_direct(queue, input, weight, bias, output, options);
+    } else {
+      detail::report_backend(queue, to_string(GemmBackend::Packed));
+      conv2d_packed(queue, input, weight, bias, output, options);
+    }
     return;
   }
   detail::report_backend(queue, to_string(backend));

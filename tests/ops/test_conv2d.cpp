@@ -39,8 +39,7 @@ ConvCase from_layer(const flownet_layers::LayerShape& l) {
   return {l.identifier(), l.ci, l.co, l.h, l.w, l.k, l.stride, l.padding, l.bias, l.activation};
 }
 
-void expect_conv_matches(const ConvCase& c, const Placement& p,
-                         DirectConvLayout direct_layout = DirectConvLayout::Default) {
+void expect_conv_matches(const ConvCase& c, const Placement& p) {
   SCOPED_TRACE(c.name);
   Queue& queue = testing::test_queue();
   reference::ConvShape s{p.batch, c.ci, c.h, c.w, c.co, c.k, c.k, c.stride, c.padding};
@@ -60,7 +59,6 @@ void expect_conv_matches(const ConvCase& c, const Placement& p,
   Tensor w = Tensor::from_host(queue, {c.co, c.ci, c.k, c.k}, weight);
   Tensor b = c.bias ? Tensor::from_host(queue, {c.co}, bias) : Tensor();
   Conv2dOptions options{c.stride, c.padding, c.activation, p.max_column_floats};
-  options.direct_layout = direct_layout;
   conv2d(queue, in.view, w, b, out.view, options);
   EXPECT_TRUE(testing::untouched_outside(queue, out)) << "elements outside the output slice were written";
   const auto got = testing::view_values(queue, out);
@@ -97,20 +95,6 @@ TEST(Conv2d, OddSizesBatchThree) {
   expect_conv_matches({"k2s2p0", 3, 4, 37, 23, 2, 2, 0, true, ActivationSpec::none()}, {1});
   expect_conv_matches({"k1s2", 6, 5, 37, 23, 1, 2, 0, true, ActivationSpec::leaky_relu(0.2f)}, {3});
   expect_conv_matches({"k1s1_direct", 6, 5, 37, 23, 1, 1, 0, false, ActivationSpec::relu()}, {3});
-}
-
-// Layers with ≤ 4 output channels run directly; both layouts (CPU strips, GPU pixels) on the
-// suite's device whatever its type: odd sizes, strides, a slice, and a predict_flow of FlowNet2
-// (194 channels in, 2 out).
-TEST(Conv2d, DirectLayoutsMatchTheReference) {
-  for (const DirectConvLayout layout : {DirectConvLayout::Strips, DirectConvLayout::Pixels}) {
-    SCOPED_TRACE(layout == DirectConvLayout::Strips ? "strips" : "pixels");
-    expect_conv_matches({"flow_k3s1", 9, 2, 37, 23, 3, 1, 1, true, ActivationSpec::leaky_relu(0.1f)}, {3}, layout);
-    expect_conv_matches({"k5s2_co3", 5, 3, 37, 23, 5, 2, 2, false, ActivationSpec::none()}, {2}, layout);
-    expect_conv_matches({"k1s1_co4", 6, 4, 37, 23, 1, 1, 0, true, ActivationSpec::relu()}, {1}, layout);
-    expect_conv_matches({"slice_flow", 6, 2, 37, 23, 3, 1, 1, true, ActivationSpec::none()}, {3, 2, 3, 5, 4, 0}, layout);
-    expect_conv_matches({"predict_flow2", 194, 2, 33, 25, 3, 1, 1, true, ActivationSpec::none()}, {1}, layout);
-  }
 }
 
 TEST(Conv2d, WritesIntoAChannelSliceAndReadsFromOne) {

@@ -20,11 +20,6 @@
 
 namespace inertialnet {
 
-// How a layer with few output channels (≤ kDirectConvMaxChannels, FlowNet's predict_flow*) is
-// computed directly, without a column matrix: 16-pixel strips per work-item (CPUs), or a pixel per
-// work-item (GPUs and accelerators, under any GEMM plan). Default: by device type.
-enum class DirectConvLayout { Default, Strips, Pixels };
-
 struct Conv2dOptions {
   int stride = 1;
   int padding = 0;  // zeros on every side
@@ -36,7 +31,6 @@ struct Conv2dOptions {
   // The weights prepared for their backend once per layer (ops/gemm_plan.hpp); null: the
   // device's backend, with the weights packed on this call when it needs them packed.
   const GemmWeights* prepared = nullptr;
-  DirectConvLayout direct_layout = DirectConvLayout::Default;
 };
 
 // The output shape [N, co, Ho, Wo] of `input` [N, ci, H, W] convolved with `weight`
