@@ -20,3 +20,15 @@
 #else
 #define ACTIVATE(v) (v)
 #endif
+
+// Sums scratch[0..size) into scratch[0] (size a power of two: the work-group size), pairing the
+// halves in a fixed order, so one work-group size always gives one result (no float atomics).
+// Every work-item of the group calls it after writing its own scratch[lane]; when it returns,
+// scratch[0] holds the sum for all of them.
+inline void work_group_tree_sum(__local float* scratch, const int lane, const int size) {
+  for (int span = size / 2; span > 0; span /= 2) {
+    barrier(CLK_LOCAL_MEM_FENCE);
+    if (lane < span) scratch[lane] += scratch[lane + span];
+  }
+  barrier(CLK_LOCAL_MEM_FENCE);
+}

@@ -52,11 +52,7 @@ void gemv_rows(__global const float* restrict w, const int w_offset, const int l
   float sum = 0.0f;
   for (int q = lane; q < depth; q += GROUP) sum = fma(wr[q], xr[q], sum);
   partial[lane] = sum;
-  barrier(CLK_LOCAL_MEM_FENCE);
-  for (int span = GROUP / 2; span > 0; span /= 2) {
-    if (lane < span) partial[lane] += partial[lane + span];
-    barrier(CLK_LOCAL_MEM_FENCE);
-  }
+  work_group_tree_sum(partial, lane, GROUP);
   if (lane == 0) {
     float total = partial[0];
 #if HAS_BIAS

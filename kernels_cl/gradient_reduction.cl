@@ -1,6 +1,8 @@
 // Deterministic reductions for training: no float atomics, a fixed summation order for a given
 // work-group size (the host picks it from the device only, so one device always sums alike).
 
+#include "common.cl"
+
 // bias_gradient: out[c] (+)= Σ_n Σ_p grad[n, c, p] over a [N, C, P] view whose samples start
 // `stride` elements apart. One work-group of LOCAL (a power of two) work-items per channel:
 // lane l sums elements l, l + LOCAL, … of every sample in order, then a tree in local memory.
@@ -17,11 +19,7 @@ __kernel void bias_gradient(__global float* out, const int out_offset,
     for (int p = lane; p < inner; p += LOCAL) sum += row[p];
   }
   partial[lane] = sum;
-  barrier(CLK_LOCAL_MEM_FENCE);
-  for (int span = LOCAL / 2; span > 0; span /= 2) {
-    if (lane < span) partial[lane] += partial[lane + span];
-    barrier(CLK_LOCAL_MEM_FENCE);
-  }
+  work_group_tree_sum(partial, lane, LOCAL);
   if (lane == 0) {
     const float previous = accumulate ? out[out_offset + c] : 0.0f;
     out[out_offset + c] = previous + partial[0];
@@ -45,10 +43,6 @@ __kernel void mse_loss(__global float* loss, const int loss_offset,
     grad[grad_offset + i] = scale * d;
   }
   partial[lane] = sum;
-  barrier(CLK_LOCAL_MEM_FENCE);
-  for (int span = LOCAL / 2; span > 0; span /= 2) {
-    if (lane < span) partial[lane] += partial[lane + span];
-    barrier(CLK_LOCAL_MEM_FENCE);
-  }
+  work_group_tree_sum(partial, lane, LOCAL);
   if (lane == 0) loss[loss_offset] = partial[0] / (float)count;
 }

@@ -3,18 +3,11 @@
 // Frames are [N, C, H, W] views: element (n, c, p) at offset + n * batch_stride + c * plane + p.
 // WG_SIZE (build option) is the work-group size of the two reduction kernels, a power of two.
 
+#include "common.cl"
+
 #ifndef WG_SIZE
 #define WG_SIZE 256
 #endif
-
-// Tree reduction of scratch[0..WG_SIZE) into scratch[0]; every work-item of the group calls it.
-inline void tree_reduce(__local float* scratch, const int lid) {
-  for (int s = WG_SIZE / 2; s > 0; s >>= 1) {
-    barrier(CLK_LOCAL_MEM_FENCE);
-    if (lid < s) scratch[lid] += scratch[lid + s];
-  }
-  barrier(CLK_LOCAL_MEM_FENCE);
-}
 
 // Stage 1. Range (groups * WG_SIZE, N * C), local (WG_SIZE, 1). Work-group g of row (n, c)
 // sums the 8-pixel chunks g * WG_SIZE + lid + k * groups * WG_SIZE of both frames (eight float
@@ -46,7 +39,7 @@ __kernel void channel_partial_sums(__global const float* restrict f1, const int 
     for (int t = chunks * 8 + lid; t < plane; t += WG_SIZE) sum += p1[t] + p2[t];
   }
   scratch[lid] = sum;
-  tree_reduce(scratch, lid);
+  work_group_tree_sum(scratch, lid, WG_SIZE);
   if (lid == 0) partial[partial_offset + row * groups + group] = scratch[0];
 }
 
@@ -58,7 +51,7 @@ __kernel void channel_means(__global const float* restrict partial, const int pa
   const int lid = get_local_id(0);
   const int row = get_group_id(0);
   scratch[lid] = lid < groups ? partial[partial_offset + row * groups + lid] : 0.0f;
-  tree_reduce(scratch, lid);
+  work_group_tree_sum(scratch, lid, WG_SIZE);
   if (lid == 0) means[means_offset + row] = scratch[0] / count;
 }
 
