@@ -251,9 +251,6 @@ class PyFlowNet {
 
 py::array_t<float> dis_flow(const py::array& first, const py::array& second, const std::string& order,
                             double flow_check) {
-  if (!std::isfinite(flow_check) || flow_check < 0) {
-    throw invalid_input("flow_check should be a non-negative number of pixels, got " + std::to_string(flow_check));
-  }
   const auto a = images_of(first, order, "img1");
   const auto b = images_of(second, order, "img2");
   if (a.size() != b.size()) throw invalid_input("img1 and img2 hold different numbers of images.");
@@ -263,10 +260,7 @@ py::array_t<float> dis_flow(const py::array& first, const py::array& second, con
     DisFlow dis;
     for (std::size_t i = 0; i < a.size(); ++i) {
       flows.push_back(dis.compute(a[i], b[i]));
-      if (flow_check > 0) {
-        const FlowField backward = dis.compute(b[i], a[i]);
-        mark_inconsistent_flow(flows.back(), backward, flow_check_threshold_px(flow_check, flows.back().width));
-      }
+      dis.check(flows.back(), a[i], b[i], flow_check);
     }
   }
   if (first.ndim() != 4) return flow_to_array(flows.front());

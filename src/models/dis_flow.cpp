@@ -7,6 +7,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/video/tracking.hpp>
 
+#include "inertialnet/models/flow_consistency.hpp"
 #include "inertialnet/runtime/error.hpp"
 
 namespace inertialnet {
@@ -63,6 +64,13 @@ FlowField DisFlow::compute(const HostImage& first, const HostImage& second) {
   std::copy(planes[0].begin<float>(), planes[0].end<float>(), flow.u.begin());
   std::copy(planes[1].begin<float>(), planes[1].end<float>(), flow.v.begin());
   return flow;
+}
+
+int DisFlow::check(FlowField& forward, const HostImage& first, const HostImage& second, double px_at_752_columns) {
+  require_flow_check_setting(px_at_752_columns);
+  if (px_at_752_columns == 0) return 0;
+  const FlowField backward = compute(second, first);
+  return mark_inconsistent_flow(forward, backward, flow_check_threshold_px(px_at_752_columns, forward.width));
 }
 
 }  // namespace inertialnet

@@ -52,4 +52,11 @@ int mark_inconsistent_flow(FlowField& forward, const FlowField& backward, double
   return marked;
 }
 
+void require_flow_check_setting(double px_at_752_columns) {
+  if (!std::isfinite(px_at_752_columns) || px_at_752_columns < 0) {
+    throw invalid_input("the flow check threshold should be a non-negative number of pixels, got " +
+                        std::to_string(px_at_752_columns));
+  }
+}
+
 }  // namespace inertialnet

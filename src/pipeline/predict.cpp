@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "inertialnet/io/camera.hpp"
+#include "inertialnet/models/flow_consistency.hpp"
 #include "inertialnet/runtime/device_selection.hpp"
 #include "inertialnet/runtime/error.hpp"
 
@@ -58,10 +59,7 @@ Prediction::Prediction(const PredictSettings& s) : settings_(s) {
                         std::to_string(*s.time_offset_s));
   }
   processor_.geometric.readout_time_s = s.readout_time_s;
-  if (!std::isfinite(s.flow_check_px) || s.flow_check_px < 0) {
-    throw invalid_input("the flow check threshold should be a non-negative number of pixels, got " +
-                        std::to_string(s.flow_check_px));
-  }
+  require_flow_check_setting(s.flow_check_px);
   processor_.flow_check_px = s.flow_check_px;
   source_ = open_frame_source(s.sequence, s.rate_hz > 0 ? std::optional<double>(s.rate_hz) : std::nullopt);
   notes_ = source_->notes();

@@ -3,7 +3,6 @@
 
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/models/dis_flow.hpp"
-#include "inertialnet/models/flow_consistency.hpp"
 #include "inertialnet/models/flownet.hpp"
 #include "inertialnet/models/inertialnet_head.hpp"
 #include "inertialnet/pipeline/rates_processor.hpp"
@@ -55,8 +54,7 @@ class RatesProcessor : public PairProcessor {
       // flow get the flow as computed (an unknown marker is no input for a network).
       if (geometric_ && options_.flow_check_px > 0) {
         FlowField marked = field;
-        const FlowField backward = dis_->compute(current.image, previous.image);
-        mark_inconsistent_flow(marked, backward, flow_check_threshold_px(options_.flow_check_px, width));
+        dis_->check(marked, previous.image, current.image, options_.flow_check_px);
         checked = upload(marked);
       }
     }

@@ -28,6 +28,13 @@ class DisFlow {
   // size or are smaller than kDisMinimumSide on a side. Not thread-safe: one instance per thread.
   FlowField compute(const HostImage& first, const HostImage& second);
 
+  // Predict's forward-backward check for the geometric head (flow_consistency.hpp): computes the
+  // flow back from `second` to `first` and marks unknown each vector of `forward` (this class's
+  // flow from `first` to `second`) whose round trip misses by more than
+  // flow_check_threshold_px(px_at_752_columns, width). 0 leaves `forward` as it is; a negative or
+  // non-finite setting is invalid_input. Returns how many vectors were marked.
+  int check(FlowField& forward, const HostImage& first, const HostImage& second, double px_at_752_columns);
+
  private:
   struct State;
   std::unique_ptr<State> state_;
