@@ -164,7 +164,7 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
       j["seed"] = options.seed;
       j["augment_flips"] = options.flip_augmentation;
       j["flow"] = to_string(set_options.flow);
-      j["input_size"] = std::to_string(width) + "x" + std::to_string(height);
+      j["input_size"] = std::to_string(options.head.input_width) + "x" + std::to_string(options.head.input_height);
       j["target"] = to_string(set_options.target);
       j["time_offset_s"] = set_options.time_offset_s;
       j["frame"] = "body";
