@@ -103,8 +103,12 @@ std::vector<Plane> build_scene(const SynthOptions& o, const SynthTrajectory& tra
     const double near = close ? 0.3 : 1.5, band = close ? 0.15 : 0.75;
     for (int i = 0; i < 4; ++i) {
       const double z = layout.uniform(near + band * i, near + band * (i + 1));
-      const Eigen::Vector3d centre(z * half_x * layout.uniform(-0.65, 0.65),
-                                   z * half_y * layout.uniform(-0.65, 0.65), z);
+      // One draw per statement: the order in which a call's arguments are evaluated is
+      // unspecified (gcc and clang differ), and the scene must not depend on the compiler. The
+      // vertical offset is drawn first, as gcc did when the tests' bounds were set.
+      const double offset_y = layout.uniform(-0.65, 0.65);
+      const double offset_x = layout.uniform(-0.65, 0.65);
+      const Eigen::Vector3d centre(z * half_x * offset_x, z * half_y * offset_y, z);
       const double width = 2 * z * half_x * layout.uniform(0.2, 0.4);
       const double height = 2 * z * half_y * layout.uniform(0.25, 0.5);
       const double yaw = layout.uniform(-35, 35) * kPi / 180, pitch = layout.uniform(-20, 20) * kPi / 180;

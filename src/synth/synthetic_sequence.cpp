@@ -106,8 +106,14 @@ SynthReport write_synthetic_sequence(const fs::path& out_dir, const SynthOptions
     const double gyro_std = o.noise ? kGyroNoiseDensity * std::sqrt(o.imu_rate_hz) : 0;
     const double accel_std = o.noise ? kAccelNoiseDensity * std::sqrt(o.imu_rate_hz) : 0;
     if (o.noise) {
-      for (int k = 0; k < 3; ++k) report.gyro_bias[k] = noise.sign() * noise.uniform(0.01, 0.04);
-      for (int k = 0; k < 3; ++k) report.accel_bias[k] = noise.sign() * noise.uniform(0.02, 0.08);
+      // The sign is drawn before the magnitude, each in its own statement (the operands of `*`
+      // are unsequenced, so one expression would leave the order to the compiler).
+      const auto signed_uniform = [&](double lo, double hi) {
+        const double sign = noise.sign();
+        return sign * noise.uniform(lo, hi);
+      };
+      for (int k = 0; k < 3; ++k) report.gyro_bias[k] = signed_uniform(0.01, 0.04);
+      for (int k = 0; k < 3; ++k) report.accel_bias[k] = signed_uniform(0.02, 0.08);
     }
     report.gyro_noise_std = gyro_std;
     const Eigen::Matrix3d R_BS = euroc_R_BS();
