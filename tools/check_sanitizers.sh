@@ -8,7 +8,8 @@
 #
 # Left out here, and why:
 #  - the CLI scripts (label cli): the same code is reached by the unit suites and the fuzzers,
-#    and their subprocess runs would triple this pass; the CLI is therefore not built either;
+#    and their subprocess runs would triple this pass. The CLI is still built, so that CI
+#    compiles every source with clang as well as gcc;
 #  - install_consumer: it installs the library and builds a consumer project against it; the
 #    sanitizer flags stay out of the installed package by design, so that consumer would not
 #    link against an instrumented archive;
@@ -29,37 +30,26 @@ selection=(-L "unit|opencl|fuzz" -E "^test_flownet_fixtures")
 mapfile -t targets < <(ctest --test-dir "$build" -N "${selection[@]}" 2>/dev/null \
   | sed -n 's/^ *Test *#[0-9]*: *//p' \
   | sed -E -e 's/^(test_.+)_(clblast|winograd)$/\1/' -e 's/^fuzz_replay_/fuzz_/' | sort -u)
-cmake --build "$build" -j "$jobs" --target "${targets[@]}"
+cmake --build "$build" -j "$jobs" --target "${targets[@]}" inertialnet_cli
 
 # Pinned cache state: PoCL compiles every kernel afresh in this pass (see the suppressions).
 export POCL_CACHE_DIR="$PWD/$build/pocl-cache"
 export INERTIALNET_CACHE_DIR="$PWD/$build/program-cache"
 rm -rf "$POCL_CACHE_DIR" "$INERTIALNET_CACHE_DIR"
 export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
-export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1"
+# intercept_tls_get_addr=0: LeakSanitizer's tracer crashed (SIGSEGV, "Tracer caught signal 11",
+# no report) at the exit of a passing OpenCL suite, a few suites per pass. The cause is in the
+# sanitizer runtime of clang 14 (up to 16): its __tls_get_addr interceptor takes a dynamic TLS
+# block whose address is 16 modulo 4096 for one allocated by glibc 2.19-2.24, and reads the
+# 16 bytes before it as that block's start and size. Since glibc 2.25 those blocks come from
+# malloc, so under ASan the two words are ASan's own chunk header, and the tracer scans a
+# range that is not mapped. A dynamic TLS block exists per thread for each dlopen'ed library
+# with thread-locals: PoCL (loaded by the ICD loader) and its LLVM, with PoCL's worker
+# threads, so OpenCL suites draw that offset now and then (verbosity=2 shows the interceptor
+# at work there). Without the interception LeakSanitizer no longer scans those
+# blocks for pointers; they belong to the OpenCL driver, whose allocations are suppressed
+# anyway, and our own thread-locals are static TLS, which is still scanned.
+export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1:intercept_tls_get_addr=0"
 export LSAN_OPTIONS="suppressions=$PWD/tests/sanitizers/lsan_suppressions.txt:print_suppressions=0"
-status=0
-ctest --test-dir "$build" --output-on-failure -j "$jobs" "${selection[@]}" || status=$?
-if [ "$status" -ne 0 ]; then
-  # LeakSanitizer's tracer (the thread that stops the process at exit to scan its memory) now
-  # and then crashes with SIGSEGV after an OpenCL suite has passed, PoCL's worker threads still
-  # alive: "Tracer caught signal 11" and "LeakSanitizer has encountered a fatal error", no
-  # report (seen once each in test_conv2d_winograd and test_head_backprop, in different passes;
-  # both passed when run again). That is the checker failing, not a finding; its cause is not
-  # pinned down (rare, and LSan prints nothing more). Such a suite runs
-  # once more, everything else as before; a suite that failed in any other way (a sanitizer
-  # report, a failed assertion, a timeout, a second tracer crash) fails the pass.
-  log="$build/Testing/Temporary/LastTest.log"
-  mapfile -t failed < <(sed 's/^[0-9]*://' "$build/Testing/Temporary/LastTestsFailed.log")
-  mapfile -t tracer < <(awk '
-    /^[0-9]+\/[0-9]+ Testing: / { name = $3 }
-    /Tracer caught signal/ { crashed[name] = 1 }
-    /ERROR: (AddressSanitizer|LeakSanitizer: detected)|runtime error:|\[  FAILED  \]/ { report[name] = 1 }
-    END { for (t in crashed) if (!(t in report)) print t }' "$log" | sort)
-  if [ "${#tracer[@]}" -eq 0 ] || [ "${#tracer[@]}" -ne "${#failed[@]}" ]; then
-    exit "$status"
-  fi
-  echo "check_sanitizers: LeakSanitizer's tracer crashed in ${tracer[*]}; running them once more"
-  ctest --test-dir "$build" --output-on-failure -j "$jobs" -R "^($(IFS='|'; echo "${tracer[*]}"))\$"
-fi
+ctest --test-dir "$build" --output-on-failure -j "$jobs" "${selection[@]}"
 bash tools/fuzz.sh "${FUZZ_SECONDS:-30}"
