@@ -5,7 +5,8 @@
 # Builds the targets in build-asan/ (clang, AddressSanitizer + UBSan, the same tree as CI's
 # sanitizer build; FUZZ_BUILD_DIR moves it). Each target starts from its seed corpus
 # (tests/fuzz/corpus/<target>/) and keeps what it learns in <build>/fuzz-corpus/<target>/;
-# a finding is written to <build>/fuzz-findings/<target>/ and fails the script. Copy it into
+# a finding is written to <build>/fuzz-findings/<target>/ and fails the script. An input that
+# runs for more than 10 s is a finding too (a hang; libFuzzer's own default waits 20 min). Copy it into
 # tests/fuzz/regressions/<target>/ with the fix: CTest replays that folder (fuzz_replay_<target>).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -34,7 +35,7 @@ for target in "${targets[@]}"; do
   mkdir -p "$corpus" "$findings"
   log="$build/fuzz-findings/$target.log"
   set +e
-  "$build/tests/fuzz/fuzz_$target" -max_total_time="$seconds" -print_final_stats=1 -max_len=65536 \
+  "$build/tests/fuzz/fuzz_$target" -max_total_time="$seconds" -timeout=10 -print_final_stats=1 -max_len=65536 \
     -artifact_prefix="$findings/" "$corpus" "tests/fuzz/corpus/$target" >"$log" 2>&1
   code=$?
   set -e

@@ -1,5 +1,6 @@
 #include "io/yaml_util.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -37,6 +38,62 @@ bool key_without_value(const std::string& line) {
   if (comment != std::string::npos) s.erase(comment);
   while (!s.empty() && (s.back() == ' ' || s.back() == '\r' || s.back() == '\t')) s.pop_back();
   return s.size() > indentation(s) + 1 && s.back() == ':' && !sequence_item(s);
+}
+
+// OpenCV's YAML parser (4.6) reads a stream of documents. When the root collection ends before
+// the text does, it skips three characters as if they were "..." or "---" and looks for the
+// next document; there a '-' that does not open "---" is neither taken nor refused, and it
+// loops on it forever (found by fuzzing: tests/fuzz/regressions/sensor_yaml/next_document_hang*).
+// The root mapping of a block-style file ends early only at a line indented less than its first
+// key, or at a line that cannot be one of its keys ("- item", "...", "---", a directive or a
+// flow collection); a flow-style root ends at its closing bracket. Calibration files are one
+// block-style mapping, so anything else is refused here, before the parser runs, with the line
+// that breaks it. `text` is normalise()'s output, whose directive line comes first;
+// `added_lines` (0 or 1) is how many lines normalise() put before the file's own first line.
+void check_one_block_mapping(const std::string& text, const fs::path& path, std::size_t added_lines) {
+  // OpenCV ends a line at a carriage return or a NUL as well and drops the rest of it, so the
+  // lines below would not be the lines it reads (a second finding of the same hang hid its '-'
+  // behind a run of carriage returns). Only "\r\n" line ends are taken.
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    if (text[i] == '\0' || (text[i] == '\r' && (i + 1 == text.size() || text[i + 1] != '\n'))) {
+      const auto before = text.begin() + static_cast<std::ptrdiff_t>(i);
+      const auto line = static_cast<std::size_t>(std::count(text.begin(), before, '\n')) + 1;
+      throw invalid_input("Calibration file " + path.string() + " line " + std::to_string(line - added_lines) + ": " +
+                          (text[i] == '\0' ? "a NUL byte" : "a carriage return inside the line") +
+                          "; the file should be YAML text.");
+    }
+  }
+  std::stringstream in(text);
+  std::size_t root_indent = std::string::npos;
+  std::size_t number = 0;
+  bool document_start = false;
+  for (std::string line; std::getline(in, line);) {
+    ++number;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (blank_or_comment(line)) continue;
+    const std::size_t indent = indentation(line);
+    const char first = line[indent];
+    const auto refuse = [&](const std::string& why) {
+      throw invalid_input("Calibration file " + path.string() + " line " + std::to_string(number - added_lines) + ": " + why +
+                          "; the file should be one YAML mapping in block style (key: value, one per line).");
+    };
+    if (root_indent == std::string::npos) {
+      if (first == '%' && indent == 0) continue;  // the directive, which OpenCV reads and drops
+      if (line.compare(indent, 3, "---") == 0 && !document_start && line.find_first_not_of(' ', indent + 3) == std::string::npos) {
+        document_start = true;
+        continue;
+      }
+      if (first == '{' || first == '[') refuse("a flow collection as the root");
+      root_indent = indent;
+    } else if (indent < root_indent) {
+      refuse("indented less than the first key");
+    } else if (indent > root_indent) {
+      continue;  // inside a value
+    }
+    if (first == '-' || first == '.' || first == '%' || first == '{' || first == '[' || first == ']' || first == '}') {
+      refuse(std::string("'") + first + "' where a key of the root mapping should be");
+    }
+  }
 }
 
 }  // namespace
@@ -79,7 +136,9 @@ cv::FileStorage open(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
   std::stringstream buffer;
   buffer << in.rdbuf();
-  const std::string text = normalise(buffer.str());
+  const std::string original = buffer.str();
+  const std::string text = normalise(original);
+  check_one_block_mapping(text, path, original.rfind("%YAML", 0) == 0 ? 0 : 1);
   cv::FileStorage storage;
   try {
     storage.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);

@@ -63,6 +63,13 @@ file(REMOVE "${WORK}/yaml_folder/mav0/cam0/sensor.yaml")
 file(MAKE_DIRECTORY "${WORK}/yaml_folder/mav0/cam0/sensor.yaml")
 run(2 ${CLI} predict yaml_folder)
 expect_match("yaml_folder/mav0/cam0/sensor.yaml is not a regular file")
+# A sensor.yaml on which OpenCV's YAML parser looped forever (a fuzzing finding, 35 bytes): the
+# root mapping ends early and a '-' follows, so it is refused before the parser runs.
+file(REMOVE_RECURSE "${WORK}/yaml_hang")
+file(COPY "${WORK}/seq/" DESTINATION "${WORK}/yaml_hang")
+file(WRITE "${WORK}/yaml_hang/mav0/cam0/sensor.yaml" "%Y:\n- coXlvBS \nY:\n- coXlvBS:r_+)+ty")
+run(2 ${CLI} predict yaml_hang)
+expect_match("yaml_hang/mav0/cam0/sensor.yaml line 2: '-' where a key of the root mapping should be")
 file(WRITE "${WORK}/not_a_folder" "")
 run(2 ${CLI} predict seq --save-flow not_a_folder)
 expect_match("--save-flow not_a_folder: cannot use it as a folder")

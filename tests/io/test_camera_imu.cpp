@@ -155,6 +155,35 @@ TEST(CameraImu, YamlIndentlessSequencesAreIndented) {
   EXPECT_EQ(yaml::normalise("a:\n  - 1\n"), "%YAML:1.0\na:\n  - 1\n");
 }
 
+// OpenCV's parser loops forever on a '-' where it looks for a second document, which it does
+// whenever the root mapping ends before the text; such files are refused first, naming the line
+// of the file (not of the adjusted text). The first case is the fuzzer's 35-byte finding.
+TEST(CameraImu, YamlWithMoreThanOneRootMappingIsRefusedBeforeOpenCvLoopsOnIt) {
+  te::TempDir dir("yaml_shapes");
+  const fs::path p = dir.path() / "sensor.yaml";
+  const auto message = [&](const std::string& text) {
+    write(p, text);
+    return invalid_input_message([&] { yaml::open(p); });
+  };
+  EXPECT_TRUE(contains(message("%Y:\n- coXlvBS \nY:\n- coXlvBS:r_+)+ty"),
+                       "sensor.yaml line 2: '-' where a key of the root mapping should be; the file should be one YAML "
+                       "mapping in block style"));
+  EXPECT_TRUE(contains(message("%YAML:1.0\na: 1\n...\n- b\n"), "line 3: '.' where a key of the root mapping should be"));
+  EXPECT_TRUE(contains(message("a: 1\n---\n- b\n"), "line 2: '-' where a key"));
+  EXPECT_TRUE(contains(message("  a: 1\nb: 2\n- c\n"), "line 2: indented less than the first key"));
+  EXPECT_TRUE(contains(message("{a: 1}\nbb-c\n"), "line 1: a flow collection as the root"));
+  EXPECT_TRUE(contains(message("- a\n- b\n"), "line 1: '-' where a key"));
+  EXPECT_TRUE(contains(message("a: 1\n\r\r+\r.99\n- c\n"), "line 2: a carriage return inside the line"));
+  EXPECT_TRUE(contains(message(std::string("a: 1\nb: 2\0\n", 12)), "line 2: a NUL byte"));
+  // What calibration files look like still opens: comments, a directive, a document start,
+  // PyYAML's sequences at their key's indentation, nested maps and multi-line flow lists.
+  for (const std::string good : {"a: 1\n", "a: 1\r\nb:\r\n  c: 2\r\n", "# c\n%YAML:1.0\n---\na: 1\n", "%YAML 1.1\n---  \na:\n- 1\n- 2\nb: 3\n",
+                                 "T_BS:\n  cols: 4\n  data: [1, 2,\n         3]\nrate_hz: 20  # Hz\n"}) {
+    write(p, good);
+    EXPECT_NO_THROW(yaml::open(p)) << good;
+  }
+}
+
 TEST(ImuSequence, ImageFolderWithAnImuFile) {
   te::TempDir dir("imu_sequence");
   te::Spec spec;
