@@ -56,6 +56,16 @@ void extend_footprint(const Plane& plane, const SynthCamera& cam, const Eigen::M
 
 // sized to hold the whole field of view along the motion's horizon, and the textured panels of
 // `General` in front of it.
+SynthCamera synth_camera(int width, int height) {
+  SynthCamera cam;
+  cam.width = width;
+  cam.height = height;
+  const auto in = synth_intrinsics(width, height);
+  cam.K << in[0], 0, in[2], 0, in[1], in[3], 0, 0, 1;
+  cam.K_inv = cam.K.inverse();
+  return cam;
+}
+
 std::vector<Plane> build_scene(const SynthOptions& o, const SynthTrajectory& traj, const SynthCamera& cam) {
   const double f = std::max(cam.K(0, 0), cam.K(1, 1));
   // Shapes up to a twelfth of the frame: the largest edges and blobs scale with the view.

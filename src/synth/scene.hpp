@@ -27,6 +27,9 @@ struct SynthCamera {
   Eigen::Matrix3d K, K_inv;
 };
 
+// The camera `synth` renders with: width × height pixels and synth_intrinsics(width, height).
+SynthCamera synth_camera(int width, int height);
+
 // Row-major H with H·(u, v, 1) = h: texture column h0/h2, row h1/h2, and 1/h2 the depth along
 // the camera's z, for the camera at centre c with orientation R_WC.
 std::array<double, 9> plane_homography(const Plane& P, const Eigen::Matrix3d& R_WC, const Eigen::Vector3d& c,

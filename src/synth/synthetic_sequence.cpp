@@ -185,12 +185,7 @@ SynthReport write_synthetic_sequence(const fs::path& out_dir, const SynthOptions
     }
 
     // Frames.
-    SynthCamera cam;
-    cam.width = o.width;
-    cam.height = o.height;
-    const auto& in = report.intrinsics;
-    cam.K << in[0], 0, in[2], 0, in[1], in[3], 0, 0, 1;
-    cam.K_inv = cam.K.inverse();
+    const SynthCamera cam = detail::synth_camera(o.width, o.height);
     const std::vector<Plane> scene = build_scene(o, traj, cam);
     std::string listing = "#timestamp [ns],filename\n";
     const std::vector<int> png{cv::IMWRITE_PNG_COMPRESSION, 3};
