@@ -40,6 +40,9 @@ bool key_without_value(const std::string& line) {
   return s.size() > indentation(s) + 1 && s.back() == ':' && !sequence_item(s);
 }
 
+// A "%YAML…" line opens the text; normalise() puts OpenCV's own before any text without one.
+bool starts_with_directive(const std::string& text) { return text.rfind("%YAML", 0) == 0; }
+
 // OpenCV's YAML parser (4.6) reads a stream of documents. When the root collection ends before
 // the text does, it skips three characters as if they were "..." or "---" and looks for the
 // next document; there a '-' that does not open "---" is neither taken nor refused, and it
@@ -74,12 +77,14 @@ void check_one_block_mapping(const std::string& text, const fs::path& path, std:
     const std::size_t indent = indentation(line);
     const char first = line[indent];
     const auto refuse = [&](const std::string& why) {
-      throw invalid_input("Calibration file " + path.string() + " line " + std::to_string(number - added_lines) + ": " + why +
-                          "; the file should be one YAML mapping in block style (key: value, one per line).");
+      throw invalid_input("Calibration file " + path.string() + " line " + std::to_string(number - added_lines) +
+                          ": " + why + "; the file should be one YAML mapping in block style (key: value, one per line).");
     };
     if (root_indent == std::string::npos) {
       if (first == '%' && indent == 0) continue;  // the directive, which OpenCV reads and drops
-      if (line.compare(indent, 3, "---") == 0 && !document_start && line.find_first_not_of(' ', indent + 3) == std::string::npos) {
+      const bool bare_document_start =
+          line.compare(indent, 3, "---") == 0 && line.find_first_not_of(' ', indent + 3) == std::string::npos;
+      if (bare_document_start && !document_start) {
         document_start = true;
         continue;
       }
@@ -99,7 +104,7 @@ void check_one_block_mapping(const std::string& text, const fs::path& path, std:
 }  // namespace
 
 std::string normalise(std::string text) {
-  if (text.rfind("%YAML", 0) != 0) {
+  if (!starts_with_directive(text)) {
     text = "%YAML:1.0\n" + text;
   } else if (text.rfind("%YAML:", 0) != 0) {
     text.replace(0, text.find('\n'), "%YAML:1.0");
@@ -138,7 +143,7 @@ cv::FileStorage open(const fs::path& path) {
   buffer << in.rdbuf();
   const std::string original = buffer.str();
   const std::string text = normalise(original);
-  check_one_block_mapping(text, path, original.rfind("%YAML", 0) == 0 ? 0 : 1);
+  check_one_block_mapping(text, path, starts_with_directive(original) ? 0 : 1);
   cv::FileStorage storage;
   try {
     storage.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY | cv::FileStorage::FORMAT_YAML);

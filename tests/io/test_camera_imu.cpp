@@ -177,8 +177,9 @@ TEST(CameraImu, YamlWithMoreThanOneRootMappingIsRefusedBeforeOpenCvLoopsOnIt) {
   EXPECT_TRUE(contains(message(std::string("a: 1\nb: 2\0\n", 12)), "line 2: a NUL byte"));
   // What calibration files look like still opens: comments, a directive, a document start,
   // PyYAML's sequences at their key's indentation, nested maps and multi-line flow lists.
-  for (const std::string good : {"a: 1\n", "a: 1\r\nb:\r\n  c: 2\r\n", "# c\n%YAML:1.0\n---\na: 1\n", "%YAML 1.1\n---  \na:\n- 1\n- 2\nb: 3\n",
-                                 "T_BS:\n  cols: 4\n  data: [1, 2,\n         3]\nrate_hz: 20  # Hz\n"}) {
+  for (const std::string good :
+       {"a: 1\n", "a: 1\r\nb:\r\n  c: 2\r\n", "# c\n%YAML:1.0\n---\na: 1\n", "%YAML 1.1\n---  \na:\n- 1\n- 2\nb: 3\n",
+        "T_BS:\n  cols: 4\n  data: [1, 2,\n         3]\nrate_hz: 20  # Hz\n"}) {
     write(p, good);
     EXPECT_NO_THROW(yaml::open(p)) << good;
   }
