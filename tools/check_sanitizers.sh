@@ -46,9 +46,9 @@ export UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1"
 # range that is not mapped. A dynamic TLS block exists per thread for each dlopen'ed library
 # with thread-locals: PoCL (loaded by the ICD loader) and its LLVM, with PoCL's worker
 # threads, so OpenCL suites draw that offset now and then (verbosity=2 shows the interceptor
-# at work there). Without the interception LeakSanitizer no longer scans those
-# blocks for pointers; they belong to the OpenCL driver, whose allocations are suppressed
-# anyway, and our own thread-locals are static TLS, which is still scanned.
+# at work there). Without the interception LeakSanitizer no longer scans those blocks for
+# pointers; they belong to the OpenCL driver, whose allocations are suppressed anyway, and our
+# own thread-locals are static TLS, which is still scanned.
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1:intercept_tls_get_addr=0"
 export LSAN_OPTIONS="suppressions=$PWD/tests/sanitizers/lsan_suppressions.txt:print_suppressions=0"
 ctest --test-dir "$build" --output-on-failure -j "$jobs" "${selection[@]}"

@@ -6,8 +6,9 @@
 # sanitizer build; FUZZ_BUILD_DIR moves it). Each target starts from its seed corpus
 # (tests/fuzz/corpus/<target>/) and keeps what it learns in <build>/fuzz-corpus/<target>/;
 # a finding is written to <build>/fuzz-findings/<target>/ and fails the script. An input that
-# runs for more than 10 s is a finding too (a hang; libFuzzer's own default waits 20 min). Copy it into
-# tests/fuzz/regressions/<target>/ with the fix: CTest replays that folder (fuzz_replay_<target>).
+# runs for more than 10 s is a finding too (a hang; libFuzzer's own default waits 20 min). Copy
+# a finding into tests/fuzz/regressions/<target>/ with the fix: CTest replays that folder
+# (fuzz_replay_<target>).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds="${1:-30}"
