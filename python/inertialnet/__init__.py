@@ -164,31 +164,44 @@ def predict(
 ):
     """Angular rates of every frame pair of a sequence, as ``inertialnet predict`` computes them.
 
-    Returns a NumPy structured array with the fields ``timestamp_ns`` (int64, the pair's second
-    frame) and ``wx, wy, wz`` (float64, rad/s), plus ``wx_geometric, …`` with ``head="both"``. The
+    Returns a NumPy structured array with one row per frame pair and the fields ``timestamp_ns``
+    (int64, the pair's second frame), ``wx, wy, wz`` (float64, rad/s) and ``status`` (str:
+    ``"ok"``, or why the pair has no answer, e.g. ``"no_texture"``; its rates are then NaN), plus
+    ``wx_geometric, wy_geometric, wz_geometric, status_geometric`` with ``head="both"``. The
     arguments are the CLI's options: without weights, DIS flow and the geometric head;
     ``flow_check`` is ``--flow-check`` (the DIS forward-backward check for the geometric head,
     pixels at 752 columns; 0: off). With ``keep_flow=True`` returns ``(rates, flows)``, flows a
     list of ``(H, W, 2)`` arrays (as computed, without the check's marks)."""
     if isinstance(weights, (str, os.PathLike)):
         weights = [weights]
-    columns, t_ns, values, flows = _native._predict(
+    columns, t_ns, values, flows, statuses = _native._predict(
         os.fspath(sequence), [os.fspath(w) for w in weights], model or "", flow or "", head or "", solver,
         float(fx), float(fy), float(cx), float(cy), float(rate_hz), device or "", keep_flow, int(max_pairs),
         int(lanes), int(decode_threads), float(flow_check))
-    dtype = [("timestamp_ns", np.int64)] + [(name, np.float64) for name in columns]
+    # Fields as in the rates CSV: wx,wy,wz,status then wx_geometric,…,status_geometric.
+    dtype = [("timestamp_ns", np.int64)]
+    status_fields = []
+    for e in range(len(columns) // 3):
+        dtype += [(name, np.float64) for name in columns[3 * e:3 * e + 3]]
+        status_fields.append("status" + columns[3 * e][2:])
+        dtype.append((status_fields[-1], "U16"))
     rates = np.zeros(len(t_ns), dtype=dtype)
     rates["timestamp_ns"] = t_ns
     for i, name in enumerate(columns):
         rates[name] = values[:, i]
+    for e, name in enumerate(status_fields):
+        rates[name] = [row[e] for row in statuses]
     return (rates, flows) if keep_flow else rates
 
 
 def write_rates_csv(path: PathLike, rates: np.ndarray) -> None:
     """Writes a structured array from :func:`predict` as the CLI's rates CSV (atomically)."""
     names = list(rates.dtype.names)
-    values = np.stack([rates[n] for n in names[1:]], axis=1) if len(rates) else np.zeros((0, len(names) - 1))
-    _native._write_rates_csv(os.fspath(path), names[1:], rates[names[0]], values)
+    status_names = [n for n in names[1:] if n == "status" or n.startswith("status_")]
+    numeric = [n for n in names[1:] if n not in status_names]
+    values = np.stack([rates[n] for n in numeric], axis=1) if len(rates) else np.zeros((0, len(numeric)))
+    statuses = [[str(s) for s in rates[n]] for n in status_names]
+    _native._write_rates_csv(os.fspath(path), numeric, rates[names[0]], values, status_names, statuses)
 
 
 def evaluate(

@@ -428,13 +428,15 @@ class PySequence {
   std::unique_ptr<FrameSource> source_;
 };
 
-// The rows of predict(): the column names, the timestamps, the values (rows × columns) and, with
-// keep_flow, each pair's flow. The Python side makes the structured array.
+// The rows of predict(): the column names, the timestamps, the values (rows × columns; NaN where
+// a pair has no answer), with keep_flow each pair's flow, and the status words (rows × estimators).
+// The Python side makes the structured array.
 py::tuple predict(const PredictSettings& settings, std::size_t max_pairs, int lanes, int decode_threads) {
   std::vector<std::int64_t> t_ns;
   std::vector<double> values;
   std::vector<FlowField> flows;
   std::vector<std::string> columns;
+  std::vector<std::string> statuses;
   {
     py::gil_scoped_release release;
     Prediction prediction(settings);
@@ -446,7 +448,10 @@ py::tuple predict(const PredictSettings& settings, std::size_t max_pairs, int la
     prediction.run(
         [&](const PairResult& r) {
           t_ns.push_back(r.t1_ns);
-          for (const auto& [name, w] : r.rates) values.insert(values.end(), w.begin(), w.end());
+          for (const EstimatorRates& answer : r.rates) {
+            values.insert(values.end(), answer.w.begin(), answer.w.end());
+            statuses.emplace_back(to_string(answer.status));
+          }
           if (r.flow) flows.push_back(*r.flow);
         },
         options);
@@ -457,7 +462,14 @@ py::tuple predict(const PredictSettings& settings, std::size_t max_pairs, int la
   std::copy(values.begin(), values.end(), v.mutable_data());
   py::list flow_list;
   for (const auto& f : flows) flow_list.append(flow_to_array(f));
-  return py::make_tuple(columns, t, v, flow_list);
+  py::list status_rows;
+  const std::size_t estimators = columns.size() / 3;
+  for (std::size_t i = 0; i < t_ns.size(); ++i) {
+    py::list row;
+    for (std::size_t e = 0; e < estimators; ++e) row.append(statuses[i * estimators + e]);
+    status_rows.append(row);
+  }
+  return py::make_tuple(columns, t, v, flow_list, status_rows);
 }
 
 std::string evaluate_json(const std::filesystem::path& rates, const std::filesystem::path& sequence,
@@ -612,7 +624,8 @@ PYBIND11_MODULE(_inertialnet, m) {
   m.def("_evaluate_json", &evaluate_json);
   m.def("_write_rates_csv",
         [](const std::filesystem::path& path, const std::vector<std::string>& columns, const py::array& t,
-           const py::array& values) {
+           const py::array& values, const std::vector<std::string>& status_names,
+           const std::vector<std::vector<std::string>>& statuses) {
           const auto ta = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(t);
           const auto va = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(values);
           const auto rows = static_cast<std::size_t>(ta.size());
@@ -629,6 +642,8 @@ PYBIND11_MODULE(_inertialnet, m) {
             table.w.push_back({row[0], row[1], row[2]});
             for (std::size_t c = 3; c < k; ++c) table.extra[c - 3][r] = row[c];
           }
+          table.status_names = status_names;
+          table.statuses = statuses;
           write_rates_csv(path, table);
         });
 

@@ -39,11 +39,24 @@ std::filesystem::path histogram_path(const std::filesystem::path& plot) {
 
 }  // namespace
 
-EvalReport evaluate(const RatesTable& rates, const EurocSequence& seq, const EvalOptions& options) {
-  rates.validate();
+EvalReport evaluate(const RatesTable& all_rates, const EurocSequence& seq, const EvalOptions& options) {
+  all_rates.validate();
   EvalReport r;
   r.sequence = seq.name;
-  r.rate_rows = rates.size();
+  r.rate_rows = all_rates.size();
+  // Rows whose estimator gave no answer (status other than ok) are counted and left out; every
+  // figure below is over the answered rows.
+  const std::vector<std::string> statuses = all_rates.status(options.head_suffix);
+  for (const auto& status : statuses) {
+    if (status != "ok") ++r.not_ok_by_status[status];
+  }
+  const RatesTable rates = all_rates.ok_rows(options.head_suffix);
+  r.rows_not_ok = all_rates.size() - rates.size();
+  if (rates.size() == 0) {
+    throw invalid_input("None of the " + std::to_string(all_rates.size()) + " rows of the rates file has an answer in " +
+                        "wx" + options.head_suffix + ",wy" + options.head_suffix + ",wz" + options.head_suffix + " (" +
+                        r.not_ok_summary() + "): nothing to evaluate.");
+  }
   r.frames_in_sequence = seq.frames.size();
   r.imu_samples = seq.imu.size();
   r.warnings = seq.warnings;
@@ -203,6 +216,9 @@ EvalReport evaluate(const RatesTable& rates, const EurocSequence& seq, const Eva
     r.warnings.push_back("The first rates row carries the sequence's first camera timestamp; eval "
                          "assumes each row is stamped with the second frame of its pair.");
   }
+  if (r.rows_not_ok > 0) {
+    r.warnings.push_back(r.not_ok_summary() + " rows without an answer (their status is not ok) were left out.");
+  }
   if (r.rows_not_frames > 0) {
     r.warnings.push_back(std::to_string(r.rows_not_frames) + " of " + std::to_string(r.rate_rows) +
                          " rates rows carry timestamps that are not camera timestamps of " +
@@ -271,12 +287,25 @@ EvalReport evaluate(const std::filesystem::path& rates_csv, const std::filesyste
   return r;
 }
 
+std::string EvalReport::not_ok_summary() const {
+  std::string text = std::to_string(rows_not_ok);
+  if (not_ok_by_status.empty()) return text;
+  text += " (";
+  bool first = true;
+  for (const auto& [status, count] : not_ok_by_status) {
+    text += (first ? "" : ", ") + status + " " + std::to_string(count);
+    first = false;
+  }
+  return text + ")";
+}
+
 std::string EvalReport::table() const {
   std::string s = "Evaluation of " + (rates_file.empty() ? std::string("predicted rates") : rates_file) +
                   " (" + columns[0] + "," + columns[1] + "," + columns[2] + ") on " + sequence + "\n";
   s += "  frames evaluated: " + std::to_string(frames_evaluated()) + " of " +
        std::to_string(rate_rows) + " rates rows (" + std::to_string(frames_in_sequence) +
        " frames in the sequence)\n";
+  if (rows_not_ok > 0) s += "  pairs without an answer, left out: " + not_ok_summary() + "\n";
   s += "  ground truth: gyro, target " + to_string(target) + ", " +
        (camera_frame ? "camera frame" : "IMU frame") + ", bias " + to_string(bias_source);
   if (bias_source != BiasSource::None) s += " " + fmt3(bias_imu_frame, "%.5f") + " rad/s (IMU frame)";
@@ -320,6 +349,9 @@ std::string EvalReport::json(bool include_series) const {
   j["imu_samples_in_span"] = imu_samples_in_span;
   j["rows_not_frames"] = rows_not_frames;
   j["rows_without_truth"] = rows_without_truth;
+  j["rows_not_ok"] = rows_not_ok;
+  j["not_ok_by_status"] = nlohmann::json::object();
+  for (const auto& [status, count] : not_ok_by_status) j["not_ok_by_status"][status] = count;
   j["target"] = to_string(target);
   j["frame"] = camera_frame ? "camera" : "imu";
   j["rates_frame"] = rates_frame;

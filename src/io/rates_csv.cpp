@@ -14,7 +14,6 @@
 
 #include "inertialnet/runtime/error.hpp"
 #include "io/csv_util.hpp"
-#include "runtime/atomic_file.hpp"
 
 namespace fs = std::filesystem;
 
@@ -32,7 +31,44 @@ std::string joined(const std::vector<std::string>& names) {
 std::vector<std::string> all_columns(const RatesTable& t) {
   std::vector<std::string> names = {"timestamp_ns", "wx", "wy", "wz"};
   names.insert(names.end(), t.extra_names.begin(), t.extra_names.end());
+  names.insert(names.end(), t.status_names.begin(), t.status_names.end());
   return names;
+}
+
+bool is_status_column(const std::string& name) { return name == "status" || name.rfind("status_", 0) == 0; }
+
+// The status column that speaks for a rates column: status<suffix> for w[xyz]<suffix>; "" for
+// columns of no group (a numeric column of the caller's own).
+std::string status_column_of(const std::string& name) {
+  if (name.size() >= 2 && name[0] == 'w' && (name[1] == 'x' || name[1] == 'y' || name[1] == 'z')) {
+    return "status" + name.substr(2);
+  }
+  return "";
+}
+
+// A status word: lowercase letters, digits and '_' (what core/pair_status.hpp writes; a newer
+// version's words read as "not ok").
+bool is_status_word(std::string_view word) {
+  if (word.empty() || word.size() > 64) return false;
+  for (const char c : word) {
+    if (!((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_')) return false;
+  }
+  return true;
+}
+
+// The schema number a "# schema:" line states; invalid_input for another document or a newer one.
+int schema_version(const std::string& value, const fs::path& path) {
+  const std::string prefix = "inertialnet.rates/";
+  if (value.rfind(prefix, 0) == 0) {
+    const std::string number = value.substr(prefix.size());
+    if (number == "1" || number == "2") return number[0] - '0';
+    if (!number.empty() && number.size() < 6 && number.find_first_not_of("0123456789") == std::string::npos) {
+      throw invalid_input(path.string() + " is a rates file of schema " + value + ", newer than this version reads (" +
+                          kRatesSchema + "); update inertialnet.");
+    }
+  }
+  throw invalid_input(path.string() + " states the schema \"" + value.substr(0, 60) + "\"; expected " + kRatesSchema +
+                      ".");
 }
 }  // namespace
 
@@ -57,6 +93,42 @@ void RatesTable::validate() const {
       throw invalid_input("Rates table: column " + name + " has " + std::to_string(extra[c].size()) +
                           " values for " + std::to_string(t_ns.size()) + " rows.");
     }
+  }
+  if (statuses.size() != status_names.size()) {
+    throw invalid_input("Rates table: " + std::to_string(status_names.size()) + " status column names but " +
+                        std::to_string(statuses.size()) + " status columns.");
+  }
+  for (std::size_t c = 0; c < statuses.size(); ++c) {
+    const auto& name = status_names[c];
+    if (!is_status_column(name) || name.find_first_of(",\"\n\r") != std::string::npos) {
+      throw invalid_input("Rates table: \"" + name + "\" is no status column name (status or status_<estimator>).");
+    }
+    if (!seen.insert(name).second) throw invalid_input("Rates table: the column " + name + " appears twice.");
+    if (statuses[c].size() != t_ns.size()) {
+      throw invalid_input("Rates table: column " + name + " has " + std::to_string(statuses[c].size()) +
+                          " values for " + std::to_string(t_ns.size()) + " rows.");
+    }
+    for (std::size_t i = 0; i < t_ns.size(); ++i) {
+      if (!is_status_word(statuses[c][i])) {
+        throw invalid_input("Rates table: row " + std::to_string(i) + " of " + name + " is \"" +
+                            statuses[c][i].substr(0, 64) + "\"; a status is a lowercase word such as ok or no_texture.");
+      }
+    }
+  }
+  // A rate that is not a number belongs to a row whose estimator did not answer.
+  const auto check_finite = [&](const std::string& name, std::size_t row, double v) {
+    if (std::isfinite(v)) return;
+    const std::string status_name = status_column_of(name);
+    for (std::size_t c = 0; c < status_names.size(); ++c) {
+      if (status_names[c] == status_name && statuses[c][row] != "ok") return;
+    }
+    throw invalid_input("Rates row " + std::to_string(row) + " (timestamp " + std::to_string(t_ns[row]) + "): " + name +
+                        " is not finite but the row's " + (status_name.empty() ? "column has no status" : status_name +
+                        " is not set to a reason") + "; a rate without an answer needs a status other than ok.");
+  };
+  for (std::size_t i = 0; i < t_ns.size(); ++i) {
+    for (int k = 0; k < 3; ++k) check_finite(kAxes[k], i, w[i][k]);
+    for (std::size_t c = 0; c < extra.size(); ++c) check_finite(extra_names[c], i, extra[c][i]);
   }
 }
 
@@ -102,6 +174,33 @@ std::vector<Vec3> RatesTable::rates(const std::string& suffix) const {
   return out;
 }
 
+std::vector<std::string> RatesTable::status(const std::string& suffix) const {
+  const std::string name = "status" + suffix;
+  for (std::size_t c = 0; c < status_names.size(); ++c) {
+    if (status_names[c] == name) return statuses[c];
+  }
+  if (!suffix.empty()) column("wx" + suffix);  // a group that does not exist: name the columns
+  return std::vector<std::string>(t_ns.size(), "ok");
+}
+
+RatesTable RatesTable::ok_rows(const std::string& suffix) const {
+  const std::vector<std::string> words = status(suffix);
+  RatesTable out;
+  out.extra_names = extra_names;
+  out.extra.resize(extra.size());
+  out.status_names = status_names;
+  out.statuses.resize(statuses.size());
+  out.metadata = metadata;
+  for (std::size_t i = 0; i < t_ns.size(); ++i) {
+    if (words[i] != "ok") continue;
+    out.t_ns.push_back(t_ns[i]);
+    out.w.push_back(w[i]);
+    for (std::size_t c = 0; c < extra.size(); ++c) out.extra[c].push_back(extra[c][i]);
+    for (std::size_t c = 0; c < statuses.size(); ++c) out.statuses[c].push_back(statuses[c][i]);
+  }
+  return out;
+}
+
 RatesTable read_rates_csv(const fs::path& path) {
   csv::LineReader reader(path, "Rates file");
   RatesTable table;
@@ -109,6 +208,10 @@ RatesTable read_rates_csv(const fs::path& path) {
   bool have_header = false;
   int axis_at[3] = {-1, -1, -1};
   std::vector<int> extra_at;
+  std::vector<int> status_at;
+  // For wx,wy,wz and each extra column: the index into status_at of its group's status, or -1.
+  int axis_status = -1;
+  std::vector<int> extra_status;
   std::size_t n_fields = 0;
   std::vector<std::size_t> lines;
 
@@ -124,7 +227,10 @@ RatesTable read_rates_csv(const fs::path& path) {
         if (text.size() > 1 && text[0] == '#' && colon != std::string::npos) {
           const std::string key(csv::trim(std::string_view(text).substr(1, colon - 1)));
           const std::string value(csv::trim(std::string_view(text).substr(colon + 1)));
-          if (!key.empty() && key.find_first_of(" \t") == std::string::npos) table.metadata.emplace_back(key, value);
+          if (!key.empty() && key.find_first_of(" \t") == std::string::npos) {
+            if (key == "schema") schema_version(value, path);
+            table.metadata.emplace_back(key, value);
+          }
         }
         continue;
       }
@@ -153,11 +259,24 @@ RatesTable read_rates_csv(const fs::path& path) {
             axis = true;
           }
         }
-        if (!axis) {
+        if (axis) continue;
+        if (is_status_column(name)) {
+          table.status_names.push_back(name);
+          status_at.push_back(static_cast<int>(i));
+        } else {
           table.extra_names.push_back(name);
           extra_at.push_back(static_cast<int>(i));
         }
       }
+      const auto status_index = [&](const std::string& column) {
+        const std::string name = status_column_of(column);
+        for (std::size_t c = 0; c < table.status_names.size(); ++c) {
+          if (table.status_names[c] == name) return static_cast<int>(c);
+        }
+        return -1;
+      };
+      axis_status = status_index("wx");
+      for (const auto& name : table.extra_names) extra_status.push_back(status_index(name));
       for (int k = 0; k < 3; ++k) {
         if (axis_at[k] < 0) {
           throw invalid_input(path.string() + " line " + std::to_string(ln) +
@@ -166,6 +285,7 @@ RatesTable read_rates_csv(const fs::path& path) {
         }
       }
       table.extra.resize(extra_at.size());
+      table.statuses.resize(status_at.size());
       have_header = true;
       continue;
     }
@@ -177,11 +297,31 @@ RatesTable read_rates_csv(const fs::path& path) {
                           std::to_string(fields.size()) + ".");
     }
     table.t_ns.push_back(csv::parse_int64(fields[0], path, ln, "timestamp_ns"));
+    std::vector<bool> ok(status_at.size());
+    for (std::size_t c = 0; c < status_at.size(); ++c) {
+      const std::string_view word = fields[static_cast<std::size_t>(status_at[c])];
+      if (!is_status_word(word)) {
+        throw invalid_input(path.string() + " line " + std::to_string(ln) + ": " + table.status_names[c] + " is \"" +
+                            std::string(word.substr(0, 64)) + "\"; expected ok or the reason the pair has no answer "
+                            "(a lowercase word such as no_texture).");
+      }
+      table.statuses[c].emplace_back(word);
+      ok[c] = word == "ok";
+    }
+    // An empty cell is an unknown rate, allowed where the column's status says why.
+    const auto value = [&](std::string_view field, const std::string& column, int status, bool rate) {
+      if (field.empty() && status >= 0 && !ok[static_cast<std::size_t>(status)]) return std::nan("");
+      if (field.empty() && status >= 0) {
+        throw invalid_input(path.string() + " line " + std::to_string(ln) + ": " + column + " is empty but " +
+                            table.status_names[static_cast<std::size_t>(status)] + " is ok.");
+      }
+      return rate ? csv::parse_bounded(field, path, ln, column, 1e3, "rad/s") : csv::parse_double(field, path, ln, column);
+    };
     Vec3 w;
-    for (int k = 0; k < 3; ++k) w[k] = csv::parse_bounded(fields[axis_at[k]], path, ln, kAxes[k], 1e3, "rad/s");
+    for (int k = 0; k < 3; ++k) w[k] = value(fields[axis_at[k]], kAxes[k], axis_status, true);
     table.w.push_back(w);
     for (std::size_t c = 0; c < extra_at.size(); ++c) {
-      table.extra[c].push_back(csv::parse_double(fields[extra_at[c]], path, ln, table.extra_names[c]));
+      table.extra[c].push_back(value(fields[extra_at[c]], table.extra_names[c], extra_status[c], extra_status[c] >= 0));
     }
     lines.push_back(ln);
   }
@@ -191,130 +331,251 @@ RatesTable read_rates_csv(const fs::path& path) {
   return table;
 }
 
-// A regular file (or a new one) is written through the atomic writer: the rows go to a
-// temporary beside it, which replaces the file when the writer closes, so the final name never
-// holds a torn row and never replaces what is not a regular file. A FIFO or a character device
-// that the user named (`-o /dev/stdout`, a pipe) is what they asked to stream to: written in
-// place.
+std::vector<std::string> RatesLayout::columns() const {
+  std::vector<std::string> names = {"wx", "wy", "wz", "status"};
+  std::vector<bool> placed(status_names.size(), false);
+  for (const auto& name : extra_names) {
+    names.push_back(name);
+    if (name.rfind("wz", 0) != 0) continue;
+    for (std::size_t c = 0; c < status_names.size(); ++c) {
+      if (!placed[c] && status_names[c] == status_column_of(name)) {
+        names.push_back(status_names[c]);
+        placed[c] = true;
+      }
+    }
+  }
+  for (std::size_t c = 0; c < status_names.size(); ++c) {
+    if (!placed[c]) names.push_back(status_names[c]);
+  }
+  return names;
+}
+
+RatesLayout rates_layout(const std::vector<std::string>& suffixes) {
+  RatesLayout layout;
+  for (const auto& suffix : suffixes) {
+    if (suffix.empty()) continue;  // wx,wy,wz,status are always there
+    for (const char* axis : kAxes) layout.extra_names.push_back(axis + suffix);
+    layout.status_names.push_back("status" + suffix);
+  }
+  return layout;
+}
+
+fs::path partial_rates_path(const fs::path& path) {
+  fs::path partial = path;
+  partial += ".partial";
+  return partial;
+}
+
+namespace {
+
+[[noreturn]] void throw_write_error(const std::string& what, const fs::path& path, int err) {
+  const std::string message = "Cannot " + what + " " + path.string() + ": " + std::strerror(err) + ".";
+  // Problems the user can fix by choosing another path are bad input, the rest are the machine's.
+  if (err == ENOENT || err == ENOTDIR || err == EACCES || err == EPERM || err == EROFS || err == EISDIR) {
+    throw invalid_input(message);
+  }
+  throw runtime_error(message);
+}
+
+// The regular file that `path` names (a symbolic link is followed, so that its target is
+// replaced and the link kept), or invalid_input when it exists as something a rename would
+// destroy (a folder, a socket).
+fs::path regular_rates_target(const fs::path& path) {
+  std::error_code ec;
+  fs::path target = path;
+  if (fs::is_symlink(fs::symlink_status(path, ec))) {
+    target = fs::weakly_canonical(path, ec);
+    if (ec) throw invalid_input("Cannot write " + path.string() + ": it is a symbolic link that cannot be followed.");
+  }
+  const fs::file_status status = fs::status(target, ec);
+  if (status.type() != fs::file_type::not_found && !fs::is_regular_file(status)) {
+    throw invalid_input("Cannot write " + path.string() + ": it exists and is not a regular file; refusing to replace it.");
+  }
+  return target;
+}
+
+void sync_folder_of(const fs::path& file) {
+  fs::path folder = file.parent_path();
+  if (folder.empty()) folder = ".";
+  const int fd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return;  // best effort: the rows are on the disk under one name or the other
+  ::fsync(fd);
+  ::close(fd);
+}
+
+}  // namespace
+
+// The rows go to `<target>.partial` (or, for a FIFO or character device the user named, to the
+// target itself), one write() each; close() renames the journal over the target.
 struct RatesCsvWriter::Stream {
-  std::unique_ptr<AtomicFile> atomic;
   int fd = -1;
-  fs::path path;
+  fs::path target;   // what close() puts in place
+  fs::path journal;  // where the rows are written; == target when streaming in place
+  bool in_place = false;
 
   void write(const std::string& text) {
-    if (atomic) {
-      atomic->write(text.data(), text.size());
-      return;
-    }
     const char* p = text.data();
     std::size_t left = text.size();
     while (left > 0) {
       const ssize_t n = ::write(fd, p, left);
       if (n < 0 && errno == EINTR) continue;
-      if (n < 0) throw runtime_error("Writing " + path.string() + " failed: " + std::strerror(errno) + ".");
+      if (n < 0) throw_write_error("write", journal, errno);
       p += n;
       left -= static_cast<std::size_t>(n);
     }
   }
   void close() {
-    if (atomic) {
-      atomic->commit();
-      atomic.reset();
-    } else if (fd >= 0) {
-      const int closing = std::exchange(fd, -1);
-      if (::close(closing) != 0) throw runtime_error("Closing " + path.string() + " failed: " + std::strerror(errno) + ".");
-    }
+    if (fd < 0) return;
+    if (!in_place && ::fsync(fd) != 0) throw_write_error("flush", journal, errno);
+    const int closing = std::exchange(fd, -1);
+    if (::close(closing) != 0) throw_write_error("close", journal, errno);
+    if (in_place) return;
+    if (::rename(journal.c_str(), target.c_str()) != 0) throw_write_error("rename " + journal.string() + " to", target, errno);
+    sync_folder_of(target);
   }
   ~Stream() {
-    if (fd >= 0) ::close(fd);
+    if (fd >= 0) ::close(fd);  // not closed: the journal stays, with every row written so far
   }
 };
 
-std::string rates_csv_header(const std::vector<std::string>& extra_names,
-                             const std::vector<std::pair<std::string, std::string>>& metadata) {
-  std::string s;
+std::string rates_csv_header(const RatesLayout& layout, const std::vector<std::pair<std::string, std::string>>& metadata) {
+  std::string s = std::string("# schema: ") + kRatesSchema + "\n";
   for (const auto& [key, value] : metadata) {
     if (key.empty() || key.find_first_of(" \t:\n\r") != std::string::npos || value.find_first_of("\n\r") != std::string::npos) {
       throw invalid_input("Rates file metadata \"" + key + "\": keys are single words, values single lines.");
     }
+    if (key == "schema") continue;  // written above, for this layout
     s += "# " + key + ": " + value + "\n";
   }
-  s += "timestamp_ns,wx,wy,wz";
-  for (const auto& name : extra_names) s += "," + name;
+  s += "timestamp_ns";
+  for (const auto& name : layout.columns()) s += "," + name;
   return s + "\n";
 }
 
-RatesCsvWriter::RatesCsvWriter(const fs::path& path, const std::vector<std::string>& extra_names,
+std::string format_rates_row(const RatesLayout& layout, const RatesRow& row) {
+  if (row.extra.size() != layout.extra_names.size() || row.statuses.size() != layout.status_names.size()) {
+    throw invalid_input("Rates row for timestamp " + std::to_string(row.t_ns) + " has " + std::to_string(row.extra.size()) +
+                        " extra values and " + std::to_string(row.statuses.size()) + " statuses, the header " +
+                        std::to_string(layout.extra_names.size()) + " and " + std::to_string(layout.status_names.size()) +
+                        ".");
+  }
+  const auto status_of = [&](const std::string& column) -> const std::string* {
+    const std::string name = status_column_of(column);
+    if (name == "status") return &row.status;
+    for (std::size_t c = 0; c < layout.status_names.size(); ++c) {
+      if (layout.status_names[c] == name) return &row.statuses[c];
+    }
+    return nullptr;
+  };
+  for (const std::string* word : {&row.status}) {
+    if (!is_status_word(*word)) throw invalid_input("Rates row for timestamp " + std::to_string(row.t_ns) + ": \"" + word->substr(0, 64) + "\" is no status word.");
+  }
+  for (const auto& word : row.statuses) {
+    if (!is_status_word(word)) throw invalid_input("Rates row for timestamp " + std::to_string(row.t_ns) + ": \"" + word.substr(0, 64) + "\" is no status word.");
+  }
+  char buf[48];
+  std::string text = std::to_string(row.t_ns);
+  const auto cell = [&](const std::string& column, double v) {
+    const std::string* status = status_of(column);
+    if (status && *status != "ok") {
+      text += ",";  // no answer: an empty cell, whatever was computed
+      return;
+    }
+    if (!std::isfinite(v)) {
+      throw invalid_input("Rates row for timestamp " + std::to_string(row.t_ns) + ": " + column +
+                          " is not finite (NaN or infinity) on a row whose status is ok; refusing to write it.");
+    }
+    std::snprintf(buf, sizeof buf, ",%.9g", v);
+    text += buf;
+  };
+  std::vector<std::string> columns = layout.columns();
+  std::size_t extra = 0, status = 0;
+  for (const auto& name : columns) {
+    if (name == "wx" || name == "wy" || name == "wz") {
+      cell(name, row.w[static_cast<std::size_t>(name[1] - 'x')]);
+    } else if (name == "status") {
+      text += "," + row.status;
+    } else if (is_status_column(name)) {
+      text += "," + row.statuses[status++];
+    } else {
+      cell(name, row.extra[extra++]);
+    }
+  }
+  return text + "\n";
+}
+
+RatesCsvWriter::RatesCsvWriter(const fs::path& path, const RatesLayout& layout,
                                const std::vector<std::pair<std::string, std::string>>& metadata)
-    : path_(path), extra_count_(extra_names.size()), out_(std::make_unique<Stream>()) {
-  out_->path = path;
+    : path_(path), layout_(layout), out_(std::make_unique<Stream>()) {
+  const std::string header = rates_csv_header(layout_, metadata);  // bad metadata before any file is made
   std::error_code error;
   const fs::file_status status = fs::status(path, error);
   if (!error && (fs::is_fifo(status) || fs::is_character_file(status))) {
+    out_->in_place = true;
+    out_->target = out_->journal = path;
     out_->fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
     if (out_->fd < 0) throw invalid_input("Cannot open " + path.string() + " for writing: " + std::strerror(errno) + ".");
   } else {
-    try {
-      out_->atomic = std::make_unique<AtomicFile>(path);
-    } catch (const Error& e) {
-      if (e.kind() != ErrorKind::InvalidInput) throw;
-      throw invalid_input("Cannot open " + path.string() + " for writing: " + e.what());
+    out_->target = regular_rates_target(path);
+    out_->journal = partial_rates_path(out_->target);
+    const fs::file_status journal = fs::symlink_status(out_->journal, error);
+    if (journal.type() != fs::file_type::not_found && !fs::is_regular_file(journal)) {
+      throw invalid_input("Cannot write " + out_->journal.string() + " (where the rows of " + path.string() +
+                          " go until the run ends): it exists and is not a regular file.");
+    }
+    out_->fd = ::open(out_->journal.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (out_->fd < 0) {
+      const int err = errno;
+      throw invalid_input("Cannot open " + out_->journal.string() + " for writing: " + std::strerror(err) + ".");
     }
   }
-  out_->write(rates_csv_header(extra_names, metadata));
+  out_->write(header);
 }
 
-RatesCsvWriter::~RatesCsvWriter() {
-  // Not closed (an error or an interruption unwound past the writer): the rows so far still
-  // make a valid file, as the class promises; a failure here has no one left to tell.
-  try {
-    close();
-  } catch (const Error&) {
-  }
-}
+RatesCsvWriter::~RatesCsvWriter() = default;  // not closed: the journal keeps the rows so far
+
+const fs::path& RatesCsvWriter::journal() const { return out_->journal; }
 
 void RatesCsvWriter::close() {
   if (out_) out_->close();
 }
 
-void RatesCsvWriter::write(std::int64_t t_ns, const Vec3& w, const std::vector<double>& extra) {
-  if (extra.size() != extra_count_) {
-    throw invalid_input("Rates row for timestamp " + std::to_string(t_ns) + " has " + std::to_string(extra.size()) +
-                        " extra values, the header " + std::to_string(extra_count_) + ".");
-  }
-  bool finite = std::isfinite(w[0]) && std::isfinite(w[1]) && std::isfinite(w[2]);
-  for (const double v : extra) finite = finite && std::isfinite(v);
-  if (!finite) {
-    throw invalid_input("Rates row " + std::to_string(rows_) + " (timestamp " + std::to_string(t_ns) +
-                        ") holds a non-finite value; refusing to write " + path_.string() + ".");
-  }
-  if (rows_ > 0 && t_ns <= last_t_ns_) {
-    throw invalid_input("Rates row " + std::to_string(rows_) + ": timestamp " + std::to_string(t_ns) +
+void RatesCsvWriter::write(const RatesRow& row) {
+  if (rows_ > 0 && row.t_ns <= last_t_ns_) {
+    throw invalid_input("Rates row " + std::to_string(rows_) + ": timestamp " + std::to_string(row.t_ns) +
                         " does not follow " + std::to_string(last_t_ns_) + "; refusing to write " + path_.string() +
                         ".");
   }
-  char buf[48];
-  std::string row = std::to_string(t_ns);
-  for (int k = 0; k < 3; ++k) {
-    std::snprintf(buf, sizeof buf, ",%.9g", w[k]);
-    row += buf;
-  }
-  for (const double v : extra) {
-    std::snprintf(buf, sizeof buf, ",%.9g", v);
-    row += buf;
-  }
-  out_->write(row + "\n");  // one write per row: a reader of a stream sees whole rows
+  out_->write(format_rates_row(layout_, row));  // one write per row: a reader, or a killed run, sees whole rows
   ++rows_;
-  last_t_ns_ = t_ns;
+  last_t_ns_ = row.t_ns;
 }
 
 void write_rates_csv(const fs::path& path, const RatesTable& table) {
   table.validate();
-  RatesCsvWriter writer(path, table.extra_names, table.metadata);
-  std::vector<double> extra(table.extra.size());
+  RatesLayout layout;
+  layout.extra_names = table.extra_names;
+  int primary = -1;
+  for (std::size_t c = 0; c < table.status_names.size(); ++c) {
+    if (table.status_names[c] == "status") {
+      primary = static_cast<int>(c);
+    } else {
+      layout.status_names.push_back(table.status_names[c]);
+    }
+  }
+  RatesCsvWriter writer(path, layout, table.metadata);
+  RatesRow row;
+  row.extra.resize(layout.extra_names.size());
   for (std::size_t i = 0; i < table.size(); ++i) {
-    for (std::size_t c = 0; c < extra.size(); ++c) extra[c] = table.extra[c][i];
-    writer.write(table.t_ns[i], table.w[i], extra);
+    row.t_ns = table.t_ns[i];
+    row.w = table.w[i];
+    row.status = primary >= 0 ? table.statuses[static_cast<std::size_t>(primary)][i] : "ok";
+    for (std::size_t c = 0; c < row.extra.size(); ++c) row.extra[c] = table.extra[c][i];
+    row.statuses.clear();
+    for (std::size_t c = 0; c < table.status_names.size(); ++c) {
+      if (static_cast<int>(c) != primary) row.statuses.push_back(table.statuses[c][i]);
+    }
+    writer.write(row);
   }
   writer.close();
 }

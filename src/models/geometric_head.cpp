@@ -16,6 +16,7 @@
 #include <algorithm>
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <utility>
 #include <vector>
@@ -103,7 +104,39 @@ void GeometricHead::check_flow(const Tensor& flow) const {
   flow.offset_int();
 }
 
+namespace {
+
+// Marks an estimate that too few of its vectors agree with, or whose inliers scatter over the
+// inlier window as if the fit explained nothing (RotationEstimate::status).
+RotationEstimate assessed(RotationEstimate est, double inlier_threshold_px) {
+  const double inliers = est.inlier_fraction * est.samples;
+  if (est.residual_px > kMaximumResidualShare * inlier_threshold_px) {
+    char text[240];
+    std::snprintf(text, sizeof text,
+                  "geometric head: the flow vectors that fit the motion found miss it by %.2f px (RMS); above %.2f px "
+                  "the flow is not following the scene (a frame of noise, a flash, a blur burst)",
+                  est.residual_px, kMaximumResidualShare * inlier_threshold_px);
+    est.status = PairStatus::Unreliable;
+    est.status_reason = text;
+  } else if (est.inlier_fraction < kMinimumInlierFraction || inliers < kMinimumInliers) {
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "geometric head: only %.0f of the %d usable flow vectors (%.0f %%) fit the motion found; at least "
+                  "%d and %.0f %% are needed to trust it",
+                  inliers, est.samples, 100 * est.inlier_fraction, kMinimumInliers, 100 * kMinimumInlierFraction);
+    est.status = PairStatus::Unreliable;
+    est.status_reason = text;
+  }
+  return est;
+}
+
+}  // namespace
+
 RotationEstimate GeometricHead::estimate(Queue& queue, const Tensor& flow, double dt, const std::atomic<bool>* stop) {
+  return assessed(solve(queue, flow, dt, stop), options_.inlier_threshold_px);
+}
+
+RotationEstimate GeometricHead::solve(Queue& queue, const Tensor& flow, double dt, const std::atomic<bool>* stop) {
   // Checked before every pass over the flow, so that the translation search (tens of passes on
   // the general model) stops soon after the flag is set.
   const auto check_stop = [stop](const char* where) {

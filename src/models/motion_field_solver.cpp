@@ -55,6 +55,7 @@
 #include <utility>
 
 #include "core/eigen_conversions.hpp"
+#include "inertialnet/core/pair_status.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "models/translation_search.hpp"
 
@@ -83,7 +84,7 @@ double distance(const Vec3& a, const Vec3& b) { return (to_eigen(a) - to_eigen(b
 
 void check_usable(const MotionFieldMoments& m) {
   if (m.usable < kMinimumSamples) {
-    throw invalid_input("geometric head: only " + std::to_string(static_cast<long long>(m.usable)) +
+    throw UnanswerablePair(PairStatus::TooFewVectors, "geometric head: only " + std::to_string(static_cast<long long>(m.usable)) +
                         " flow vectors of the sample grid are usable (known and ending inside the image); at least " +
                         std::to_string(static_cast<int>(kMinimumSamples)) + " are needed");
   }
@@ -184,7 +185,7 @@ RotationEstimate solve_motion_field(const MomentsFunction& moments, double dt, d
       q.check(next_t);
       Eigen::Vector3d dw;
       if (!std::isfinite(q.cost(next_t, &dw))) {
-        throw invalid_input("geometric head: the flow samples do not determine rotation and translation");
+        throw UnanswerablePair(PairStatus::Unreliable, "geometric head: the flow samples do not determine rotation and translation");
       }
       run.converged = pass > 0 && s <= sigma_final && q.significance(next_t, dw) < kStepSignificance;
       const Eigen::Vector3d next_omega = to_eigen(run.omega) + dw;

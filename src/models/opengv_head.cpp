@@ -22,6 +22,7 @@
 
 #include "core/eigen_conversions.hpp"
 #include "core/so3.hpp"
+#include "inertialnet/core/pair_status.hpp"
 #include "inertialnet/runtime/error.hpp"
 
 #if defined(__x86_64__) && EIGEN_MAX_STATIC_ALIGN_BYTES != 16
@@ -69,7 +70,7 @@ RotationEstimate solve_opengv(const std::vector<NormalizedCorrespondence>& corre
   if (!(dt > 0) || !std::isfinite(dt)) throw invalid_input("geometric head: the frame interval dt must be positive");
   if (!(focal_px > 0) || !std::isfinite(focal_px)) throw invalid_input("geometric head: the focal length must be positive");
   if (correspondences.size() < 10) {
-    throw invalid_input("geometric head (OpenGV): only " + std::to_string(correspondences.size()) +
+    throw UnanswerablePair(PairStatus::TooFewVectors, "geometric head (OpenGV): only " + std::to_string(correspondences.size()) +
                         " usable flow vectors on the sample grid; at least 10 are needed");
   }
 
@@ -97,7 +98,7 @@ RotationEstimate solve_opengv(const std::vector<NormalizedCorrespondence>& corre
   {
     opengv::sac::Ransac<sacp::RotationOnlySacProblem> ransac(options.ransac_iterations, threshold);
     ransac.sac_model_ = std::make_shared<sacp::RotationOnlySacProblem>(adapter, false);  // false: fixed seed
-    if (!ransac.computeModel()) throw invalid_input("geometric head (OpenGV): two-point RANSAC found no rotation");
+    if (!ransac.computeModel()) throw UnanswerablePair(PairStatus::Unreliable, "geometric head (OpenGV): two-point RANSAC found no rotation");
     ransac.sac_model_->optimizeModelCoefficients(ransac.inliers_, ransac.model_coefficients_, rotation);
     inliers = ransac.inliers_;
     iterations = ransac.iterations_;
@@ -123,7 +124,7 @@ RotationEstimate solve_opengv(const std::vector<NormalizedCorrespondence>& corre
     opengv::sac::Ransac<sacp::CentralRelativePoseSacProblem> ransac(options.ransac_iterations, 2 * threshold);
     ransac.sac_model_ =
         std::make_shared<sacp::CentralRelativePoseSacProblem>(adapter, sacp::CentralRelativePoseSacProblem::NISTER, false);
-    if (!ransac.computeModel()) throw invalid_input("geometric head (OpenGV): five-point RANSAC found no pose");
+    if (!ransac.computeModel()) throw UnanswerablePair(PairStatus::Unreliable, "geometric head (OpenGV): five-point RANSAC found no pose");
     opengv::transformation_t refined;
     ransac.sac_model_->optimizeModelCoefficients(ransac.inliers_, ransac.model_coefficients_, refined);
     rotation = refined.block<3, 3>(0, 0);

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "inertialnet/core/constants.hpp"
+#include "inertialnet/core/pair_status.hpp"
 #include "inertialnet/runtime/error.hpp"
 
 namespace inertialnet::detail {
@@ -27,7 +28,7 @@ Eigen::Matrix3d symmetric(const std::array<double, 6>& u) {
 void check_conditioning(const Eigen::Matrix3d& n) {
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(n, Eigen::EigenvaluesOnly);
   if (!(eig.eigenvalues()(0) > 1e-12 * eig.eigenvalues()(2))) {
-    throw invalid_input("geometric head: the flow samples do not determine the rotation (degenerate normal equations; "
+    throw UnanswerablePair(PairStatus::Unreliable, "geometric head: the flow samples do not determine the rotation (degenerate normal equations; "
                         "too few usable vectors, or all on a line)");
   }
 }

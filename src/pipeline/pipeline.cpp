@@ -61,7 +61,14 @@ void decode_loop(Schedule& s, FrameSource& source) {
     auto frame = std::make_shared<Frame>();
     frame->index = index;
     frame->t_ns = source.timestamp_ns(index);
-    frame->image = source.decode(index);
+    try {
+      frame->image = source.decode(index);
+    } catch (const Error& e) {
+      // A damaged frame costs its two pairs, not the run (PairStatus::DecodeError).
+      if (e.kind() != ErrorKind::InvalidInput) throw;
+      frame->image = HostImage{};
+      frame->error = e.what();
+    }
     const double seconds = since(start);
     lock.lock();
     s.stats.decode_seconds += seconds;

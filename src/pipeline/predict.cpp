@@ -139,6 +139,10 @@ std::vector<std::string> Prediction::columns() const {
   return columns;
 }
 
+RatesLayout Prediction::layout() const {
+  return processor_.inertialnet_head && processor_.geometric_head ? rates_layout({"", "_geometric"}) : rates_layout({""});
+}
+
 std::vector<std::pair<std::string, std::string>> Prediction::csv_metadata() const {
   const auto format_number = [](double v) {
     char buf[32];
@@ -165,8 +169,8 @@ std::vector<std::pair<std::string, std::string>> Prediction::csv_metadata() cons
 void Prediction::warm_up(const std::function<void(const DeviceInfo& device, double seconds)>& report) {
   auto source = open_frame_source(settings_.sequence,
                                   settings_.rate_hz > 0 ? std::optional<double>(settings_.rate_hz) : std::nullopt);
-  const Frame first{0, source->timestamp_ns(0), source->decode(0)};
-  const Frame second{1, source->timestamp_ns(1), source->decode(1)};
+  const Frame first{0, source->timestamp_ns(0), source->decode(0), {}};
+  const Frame second{1, source->timestamp_ns(1), source->decode(1), {}};
   const std::atomic<bool> keep_going{false};
   const auto factory = rates_processor(weights_of_, processor_);
   for (const auto& device : devices_) {
@@ -183,9 +187,11 @@ PipelineStats Prediction::run(const std::function<void(const PairResult&)>& sink
   std::vector<Device*> devices;
   for (const auto& d : devices_) devices.push_back(d.get());
   auto checked = [&sink](const PairResult& r) {
-    // Inputs are checked where they enter; a NaN here is a failure of the computation, never a rate.
-    for (const auto& [name, w] : r.rates) {
-      if (!std::isfinite(w[0]) || !std::isfinite(w[1]) || !std::isfinite(w[2])) {
+    // The processor marks what it cannot answer; a NaN in an answer is a failure of the
+    // computation, never a rate.
+    for (const EstimatorRates& answer : r.rates) {
+      const auto& w = answer.w;
+      if (answer.ok() && (!std::isfinite(w[0]) || !std::isfinite(w[1]) || !std::isfinite(w[2]))) {
         throw runtime_error("the rates computed for the frame at timestamp " + std::to_string(r.t1_ns) +
                             " are not finite (NaN or infinity); stopping rather than writing them.");
       }
@@ -193,6 +199,59 @@ PipelineStats Prediction::run(const std::function<void(const PairResult&)>& sink
     sink(r);
   };
   return run_pipeline(*source_, devices, factory, checked, options);
+}
+
+RatesRow rates_row(const PairResult& r) {
+  RatesRow row;
+  row.t_ns = r.t1_ns;
+  if (r.rates.empty()) throw runtime_error("pair " + std::to_string(r.index) + " has no estimator's answer");
+  const EstimatorRates& first = r.rates.front();
+  row.w = {first.w[0], first.w[1], first.w[2]};
+  row.status = to_string(first.status);
+  for (std::size_t i = 1; i < r.rates.size(); ++i) {
+    row.extra.insert(row.extra.end(), r.rates[i].w.begin(), r.rates[i].w.end());
+    row.statuses.push_back(to_string(r.rates[i].status));
+  }
+  return row;
+}
+
+std::vector<std::string> unanswered_messages(const PairResult& r) {
+  std::vector<std::string> lines;
+  for (const EstimatorRates& answer : r.rates) {
+    if (answer.ok()) continue;
+    lines.push_back("pair " + std::to_string(r.index) + " (frames " + std::to_string(r.index - 1) + " → " +
+                    std::to_string(r.index) + ", t = " + std::to_string(r.t0_ns) + " → " + std::to_string(r.t1_ns) +
+                    " ns): " + answer.name + ": " + to_string(answer.status) + ": " + answer.reason);
+  }
+  return lines;
+}
+
+void UnansweredTally::add(const PairResult& r) {
+  ++pairs;
+  const EstimatorRates* first_bad = nullptr;
+  bool any_ok = false;
+  for (const EstimatorRates& answer : r.rates) {
+    if (answer.ok()) {
+      any_ok = true;
+    } else if (!first_bad) {
+      first_bad = &answer;
+    }
+  }
+  if (!first_bad) return;
+  ++unanswered;
+  if (!any_ok) ++answered_by_none;
+  ++by_status[to_string(first_bad->status)];
+}
+
+std::string UnansweredTally::summary() const {
+  if (unanswered == 0) return "";
+  std::string text = std::to_string(unanswered) + " of " + std::to_string(pairs) + " pairs without an answer (";
+  bool first = true;
+  for (const auto& [status, count] : by_status) {
+    text += (first ? "" : ", ") + status + " " + std::to_string(count);
+    first = false;
+  }
+  return text + ")";
 }
 
 }  // namespace inertialnet

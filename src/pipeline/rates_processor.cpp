@@ -1,10 +1,14 @@
 #include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <limits>
 #include <string>
 
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/models/dis_flow.hpp"
 #include "inertialnet/models/flownet.hpp"
 #include "inertialnet/models/inertialnet_head.hpp"
+#include "inertialnet/models/texture.hpp"
 #include "inertialnet/pipeline/rates_processor.hpp"
 #include "inertialnet/runtime/queue.hpp"
 
@@ -28,12 +32,32 @@ class RatesProcessor : public PairProcessor {
 
   void process(const Frame& previous, const Frame& current, PairResult& result,
                const std::atomic<bool>& stop) override {
-    check_sizes(previous, current);
+    if (head_) result.rates.push_back({"inertialnet", unknown(), PairStatus::Ok, {}});
+    if (geometric_) result.rates.push_back({"geometric", unknown(), PairStatus::Ok, {}});
+    // Frames that cannot be measured answer the pair for every estimator, before any flow.
+    if (!previous.error.empty() || !current.error.empty()) {
+      const Frame& bad = previous.error.empty() ? current : previous;
+      return unanswered(result, PairStatus::DecodeError, frame_name(bad) + " could not be decoded: " + bad.error);
+    }
+    if (const std::string mismatch = size_mismatch(previous, current); !mismatch.empty()) {
+      return unanswered(result, PairStatus::DecodeError, mismatch);
+    }
+    check_minimum_size(current);
+    for (const Frame* frame : {&previous, &current}) {
+      const double textured = textured_fraction(frame->image);
+      if (textured < kMinimumTexturedFraction) {
+        char share[96];
+        std::snprintf(share, sizeof share, " shows almost no texture (%.2f %% of its pixels; at least %.1f %% needed)",
+                      100 * textured, 100 * kMinimumTexturedFraction);
+        return unanswered(result, PairStatus::NoTexture, frame_name(*frame) + share + ": nothing for optical flow to follow");
+      }
+    }
     Queue& q = *queue_;
     const int width = current.image.width, height = current.image.height;
     auto t = Clock::now();
     Tensor flow;
     Tensor checked;  // the DIS flow with its inconsistent vectors marked unknown: the geometric head's
+    std::string flow_problem;  // why the flow cannot be used, when it cannot
     if (flownet_) {
       const Shape shape{1, 3, height, width};
       const Tensor frame1 = Tensor::from_host(q, shape, previous.image.data);
@@ -41,6 +65,7 @@ class RatesProcessor : public PairProcessor {
       t = lap(result, "upload", t);
       flow = flownet_->compute(q, frame1, frame2, &stop);
       q.finish();
+      flow_problem = non_finite_flow(flow.to_host(q));
     } else {
       const auto upload = [&](const FlowField& field) {
         std::vector<float> data(2 * field.pixel_count());
@@ -49,22 +74,34 @@ class RatesProcessor : public PairProcessor {
         return Tensor::from_host(q, {1, 2, height, width}, data);
       };
       const FlowField field = dis_->compute(previous.image, current.image);
+      std::vector<float> planes(field.u);
+      planes.insert(planes.end(), field.v.begin(), field.v.end());
+      flow_problem = non_finite_flow(planes);
       flow = upload(field);
       // Only the geometric head's solvers skip unknown vectors; the learned head and the saved
       // flow get the flow as computed (an unknown marker is no input for a network).
-      if (geometric_ && options_.flow_check_px > 0) {
+      if (geometric_ && options_.flow_check_px > 0 && flow_problem.empty()) {
         FlowField marked = field;
         dis_->check(marked, previous.image, current.image, options_.flow_check_px);
         checked = upload(marked);
       }
     }
     t = lap(result, "flow", t);
+    if (!flow_problem.empty()) return unanswered(result, PairStatus::NonFinite, flow_problem);
+    std::size_t next = 0;
     if (head_) {
+      EstimatorRates& answer = result.rates[next++];
       const auto omega = head_->compute(q, flow, &stop).to_host(q);
-      result.rates.push_back({"inertialnet", {omega[0], omega[1], omega[2]}});
+      if (std::isfinite(omega[0]) && std::isfinite(omega[1]) && std::isfinite(omega[2])) {
+        answer.w = {omega[0], omega[1], omega[2]};
+      } else {
+        answer.status = PairStatus::NonFinite;
+        answer.reason = "the InertialNet head's output is not finite (NaN or infinity)";
+      }
       t = lap(result, "inertialnet_head", t);
     }
     if (geometric_) {
+      EstimatorRates& answer = result.rates[next++];
       std::int64_t dt_ns = 0;
       if (__builtin_sub_overflow(current.t_ns, previous.t_ns, &dt_ns)) {
         throw invalid_input("frames at timestamps " + std::to_string(previous.t_ns) + " and " +
@@ -72,9 +109,22 @@ class RatesProcessor : public PairProcessor {
                             "a signed 64-bit count of nanoseconds.");
       }
       const double dt = static_cast<double>(dt_ns) * 1e-9;
-      const RotationEstimate estimate = geometric_->estimate(q, checked.defined() ? checked : flow, dt, &stop);
-      const Vec3 w = to_body(options_.camera_to_body, estimate.omega);
-      result.rates.push_back({"geometric", {w[0], w[1], w[2]}});
+      try {
+        const RotationEstimate estimate = geometric_->estimate(q, checked.defined() ? checked : flow, dt, &stop);
+        const Vec3 w = to_body(options_.camera_to_body, estimate.omega);
+        if (estimate.status != PairStatus::Ok) {
+          answer.status = estimate.status;
+          answer.reason = estimate.status_reason;
+        } else if (std::isfinite(w[0]) && std::isfinite(w[1]) && std::isfinite(w[2])) {
+          answer.w = {w[0], w[1], w[2]};
+        } else {
+          answer.status = PairStatus::NonFinite;
+          answer.reason = "the geometric head's rates are not finite (NaN or infinity)";
+        }
+      } catch (const UnanswerablePair& e) {
+        answer.status = e.status();
+        answer.reason = e.what();
+      }
       t = lap(result, "geometric_head", t);
     }
     if (options_.keep_flow) {
@@ -86,19 +136,51 @@ class RatesProcessor : public PairProcessor {
   BufferPoolStats temporaries() const override { return queue_->buffers().stats(); }
 
  private:
-  // Before OpenCV or the device sees the frames, whose own checks end in assertion text.
-  void check_sizes(const Frame& previous, const Frame& current) const {
-    const auto size = [](const Frame& f) { return std::to_string(f.image.width) + "x" + std::to_string(f.image.height); };
-    const auto name = [](const Frame& f) {
-      return "frame " + std::to_string(f.index) + " (t = " + std::to_string(f.t_ns) + " ns)";
-    };
-    if (previous.image.width != current.image.width || previous.image.height != current.image.height) {
-      throw invalid_input(name(current) + " is " + size(current) + " but " + name(previous) + " is " + size(previous) +
-                          "; every frame of a sequence must have the same size.");
+  static std::array<double, 3> unknown() {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    return {nan, nan, nan};
+  }
+
+  static std::string frame_name(const Frame& f) {
+    return "frame " + std::to_string(f.index) + " (t = " + std::to_string(f.t_ns) + " ns)";
+  }
+
+  // Every estimator of the pair gets `status`: nothing in the pair can be measured.
+  static void unanswered(PairResult& result, PairStatus status, const std::string& reason) {
+    for (EstimatorRates& answer : result.rates) {
+      answer.w = unknown();
+      answer.status = status;
+      answer.reason = reason;
     }
-    if (dis_ && (current.image.width < kDisMinimumSide || current.image.height < kDisMinimumSide)) {
-      throw invalid_input(name(current) + " is " + size(current) + "; DIS optical flow needs frames of at least " +
-                          std::to_string(kDisMinimumSide) + "x" + std::to_string(kDisMinimumSide) + " pixels.");
+  }
+
+  // "" when the flow's values are all finite, else where the first one is not.
+  static std::string non_finite_flow(const std::vector<float>& planes) {
+    for (std::size_t i = 0; i < planes.size(); ++i) {
+      if (!std::isfinite(planes[i])) {
+        return "the optical flow holds a non-finite value (NaN or infinity) at element " + std::to_string(i);
+      }
+    }
+    return "";
+  }
+
+  // Before OpenCV or the device sees the frames, whose own checks end in assertion text: a frame
+  // of another size than its neighbour (a damaged or stray file) cannot be paired with it.
+  std::string size_mismatch(const Frame& previous, const Frame& current) const {
+    const auto size = [](const Frame& f) { return std::to_string(f.image.width) + "x" + std::to_string(f.image.height); };
+    if (previous.image.width != current.image.width || previous.image.height != current.image.height) {
+      return frame_name(current) + " is " + size(current) + " but " + frame_name(previous) + " is " + size(previous) +
+             "; every frame of a sequence must have the same size";
+    }
+    return "";
+  }
+
+  // Frames too small for DIS are a property of the sequence, not of one pair: bad input.
+  void check_minimum_size(const Frame& f) const {
+    if (dis_ && (f.image.width < kDisMinimumSide || f.image.height < kDisMinimumSide)) {
+      throw invalid_input(frame_name(f) + " is " + std::to_string(f.image.width) + "x" + std::to_string(f.image.height) +
+                          "; DIS optical flow needs frames of at least " + std::to_string(kDisMinimumSide) + "x" +
+                          std::to_string(kDisMinimumSide) + " pixels.");
     }
   }
 

@@ -1,7 +1,10 @@
-// The rates CSV (timestamp_ns,wx,wy,wz[,extra…]): round trip and errors.
+// The rates CSV (schema inertialnet.rates/2: timestamp_ns,wx,wy,wz,status[,…]): round trip,
+// statuses, schema-1 files, the journal a run writes, and errors.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
+#include <iterator>
 #include <functional>
 
 #include "eval/synthetic_euroc.hpp"
@@ -60,7 +63,9 @@ TEST(RatesCsv, RoundTripIsExactForFloats) {
   std::ifstream in(path);
   std::string header;
   std::getline(in, header);
-  EXPECT_EQ(header, "timestamp_ns,wx,wy,wz,wx_geometric,wy_geometric,wz_geometric");
+  EXPECT_EQ(header, "# schema: inertialnet.rates/2");
+  std::getline(in, header);
+  EXPECT_EQ(header, "timestamp_ns,wx,wy,wz,status,wx_geometric,wy_geometric,wz_geometric");
 }
 
 TEST(RatesCsv, TolerantReading) {
@@ -123,7 +128,7 @@ TEST(RatesCsv, WriterRefusesBadTables) {
   RatesTable t;
   t.t_ns = {1, 2};
   t.w = {{0, 0, 0}, {0, std::nan(""), 0}};
-  EXPECT_TRUE(contains(invalid_input_message([&] { write_rates_csv(p, t); }), "non-finite"));
+  EXPECT_TRUE(contains(invalid_input_message([&] { write_rates_csv(p, t); }), "not finite"));
   t.w[1][1] = 0;
   t.t_ns[1] = 1;
   EXPECT_TRUE(contains(invalid_input_message([&] { write_rates_csv(p, t); }), "does not follow"));
@@ -151,11 +156,14 @@ TEST(RatesCsv, MetadataRoundTripAndOldFiles) {
   const auto path = dir.path() / "meta.csv";
   write_rates_csv(path, t);
   const RatesTable back = read_rates_csv(path);
-  EXPECT_EQ(back.metadata, t.metadata);
+  auto expected = t.metadata;
+  expected.insert(expected.begin(), {"schema", "inertialnet.rates/2"});
+  EXPECT_EQ(back.metadata, expected);
   EXPECT_EQ(back.meta("frame").value_or(""), "body");
   EXPECT_FALSE(back.meta("readout_time_s").has_value());
   EXPECT_NEAR(back.meta_number("time_offset_s").value_or(0), 0.04, 1e-15);
-  EXPECT_EQ(rates_csv_header({"wx_g"}, {{"frame", "camera"}}), "# frame: camera\ntimestamp_ns,wx,wy,wz,wx_g\n");
+  EXPECT_EQ(rates_csv_header(rates_layout({"", "_g"}), {{"frame", "camera"}}),
+            "# schema: inertialnet.rates/2\n# frame: camera\ntimestamp_ns,wx,wy,wz,status,wx_g,wy_g,wz_g,status_g\n");
   EXPECT_THROW(rates_csv_header({}, {{"two words", "x"}}), Error);
 
   const auto old = write_text(dir, "# written by an older predict\ntimestamp_ns,wx,wy,wz\n5,1,2,3\n");
@@ -164,4 +172,85 @@ TEST(RatesCsv, MetadataRoundTripAndOldFiles) {
   EXPECT_EQ(o.size(), 1u);
   const auto bad = write_text(dir, "# time_offset_s: soon\ntimestamp_ns,wx,wy,wz\n5,1,2,3\n");
   EXPECT_THROW(read_rates_csv(bad).meta_number("time_offset_s"), Error);
+}
+
+// Every pair has a row: a pair without an answer has empty rates and a status saying why, for
+// each estimator on its own (issue: one bad pair ended the whole run).
+TEST(RatesCsv, StatusesRoundTripWithEmptyRates) {
+  te::TempDir dir("rates_status");
+  const auto path = dir.path() / "status.csv";
+  {
+    RatesCsvWriter writer(path, rates_layout({"", "_geometric"}), {{"frame", "body"}});
+    const double nan = std::nan("");
+    writer.write({100, {0.1, 0.2, 0.3}, "ok", {1, 2, 3}, {"ok"}});
+    writer.write({200, {nan, nan, nan}, "no_texture", {nan, nan, nan}, {"no_texture"}});
+    writer.write({300, {0.4, 0.5, 0.6}, "ok", {nan, 5, nan}, {"too_few_vectors"}});
+    writer.close();
+  }
+  std::ifstream in(path);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_TRUE(contains(text, "timestamp_ns,wx,wy,wz,status,wx_geometric,wy_geometric,wz_geometric,status_geometric\n")) << text;
+  EXPECT_TRUE(contains(text, "\n200,,,,no_texture,,,,no_texture\n")) << text;
+  EXPECT_TRUE(contains(text, "\n300,0.4,0.5,0.6,ok,,,,too_few_vectors\n")) << text;  // a rate without an answer is not written
+  const RatesTable r = read_rates_csv(path);
+  ASSERT_EQ(r.size(), 3u);
+  EXPECT_EQ(r.status(), (std::vector<std::string>{"ok", "no_texture", "ok"}));
+  EXPECT_EQ(r.status("_geometric"), (std::vector<std::string>{"ok", "no_texture", "too_few_vectors"}));
+  EXPECT_TRUE(std::isnan(r.w[1][0]));
+  EXPECT_TRUE(std::isnan(r.rates("_geometric")[2][1]));
+  const RatesTable ok = r.ok_rows("_geometric");
+  ASSERT_EQ(ok.size(), 1u);
+  EXPECT_EQ(ok.t_ns[0], 100);
+  EXPECT_EQ(r.ok_rows().t_ns, (std::vector<std::int64_t>{100, 300}));
+  // A schema-1 file (no status column) reads as all ok.
+  const RatesTable old = read_rates_csv(write_text(dir, "timestamp_ns,wx,wy,wz\n5,1,2,3\n"));
+  EXPECT_EQ(old.status(), std::vector<std::string>{"ok"});
+}
+
+TEST(RatesCsv, StatusErrorsNameTheLine) {
+  te::TempDir dir("rates_status_err");
+  auto msg = [&](const std::string& text) { return invalid_input_message([&] { read_rates_csv(write_text(dir, text)); }); };
+  std::string m = msg("timestamp_ns,wx,wy,wz,status\n1,0,0,0,ok\n2,,,,ok\n");
+  EXPECT_TRUE(contains(m, "line 3: wx is empty but status is ok")) << m;
+  m = msg("timestamp_ns,wx,wy,wz,status\n1,0,0,0,OK!\n");
+  EXPECT_TRUE(contains(m, "line 2: status is \"OK!\"")) << m;
+  m = msg("timestamp_ns,wx,wy,wz,status\n1,0,0,0,\n");
+  EXPECT_TRUE(contains(m, "line 2: status is \"\"")) << m;
+  m = msg("timestamp_ns,wx,wy,wz\n1,,0,0\n");  // schema 1: no status to explain an empty rate
+  EXPECT_TRUE(contains(m, "line 2")) << m;
+  m = msg("# schema: inertialnet.rates/3\ntimestamp_ns,wx,wy,wz,status\n1,0,0,0,ok\n");
+  EXPECT_TRUE(contains(m, "newer than this version reads")) << m;
+  m = msg("# schema: something/else\ntimestamp_ns,wx,wy,wz,status\n1,0,0,0,ok\n");
+  EXPECT_TRUE(contains(m, "expected inertialnet.rates/2")) << m;
+}
+
+// A run's rows go to <name>.partial, one write each, and replace <name> only when the run
+// completes: a run that fails (or is killed) leaves a complete earlier file untouched and its
+// own rows readable in the journal (issue: a failed rerun replaced a good CSV).
+TEST(RatesCsv, WriterJournalLeavesGoodOutputUntilClosed) {
+  te::TempDir dir("rates_journal");
+  const auto path = dir.path() / "rates.csv";
+  std::ofstream(path) << "# schema: inertialnet.rates/2\ntimestamp_ns,wx,wy,wz,status\n1,0.5,0.5,0.5,ok\n";
+  {
+    RatesCsvWriter writer(path);
+    EXPECT_EQ(writer.journal(), partial_rates_path(path));
+    writer.write({10, {0.1, 0.2, 0.3}, "ok", {}, {}});
+    writer.write({20, {0.1, 0.2, 0.3}, "ok", {}, {}});
+    // Every row is on the disk as it is written: what a SIGKILL would leave.
+    EXPECT_EQ(read_rates_csv(writer.journal()).size(), 2u);
+    // Destroyed without close(): an error or an interruption.
+  }
+  EXPECT_EQ(read_rates_csv(path).t_ns, std::vector<std::int64_t>{1});  // the earlier run's output, intact
+  EXPECT_EQ(read_rates_csv(partial_rates_path(path)).size(), 2u);
+  {
+    RatesCsvWriter writer(path);  // a rerun replaces the stale journal
+    writer.write({30, {0.1, 0.2, 0.3}, "ok", {}, {}});
+    writer.close();
+  }
+  EXPECT_EQ(read_rates_csv(path).t_ns, std::vector<std::int64_t>{30});
+  EXPECT_FALSE(std::filesystem::exists(partial_rates_path(path)));
+  // Nothing else is left beside it.
+  std::size_t files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir.path())) files += entry.is_regular_file();
+  EXPECT_EQ(files, 1u);
 }

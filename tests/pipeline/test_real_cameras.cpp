@@ -37,7 +37,7 @@ RatesTable predict(FrameSource& source, const CameraIntrinsics& camera, const st
   RatesTable table;
   table.metadata = {{"frame", camera_to_body ? "body" : "camera"}, {"estimator", "inter_frame"}};
   run_pipeline(source, {&testing::test_device()}, rates_processor({}, processor), [&](const PairResult& r) {
-    const auto& w = r.rates.at(0).second;
+    const auto& w = r.rates.at(0).w;
     table.t_ns.push_back(r.t1_ns);
     table.w.push_back({w[0], w[1], w[2]});
   });

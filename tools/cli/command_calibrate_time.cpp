@@ -44,12 +44,20 @@ RatesTable predict_weight_free(const CalibrateTimeOptions& o, const EurocSequenc
   Prediction prediction(settings);
   RatesTable table;
   table.metadata = prediction.csv_metadata();
+  table.status_names = {"status"};
+  table.statuses.resize(1);
   info("no rates file given: predicting " + std::to_string(prediction.pairs()) + " pairs with " + prediction.method());
+  UnansweredTally tally;
   prediction.run([&](const PairResult& r) {
-    const auto& w = r.rates.front().second;
-    table.t_ns.push_back(r.t1_ns);
-    table.w.push_back({w[0], w[1], w[2]});
+    // A pair without an answer keeps its row and status; the estimate leaves it out.
+    const RatesRow row = rates_row(r);
+    table.t_ns.push_back(row.t_ns);
+    table.w.push_back(row.w);
+    table.statuses[0].push_back(row.status);
+    tally.add(r);
+    for (const auto& line : unanswered_messages(r)) warning(line);
   });
+  if (!tally.summary().empty()) warning(tally.summary() + "; the estimate leaves them out");
   return table;
 }
 }  // namespace

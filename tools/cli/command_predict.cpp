@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <algorithm>
 #include <memory>
 
 #include "commands.hpp"
@@ -83,6 +84,38 @@ void save_flow(const std::filesystem::path& folder, const std::string& format, s
   }
 }
 
+// -o must name something a rates CSV can go to, and never a file the run reads: the video, a
+// file of the sequence's folder (a EuRoC folder's cam0/data.csv, an image) or a weights file.
+// Checked before the weights load, so that a mistake costs nothing.
+void refuse_input_as_output(const std::string& output, const std::string& option, const std::string& sequence,
+                            const std::vector<std::string>& weights) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::file_status status = fs::status(output, ec);
+  if (fs::exists(status)) {
+    if (!fs::is_regular_file(status) && !fs::is_fifo(status) && !fs::is_character_file(status)) {
+      throw invalid_input(option + " " + output + ": it exists and is not a file; give the path of a rates CSV.");
+    }
+    const auto same = [&](const std::string& input) {
+      std::error_code e;
+      return fs::equivalent(output, input, e) && !e;
+    };
+    for (const auto& w : weights) {
+      if (same(w)) throw invalid_input(option + " " + output + " is the weights file " + w + "; refusing to replace an input.");
+    }
+    if (same(sequence)) throw invalid_input(option + " " + output + " is the sequence itself; refusing to replace an input.");
+    if (fs::is_directory(sequence, ec) && fs::is_regular_file(status)) {
+      const fs::path folder = fs::weakly_canonical(sequence, ec);
+      const fs::path file = fs::weakly_canonical(output, ec);
+      const auto [end, ignored] = std::mismatch(folder.begin(), folder.end(), file.begin(), file.end());
+      if (end == folder.end()) {
+        throw invalid_input(option + " " + output + " is a file of the sequence " + sequence +
+                            "; refusing to replace an input (write the rates next to the sequence, or give a new name).");
+      }
+    }
+  }
+}
+
 }  // namespace
 
 Command register_predict(CLI::App& app, const GlobalOptions& global) {
@@ -156,12 +189,16 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
     settings.no_cache = global.no_cache;
     settings.keep_flow = !o->save_flow.empty();
     if (o->profile) settings.profiler = &profiler;
+    // Outputs are checked before the weights load and any pair is computed.
+    if (!o->save_flow.empty()) prepare_output_folder(o->save_flow, "--save-flow");
+    if (!o->output.empty()) {
+      prepare_output_file(o->output, "-o");
+      refuse_input_as_output(o->output, "-o", o->sequence, o->weights);
+    }
     Prediction prediction(settings);
     for (const auto& note : prediction.notes()) info("note: " + note);
     if (const WeightSet* weights = prediction.weights()) warn_if_synthetic(*weights);
     const RatesProcessorOptions& processor = prediction.processor();
-    if (!o->save_flow.empty()) prepare_output_folder(o->save_flow, "--save-flow");
-    if (!o->output.empty()) prepare_output_file(o->output, "-o");
 
     const std::size_t pairs = prediction.pairs(o->max_pairs);
     const auto& infos = prediction.device_infos();
@@ -184,28 +221,27 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
       if (o->profile) profiler.collect();  // the warm-up pair is not one of the profiled ones
     }
 
-    // Columns: the first estimator is wx,wy,wz; a second one adds wx_<name>,wy_<name>,wz_<name>.
-    const std::vector<std::string> columns = prediction.columns();
-    const std::vector<std::string> extra(columns.begin() + 3, columns.end());
+    // Columns: wx,wy,wz,status for the first estimator; a second one adds its group
+    // wx_<name>,wy_<name>,wz_<name>,status_<name>. Every pair gets a row, answered or not.
+    const RatesLayout layout = prediction.layout();
     std::unique_ptr<RatesCsvWriter> file_writer;
     const auto metadata = prediction.csv_metadata();
-    if (!o->output.empty()) file_writer = std::make_unique<RatesCsvWriter>(o->output, extra, metadata);
-    if (!file_writer) std::cout << rates_csv_header(extra, metadata);
+    if (!o->output.empty()) file_writer = std::make_unique<RatesCsvWriter>(o->output, layout, metadata);
+    if (!file_writer) std::cout << rates_csv_header(layout, metadata);
 
     Progress progress("predict", pairs);
     std::size_t done = 0;
+    UnansweredTally tally;
     auto sink = [&](const PairResult& r) {
-      const auto& w = r.rates.front().second;
-      std::vector<double> more;
-      for (std::size_t i = 1; i < r.rates.size(); ++i) more.insert(more.end(), r.rates[i].second.begin(), r.rates[i].second.end());
+      const RatesRow row = rates_row(r);
       if (file_writer) {
-        file_writer->write(r.t1_ns, {w[0], w[1], w[2]}, more);
+        file_writer->write(row);
       } else {
-        std::printf("%lld,%.9g,%.9g,%.9g", static_cast<long long>(r.t1_ns), w[0], w[1], w[2]);
-        for (const double v : more) std::printf(",%.9g", v);
-        std::printf("\n");
+        std::cout << format_rates_row(layout, row);
         flush_standard_output();  // a row at a time, so a closed pipe stops the run at once
       }
+      tally.add(r);
+      for (const auto& line : unanswered_messages(r)) warning(line);
       if (r.flow) save_flow(o->save_flow, o->flow_format, r.t1_ns, *r.flow);
       progress.update(++done);
     };
@@ -217,7 +253,16 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
     options.cancel = &interrupt_requested();
     const PipelineStats stats = [&] {
       const InterruptGuard guard;
-      return prediction.run(sink, options);
+      try {
+        return prediction.run(sink, options);
+      } catch (const Error&) {
+        progress.finish();
+        if (file_writer && file_writer->rows() > 0) {
+          info("the " + std::to_string(file_writer->rows()) + " rows computed before the error are in " +
+               file_writer->journal().string() + "; " + o->output + " is untouched");
+        }
+        throw;
+      }
     }();
     progress.finish();  // the summary below starts on a line of its own
 
@@ -243,11 +288,27 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
                         std::to_string(options.lanes_per_device) + " lanes in flight per device, after a warm-up pair",
                     per_pair);
     }
-    if (file_writer) file_writer->close();  // a failed write or rename is exit 1, not a silent loss
+    // An interrupted run, or one in which no pair could be answered, leaves a complete output of
+    // an earlier run in place: its rows stay in the journal beside it.
     if (stats.cancelled) {
-      std::cerr << "inertialnet: interrupted after " << stats.pairs << " of " << pairs
-                << " pairs; the rates written so far are complete rows\n";
+      std::cerr << "inertialnet: interrupted after " << stats.pairs << " of " << pairs << " pairs; "
+                << (file_writer ? "the rows so far are in " + file_writer->journal().string() + " (" + o->output +
+                                      " is untouched)"
+                                : std::string("the rates written so far are complete rows"))
+                << "\n";
       return 1;
+    }
+    if (tally.pairs > 0 && tally.answered_by_none == tally.pairs) {
+      throw invalid_input("none of the " + std::to_string(tally.pairs) + " pairs of " + prediction.source().description() +
+                          " could be answered (" + tally.summary() + ")" +
+                          (file_writer ? "; their rows, with the reasons, are in " + file_writer->journal().string() +
+                                             " and " + o->output + " is untouched"
+                                       : std::string()) +
+                          ".");
+    }
+    if (file_writer) file_writer->close();  // a failed write or rename is exit 1, not a silent loss
+    if (!tally.summary().empty()) {
+      warning(tally.summary() + "; their rows say why (status column) and eval leaves them out");
     }
     return 0;
   };

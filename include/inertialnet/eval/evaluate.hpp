@@ -20,6 +20,7 @@
 #pragma once
 
 #include <array>
+#include <map>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -70,6 +71,10 @@ struct EvalReport {
   std::size_t imu_samples_in_span = 0;
   std::size_t rows_not_frames = 0;   // rows whose timestamp is no camera timestamp of the sequence
   std::size_t rows_without_truth = 0;  // rows on frames the IMU does not cover (or frame 0 for mean)
+  // Rows whose status for this estimator is not ok (pairs without an answer): left out of every
+  // figure, counted here by status word.
+  std::size_t rows_not_ok = 0;
+  std::map<std::string, std::size_t> not_ok_by_status;
 
   SyncTarget target = SyncTarget::Spline;
   bool camera_frame = false;
@@ -93,6 +98,7 @@ struct EvalReport {
   std::vector<std::string> warnings;         // reader and matching problems
 
   std::size_t frames_evaluated() const { return t_ns.size(); }
+  std::string not_ok_summary() const;        // "3 (decode_error 1, no_texture 2)"
   std::string table() const;                 // human-readable report, Table 1 layout
   // This estimator's object of the "inertialnet.eval/1" document (below); series: per-frame values.
   std::string json(bool include_series = false) const;
@@ -107,7 +113,8 @@ struct EvalReport {
 //       "columns": {"x": "wx", "y": "wy", "z": "wz"}
 //       "sequence", "rates_file": string
 //       "rate_rows", "frames_in_sequence", "frames_evaluated", "imu_samples",
-//       "imu_samples_in_span", "rows_not_frames", "rows_without_truth": int
+//       "imu_samples_in_span", "rows_not_frames", "rows_without_truth", "rows_not_ok": int
+//       "not_ok_by_status": {status word: int}   (rows left out because the pair had no answer)
 //       "target": "spline" | "mean",  "frame": "imu" | "camera"
 //       "rates_frame": "body" | "camera" | "unstated"   (the frame the rates file states)
 //       "time_offset_s": number   (shift applied, t_imu = t_cam + offset, readout/2 included)

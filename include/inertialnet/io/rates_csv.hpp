@@ -1,16 +1,26 @@
-// The angular-rates CSV that `predict` writes and `eval` reads:
+// The angular-rates CSV that `predict` writes and `eval` reads (schema inertialnet.rates/2):
 //
-//   timestamp_ns,wx,wy,wz[,extra,…]
-//   1403715273312143104,0.0123,-0.0456,0.0789
+//   # schema: inertialnet.rates/2
+//   # frame: body
+//   timestamp_ns,wx,wy,wz,status
+//   1403715273312143104,0.0123,-0.0456,0.0789,ok
+//   1403715273362143104,,,,no_texture
 //
-// One row per frame pair, stamped with the pair's second frame t_k; rates in rad/s. Further
-// named columns may follow (a second head: wx_geometric,wy_geometric,wz_geometric). Values are
-// written with %.9g, enough to round-trip a float exactly. Reading trims whitespace, skips blank
-// lines and '#' comments before the header, and rejects malformed rows, non-finite values and
-// timestamps that do not strictly increase, naming the file and line.
+// One row per frame pair, stamped with the pair's second frame t_k; rates in rad/s. Every pair
+// has a row: `status` is `ok`, or why the estimator has no trustworthy answer (core/pair_status.hpp:
+// decode_error, no_texture, too_few_vectors, unreliable, non_finite), and then its rates are
+// empty (NaN when read). A second estimator adds its group wx_<name>,wy_<name>,wz_<name>,
+// status_<name> (with both heads: wx_geometric,…,status_geometric). Further numeric columns may
+// follow. Values are written with %.9g, enough to round-trip a float exactly. Reading trims
+// whitespace, skips blank lines and '#' comments before the header, and rejects malformed rows,
+// non-finite values, empty rates on an `ok` row and timestamps that do not strictly increase,
+// naming the file and line.
 //
-// Metadata: "# key: value" lines before the header state what the columns are (files written
-// before these lines existed have none, and stay readable):
+// Files of schema 1 (no schema line, no status columns; written before every pair had a row)
+// stay readable: every row is `ok`. A schema newer than 2 is refused.
+//
+// Metadata: "# key: value" lines before the header state what the columns are:
+//   # schema: inertialnet.rates/2    the layout above (written first)
 //   # frame: body                    the frame of wx,wy,wz: body (IMU) or camera
 //   # frame_geometric: body          the frame of wx_geometric,… (`frame` when not stated)
 //   # estimator: inter_frame         what wx,wy,wz estimate: inter_frame (a rotation between two
@@ -37,11 +47,17 @@
 
 namespace inertialnet {
 
+inline constexpr const char* kRatesSchema = "inertialnet.rates/2";
+
 struct RatesTable {
   std::vector<std::int64_t> t_ns;
-  std::vector<Vec3> w;                             // wx, wy, wz (rad/s)
-  std::vector<std::string> extra_names;            // further columns, in file order
-  std::vector<std::vector<double>> extra;          // extra[c][row]
+  std::vector<Vec3> w;                             // wx, wy, wz (rad/s; NaN where not ok)
+  std::vector<std::string> extra_names;            // further numeric columns, in file order
+  std::vector<std::vector<double>> extra;          // extra[c][row] (NaN where not ok)
+  // The status columns ("status", "status_geometric", …) and their words, statuses[c][row].
+  // Empty for a schema-1 file: every row is then ok.
+  std::vector<std::string> status_names;
+  std::vector<std::vector<std::string>> statuses;
   std::vector<std::pair<std::string, std::string>> metadata;  // "# key: value" lines, in order
 
   // The value of metadata `key`, if the file states it.
@@ -54,42 +70,83 @@ struct RatesTable {
   std::vector<double> column(const std::string& name) const;
   // Columns wx<suffix>, wy<suffix>, wz<suffix> as rates ("" gives w, "_geometric" a second head).
   std::vector<Vec3> rates(const std::string& suffix = "") const;
-  // Throws invalid_input unless every column has one value per row and extra names are unique.
+  // Column status<suffix>: each row's status word; all "ok" when the file has no such column.
+  std::vector<std::string> status(const std::string& suffix = "") const;
+  // The rows whose status<suffix> is ok, every column kept (what eval measures).
+  RatesTable ok_rows(const std::string& suffix = "") const;
+  // Throws invalid_input unless every column has one value per row, names are unique, status
+  // words are lowercase words and every non-finite rate sits on a row that is not ok.
   void validate() const;
 };
 
 RatesTable read_rates_csv(const std::filesystem::path& path);
 
-// Writes rows as they come. A regular file is written through the library's atomic writer
-// (runtime/atomic_file.hpp) and appears, or replaces the old one, when the writer closes: by
-// close(), which reports write errors, or by the destructor, so that a run cut short (Ctrl-C,
-// an error) still leaves a valid CSV of the rows so far. A FIFO or character device the caller
-// names (/dev/stdout, a pipe) is written in place, one whole row per write; any other non-regular
-// target is refused. Refuses non-finite values and timestamps that do not increase.
+// The columns after timestamp_ns: wx,wy,wz,status, then the numeric `extra_names` in order, a
+// status column status<suffix> following the column wz<suffix> of its group (status_geometric
+// after wz_geometric). `status_names` lists the status columns besides "status".
+struct RatesLayout {
+  std::vector<std::string> extra_names;
+  std::vector<std::string> status_names;  // "status_geometric", …
+  // The header's column names after timestamp_ns, in file order.
+  std::vector<std::string> columns() const;
+};
+
+// The layout of estimator groups: "" → wx,wy,wz,status; "_geometric" → wx_geometric,…,status_geometric.
+RatesLayout rates_layout(const std::vector<std::string>& suffixes);
+
+// One row: the primary rates and status, then `extra` in the order of extra_names and `statuses`
+// in the order of status_names. A rate of a row whose group's status is not ok is written as an
+// empty cell, whatever its value.
+struct RatesRow {
+  std::int64_t t_ns = 0;
+  Vec3 w{};
+  std::string status = "ok";
+  std::vector<double> extra;
+  std::vector<std::string> statuses;
+};
+
+// Writes rows as they come, so that a run that fails or is killed never loses good output:
+//  * A regular file `rates.csv` is written as `rates.csv.partial` beside it (one write() per
+//    row, so that a killed run leaves whole rows): close() flushes it to the disk and renames it
+//    over `rates.csv`. Until then an existing `rates.csv` is untouched. A writer destroyed
+//    without close() (an error, Ctrl-C, a crash) leaves `rates.csv.partial`: a valid rates CSV
+//    of the rows so far, which eval reads and a rerun replaces. That is the only file a failed or
+//    killed run leaves behind.
+//  * A FIFO or character device the caller names (/dev/stdout, a pipe) is written in place, one
+//    whole row per write; any other non-regular target (a folder, a socket) is refused.
+// Refuses non-finite rates on ok rows, unknown status words and timestamps that do not increase.
 class RatesCsvWriter {
  public:
-  RatesCsvWriter(const std::filesystem::path& path, const std::vector<std::string>& extra_names = {},
+  RatesCsvWriter(const std::filesystem::path& path, const RatesLayout& layout = {},
                  const std::vector<std::pair<std::string, std::string>>& metadata = {});
   ~RatesCsvWriter();
   RatesCsvWriter(const RatesCsvWriter&) = delete;
   RatesCsvWriter& operator=(const RatesCsvWriter&) = delete;
-  void write(std::int64_t t_ns, const Vec3& w, const std::vector<double>& extra = {});
+  void write(const RatesRow& row);
   // Puts the file in place (flushed to the disk); throws when that fails. Call once, at the end.
   void close();
   std::size_t rows() const { return rows_; }
+  // Where the rows are until close(): `<path>.partial` for a regular file, else the path itself.
+  const std::filesystem::path& journal() const;
 
  private:
   std::filesystem::path path_;
-  std::size_t extra_count_;
+  RatesLayout layout_;
   struct Stream;
   std::unique_ptr<Stream> out_;
   std::size_t rows_ = 0;
   std::int64_t last_t_ns_ = 0;
 };
+
+// `<path>.partial`: where an unfinished run's rows are (RatesCsvWriter).
+std::filesystem::path partial_rates_path(const std::filesystem::path& path);
+
 void write_rates_csv(const std::filesystem::path& path, const RatesTable& table);
-// The header lines (metadata lines, then the column names), each ending in '\n': what the writer
-// puts first, for writers to other streams (predict's standard output).
-std::string rates_csv_header(const std::vector<std::string>& extra_names,
+// The header lines (the schema line, the metadata lines, then the column names), each ending in
+// '\n': what the writer puts first, for writers to other streams (predict's standard output).
+std::string rates_csv_header(const RatesLayout& layout,
                              const std::vector<std::pair<std::string, std::string>>& metadata = {});
+// One row as the writer writes it, ending in '\n'.
+std::string format_rates_row(const RatesLayout& layout, const RatesRow& row);
 
 }  // namespace inertialnet

@@ -8,8 +8,11 @@
 // Each frame is decoded once although it belongs to two pairs. Lanes on one device run on
 // separate in-order queues, so one pair's transfers overlap another's compute; lanes on several
 // devices (--device all) share the work. Everything is bounded by a window of pairs, so memory
-// stays flat on any sequence length. An error in any stage, or the cancel flag (SIGINT), stops
-// every stage; results already emitted stay emitted, and the error is rethrown to the caller.
+// stays flat on any sequence length. A frame the source cannot decode (an Error of kind
+// InvalidInput from FrameSource::decode) is no error of the run: it goes to the processor marked
+// as such, and its two pairs are answered with PairStatus::DecodeError. Any other error in any
+// stage, or the cancel flag (SIGINT), stops every stage; results already emitted stay emitted,
+// and the error is rethrown to the caller.
 #pragma once
 
 #include <array>
@@ -22,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "inertialnet/core/pair_status.hpp"
 #include "inertialnet/runtime/buffer_pool.hpp"
 #include "inertialnet/runtime/device.hpp"
 #include "inertialnet/io/flow_io.hpp"
@@ -32,7 +36,17 @@ namespace inertialnet {
 struct Frame {
   std::size_t index = 0;
   std::int64_t t_ns = 0;
-  HostImage image;
+  HostImage image;   // empty when the frame could not be decoded
+  std::string error;  // why it could not be decoded (the source's message); empty when it was
+};
+
+// One estimator's answer for a pair: rates, or a status other than ok and why.
+struct EstimatorRates {
+  std::string name;              // "inertialnet", "geometric"
+  std::array<double, 3> w{};     // rad/s; NaN unless status is ok
+  PairStatus status = PairStatus::Ok;
+  std::string reason;            // for the user, when status is not ok ("only 5 flow vectors …")
+  bool ok() const { return status == PairStatus::Ok; }
 };
 
 // What one pair (frames k−1 → k) yields.
@@ -40,15 +54,19 @@ struct PairResult {
   std::size_t index = 0;   // k ≥ 1
   std::int64_t t0_ns = 0;  // frame k−1
   std::int64_t t1_ns = 0;  // frame k: the timestamp the rates CSV carries
-  // Angular rates by estimator ("inertialnet", "geometric"), camera frame, rad/s, in the
-  // order the processor adds them.
-  std::vector<std::pair<std::string, std::array<double, 3>>> rates;
+  // Angular rates by estimator, in the order the processor adds them (the InertialNet head
+  // before the geometric one); frame as RatesProcessorOptions says. Every estimator has an entry
+  // for every pair, answered or not.
+  std::vector<EstimatorRates> rates;
   std::optional<FlowField> flow;          // when the processor was asked to keep it
   std::map<std::string, double> seconds;  // time per stage ("upload", "flow", "head", …)
   std::string device;                     // where it ran
 };
 
 // Turns one frame pair into rates. One instance per lane; called from that lane's thread only.
+// A frame that could not be decoded reaches process() with its error set and no image: the
+// processor answers the pair with PairStatus::DecodeError. A pair that cannot be answered is a
+// status in the result, not an exception; exceptions stop the whole run.
 // `stop` turns true when the pipeline is stopping: long computations poll it between layers
 // (the networks do) and give up by throwing, so cancellation does not wait for a whole pair.
 class PairProcessor {

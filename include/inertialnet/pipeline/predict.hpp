@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "inertialnet/io/frame_source.hpp"
+#include "inertialnet/io/rates_csv.hpp"
 #include "inertialnet/models/weights.hpp"
 #include "inertialnet/pipeline/pipeline.hpp"
 #include "inertialnet/pipeline/rates_processor.hpp"
@@ -67,6 +68,9 @@ class Prediction {
   // The rates columns after timestamp_ns: wx,wy,wz for the first estimator, then
   // wx_<name>,wy_<name>,wz_<name> for a second (with both heads: wx_geometric, …).
   std::vector<std::string> columns() const;
+  // The rates CSV's columns for these estimators: wx,wy,wz,status, then with both heads
+  // wx_geometric,wy_geometric,wz_geometric,status_geometric.
+  RatesLayout layout() const;
   // What the columns are, as the rates CSV states it in its `# key: value` lines (frame and
   // estimator per column, time offset, readout time; docs/data_conventions.md, "Rates CSV").
   std::vector<std::pair<std::string, std::string>> csv_metadata() const;
@@ -78,8 +82,9 @@ class Prediction {
   // The sequence is opened again because a video source decodes in order from its start.
   void warm_up(const std::function<void(const DeviceInfo& device, double seconds)>& report = {});
 
-  // Hands each pair's result to `sink` in pair order; a rate that is not finite stops the run
-  // with runtime_error before it reaches the sink.
+  // Hands each pair's result to `sink` in pair order, every pair, answered or not (a pair that
+  // cannot be answered has a status other than ok: PairResult::rates); a rate marked ok that is
+  // not finite stops the run with runtime_error before it reaches the sink.
   PipelineStats run(const std::function<void(const PairResult&)>& sink, const PipelineOptions& options = {});
 
  private:
@@ -91,6 +96,27 @@ class Prediction {
   std::vector<std::unique_ptr<Device>> devices_;
   std::vector<std::unique_ptr<WeightSet>> weight_sets_;
   std::map<const Device*, const WeightSet*> weights_of_;
+};
+
+// One pair as a rates CSV row of Prediction::layout(): the first estimator's rates and status,
+// then the others'.
+RatesRow rates_row(const PairResult& result);
+
+// One line per estimator that did not answer the pair, naming the pair, its frames and times,
+// the estimator, the status and why: "pair 41 (frames 40 → 41, t = 2000000000 → 2050000000 ns):
+// geometric: no_texture: frame 41 … shows almost no texture …". Empty when every estimator answered.
+std::vector<std::string> unanswered_messages(const PairResult& result);
+
+// Counts of the pairs a run could not answer, by status word (over all estimators: a pair counts
+// once, under the first estimator's status that is not ok).
+struct UnansweredTally {
+  std::size_t pairs = 0;       // pairs seen
+  std::size_t unanswered = 0;  // pairs with at least one estimator not ok
+  std::size_t answered_by_none = 0;  // pairs that no estimator answered
+  std::map<std::string, std::size_t> by_status;
+  void add(const PairResult& result);
+  // "3 of 299 pairs without an answer (no_texture 2, decode_error 1)"; "" when every pair was answered.
+  std::string summary() const;
 };
 
 }  // namespace inertialnet
