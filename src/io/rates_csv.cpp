@@ -532,7 +532,14 @@ RatesCsvWriter::RatesCsvWriter(const fs::path& path, const RatesLayout& layout,
   out_->write(header);
 }
 
-RatesCsvWriter::~RatesCsvWriter() = default;  // not closed: the journal keeps the rows so far
+RatesCsvWriter::~RatesCsvWriter() {
+  // Not closed: the journal keeps the rows so far, unless there are none (a run that failed
+  // before its first pair leaves nothing behind).
+  if (out_ && out_->fd >= 0 && !out_->in_place && rows_ == 0) {
+    ::close(std::exchange(out_->fd, -1));
+    ::unlink(out_->journal.c_str());
+  }
+}
 
 const fs::path& RatesCsvWriter::journal() const { return out_->journal; }
 

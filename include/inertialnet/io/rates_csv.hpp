@@ -109,9 +109,9 @@ struct RatesRow {
 //  * A regular file `rates.csv` is written as `rates.csv.partial` beside it (one write() per
 //    row, so that a killed run leaves whole rows): close() flushes it to the disk and renames it
 //    over `rates.csv`. Until then an existing `rates.csv` is untouched. A writer destroyed
-//    without close() (an error, Ctrl-C, a crash) leaves `rates.csv.partial`: a valid rates CSV
-//    of the rows so far, which eval reads and a rerun replaces. That is the only file a failed or
-//    killed run leaves behind.
+//    without close() (an error, Ctrl-C) leaves `rates.csv.partial`: a valid rates CSV of the rows
+//    so far, which eval reads and a rerun replaces (none when no row was written). A killed
+//    process leaves the same file. That is the only file a failed or killed run leaves behind.
 //  * A FIFO or character device the caller names (/dev/stdout, a pipe) is written in place, one
 //    whole row per write; any other non-regular target (a folder, a socket) is refused.
 // Refuses non-finite rates on ok rows, unknown status words and timestamps that do not increase.
