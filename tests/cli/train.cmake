@@ -47,6 +47,17 @@ expect_no_match("wrote")
 run(2 ${CLI} train --train a --val b --head-size 64x48 --optimizer sgd --lr 1e-3 --epochs 4 -o head.safetensors
     --cache cache --resume)
 expect_match("head.state.safetensors was trained with the optimizer adam, this run asks for sgd")
+# A resumed run whose epochs do not beat the state's best (a learning rate too small to move a
+# weight): -o keeps that epoch's head and says so (before: "best epoch 0 … 0.000", "wrote (best)").
+file(SHA256 "${WORK}/head.safetensors" best_before)
+run(0 ${CLI} train --train a --val b --head-size 64x48 --optimizer adam --lr 1e-30 --epochs 4 -o head.safetensors
+    --cache cache --resume)
+expect_match("best epoch 3 \\(before this run\\): mean validation RMSE [0-9.]+ deg/s; no epoch of this run improved")
+expect_match("kept head.safetensors \\(best\\), wrote head.last.safetensors \\(last\\)")
+file(SHA256 "${WORK}/head.safetensors" best_after)
+if(NOT best_before STREQUAL best_after)
+  message(FATAL_ERROR "the best head changed although no epoch improved")
+endif()
 run(2 ${CLI} train --train a --val b --head-size 64x48 --epochs 4 -o nostate.safetensors --cache cache --resume)
 expect_match("--resume: there is no training state nostate.state.safetensors")
 
