@@ -58,6 +58,18 @@ file(SHA256 "${WORK}/head.safetensors" best_after)
 if(NOT best_before STREQUAL best_after)
   message(FATAL_ERROR "the best head changed although no epoch improved")
 endif()
+# A state whose epoch is not a number (edited in place, same length, so the file stays readable):
+# exit 2 naming the file and the key (before: "error: stoi", exit 1).
+file(MAKE_DIRECTORY "${WORK}/damaged")
+file(COPY_FILE "${WORK}/head.state.safetensors" "${WORK}/damaged/h.state.safetensors")
+execute_process(COMMAND sed -i -E "s/\"inertialnet\\.train\\.epoch\":\"[0-9]\"/\"inertialnet.train.epoch\":\"x\"/"
+                        "${WORK}/damaged/h.state.safetensors" RESULT_VARIABLE sed_code)
+if(NOT sed_code EQUAL 0)
+  message(FATAL_ERROR "sed could not edit the state")
+endif()
+run(2 ${CLI} train --train a --val b --head-size 64x48 --optimizer adam --epochs 5 -o damaged/h.safetensors
+    --cache cache --resume)
+expect_match("damaged/h.state.safetensors: the training state's inertialnet.train.epoch is 'x', expected a whole number")
 run(2 ${CLI} train --train a --val b --head-size 64x48 --epochs 4 -o nostate.safetensors --cache cache --resume)
 expect_match("--resume: there is no training state nostate.state.safetensors")
 
