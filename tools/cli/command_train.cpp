@@ -91,14 +91,18 @@ bool inside(const fs::path& path, const fs::path& folder) {
 void check_outputs(const std::vector<Output>& outputs, const std::vector<std::string>& weights,
                    const std::vector<std::string>& sequences) {
   for (const auto& out : outputs) {
-    prepare_output_file(out.path.string(), out.option);
+    if (out.path.empty() || out.path.filename().empty()) {
+      throw invalid_input(out.option + " '" + out.path.string() + "': expected a file name.");
+    }
     std::error_code ec;
     const fs::file_status link = fs::symlink_status(out.path, ec);
     const fs::file_status target = fs::status(out.path, ec);
     if (fs::is_symlink(link) && target.type() == fs::file_type::not_found) {
       throw invalid_input(out.option + " " + out.path.string() + ": it is a symbolic link that leads nowhere; refusing to write through it.");
     }
-    if (target.type() != fs::file_type::not_found && !fs::is_regular_file(target)) {
+    // (file_type::none: the status could not be read, e.g. no permission; the writer reports that.)
+    if (target.type() != fs::file_type::not_found && target.type() != fs::file_type::none &&
+        !fs::is_regular_file(target)) {
       throw invalid_input(out.option + " " + out.path.string() + ": it exists and is not a regular file (" +
                           (fs::is_directory(target) ? "a folder" : "a device, FIFO or socket") +
                           "); refusing to replace it.");
@@ -126,6 +130,8 @@ void check_outputs(const std::vector<Output>& outputs, const std::vector<std::st
       }
     }
   }
+  // Only now, so that a refused output leaves no new folder behind (inside a sequence, say).
+  for (const auto& out : outputs) prepare_output_file(out.path.string(), out.option);
 }
 
 }  // namespace
