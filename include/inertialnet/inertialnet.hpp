@@ -97,4 +97,5 @@
 // train
 #include "inertialnet/train/flip_augmentation.hpp"
 #include "inertialnet/train/trainer.hpp"
+#include "inertialnet/train/training_log.hpp"
 #include "inertialnet/train/training_set.hpp"

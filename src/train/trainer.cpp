@@ -1,10 +1,12 @@
 #include "inertialnet/train/trainer.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cstdio>
 #include <chrono>
 #include <cmath>
 #include <numeric>
+#include <sstream>
 
 #include "inertialnet/core/constants.hpp"
 #include "inertialnet/core/random.hpp"
@@ -23,6 +25,53 @@ namespace {
 constexpr const char* kStateEpoch = "inertialnet.train.epoch";
 constexpr const char* kStateSteps = "inertialnet.train.steps";
 constexpr const char* kStateBest = "inertialnet.train.best_rmse";
+// Written since the states carry them; a state without them is read as before (the optimiser
+// then told by its second moments, which only Adam fills).
+constexpr const char* kStateOptimizer = "inertialnet.train.optimizer";
+constexpr const char* kStateBestEpoch = "inertialnet.train.best_epoch";
+
+// A metadata number of a training state, whole and within [lo, hi]; otherwise invalid_input naming
+// the file, the key and the value (a state is a file the user hands us: never "stoi").
+std::int64_t state_integer(const std::map<std::string, std::string>& meta, const char* key,
+                           const std::filesystem::path& path, std::int64_t lo, std::int64_t hi) {
+  const std::string& text = meta.at(key);
+  std::int64_t value = 0;
+  const char* end = text.data() + text.size();
+  const auto [ptr, ec] = std::from_chars(text.data(), end, value);
+  if (text.empty() || ec != std::errc() || ptr != end || value < lo || value > hi) {
+    throw invalid_input(path.string() + ": the training state's " + key + " is '" + text.substr(0, 40) +
+                        (text.size() > 40 ? "…" : "") + "', expected a whole number from " + std::to_string(lo) +
+                        " to " + std::to_string(hi) + "; the file is damaged or not a state `train` wrote");
+  }
+  return value;
+}
+
+double state_number(const std::map<std::string, std::string>& meta, const char* key, const std::filesystem::path& path) {
+  const std::string& text = meta.at(key);
+  double value = 0;
+  const char* end = text.data() + text.size();
+  const auto [ptr, ec] = std::from_chars(text.data(), end, value);
+  // −1 is what a state saved before any epoch holds ("no best yet"); anything else is an RMSE.
+  if (text.empty() || ec != std::errc() || ptr != end || !std::isfinite(value) || (value < 0 && value != -1)) {
+    throw invalid_input(path.string() + ": the training state's " + key + " is '" + text.substr(0, 40) +
+                        (text.size() > 40 ? "…" : "") + "', expected a finite RMSE (≥ 0, or -1 before the first "
+                        "epoch); the file is damaged or not a state `train` wrote");
+  }
+  return value;
+}
+
+// The first non-finite value of `values`, or values.size().
+std::size_t first_non_finite(const std::vector<float>& values) {
+  for (std::size_t i = 0; i < values.size(); ++i)
+    if (!std::isfinite(values[i])) return i;
+  return values.size();
+}
+
+std::string number(double v) {
+  std::ostringstream text;
+  text << v;
+  return text.str();
+}
 
 // Σ over axes of the RMSE: the one number "best" compares.
 double mean_rmse(const Vec3& v) { return (v[0] + v[1] + v[2]) / 3.0; }
@@ -75,6 +124,14 @@ Trainer::Trainer(Device& device, const TrainerOptions& options)
   options_.head.validate();
   if (options.epochs < 1 || options.batch < 1) throw invalid_input("training: epochs and batch must be at least 1");
   if (!(options.lr > 0.0f) || !std::isfinite(options.lr)) throw invalid_input("training: the learning rate must be positive");
+  // A negative or non-finite decay or momentum pushes the weights away from zero or to NaN from
+  // the first step: refused here, not discovered as a diverged run.
+  if (!(options.weight_decay >= 0.0f) || !std::isfinite(options.weight_decay)) {
+    throw invalid_input("training: the weight decay must be a finite number ≥ 0, got " + number(options.weight_decay));
+  }
+  if (!(options.momentum >= 0.0f) || !std::isfinite(options.momentum)) {
+    throw invalid_input("training: the SGD momentum must be a finite number ≥ 0, got " + number(options.momentum));
+  }
   // torch.nn's defaults for Conv2d and Linear: weights and biases uniform in ±1/sqrt(fan-in).
   for (const auto& spec : head_parameters(options_.head)) {
     const std::string weight_name = spec.name.substr(0, spec.name.rfind('.')) + ".weight";
@@ -198,13 +255,44 @@ bool Trainer::train(const TrainingSet& train_set, const TrainingSet& val_set, co
       const Tensor target = Tensor::from_host(*queue_, {n, 3}, targets);
       const std::uint64_t dropout_seed = splitmix64(options_.seed + 0x9E3779B97F4A7C15ull * static_cast<std::uint64_t>(steps_ + 1));
       const double loss = head_for(n).loss_and_gradients(*queue_, params_, flow, target, dropout_seed, grads_);
+      // Checked before the step, so that the parameters stay those of the last finite loss and no
+      // NaN ever reaches a checkpoint (the callbacks that write them run after whole epochs).
+      if (!std::isfinite(loss)) {
+        std::string cause;
+        for (std::size_t i = 0; i < count && cause.empty(); ++i) {
+          const std::size_t s = order[first + i];
+          const float* f = flows.data() + i * floats;
+          const bool bad_flow = !std::all_of(f, f + floats, [](float v) { return std::isfinite(v); });
+          const bool bad_target = !std::all_of(targets.begin() + static_cast<std::ptrdiff_t>(3 * i),
+                                               targets.begin() + static_cast<std::ptrdiff_t>(3 * i + 3),
+                                               [](float v) { return std::isfinite(v); });
+          if (bad_flow || bad_target) {
+            cause = "training sample " + std::to_string(s) + " (frame at " + std::to_string(train_set.timestamp_ns(s)) +
+                    " ns) has a non-finite " + (bad_flow ? "flow" : "target") + "; the training set is damaged";
+          }
+        }
+        if (cause.empty()) {
+          cause = "the inputs are finite, so the weights diverged: the learning rate " + number(lr) +
+                  " is likely too large for this head (try one ten times smaller)";
+        }
+        throw runtime_error("training stopped: the loss of epoch " + std::to_string(epoch) + ", mini-batch " +
+                            std::to_string(b + 1) + " of " + std::to_string(batches) + " is " + number(loss) +
+                            "; " + cause + ". Nothing of this epoch was saved.");
+      }
       step(*queue_, lr);
       loss_sum += loss;
       if (callbacks.on_batch) callbacks.on_batch(epoch, b + 1, batches, loss);
     }
     queue_->finish();
-    epoch_ = epoch;
     const Evaluation e = evaluate(val_set);
+    // The last step may have left non-finite weights that no training loss has seen yet.
+    if (!std::isfinite(e.loss)) {
+      throw runtime_error("training stopped: the validation loss after epoch " + std::to_string(epoch) + " is " +
+                          number(e.loss) + " (the training losses were finite): the last step's weights are not "
+                          "finite, the learning rate " + number(lr) + " is likely too large for this head (try one "
+                          "ten times smaller). Nothing of this epoch was saved.");
+    }
+    epoch_ = epoch;
     EpochReport r;
     r.epoch = epoch;
     r.epochs = options_.epochs;
@@ -269,7 +357,9 @@ void Trainer::save_state(const std::filesystem::path& path) const {
                     {{kMetadataHead, head_config_to_json(options_.head)},
                      {kStateEpoch, std::to_string(epoch_)},
                      {kStateSteps, std::to_string(steps_)},
-                     {kStateBest, best}});
+                     {kStateBest, best},
+                     {kStateBestEpoch, std::to_string(best_.epoch)},
+                     {kStateOptimizer, to_string(options_.optimizer)}});
 }
 
 void Trainer::resume(const std::filesystem::path& path) {
@@ -282,20 +372,69 @@ void Trainer::resume(const std::filesystem::path& path) {
   for (auto* key : {kStateEpoch, kStateSteps, kStateBest}) {
     if (!meta.count(key)) throw invalid_input(path.string() + " is not a training state (no " + std::string(key) + ")");
   }
+  // Every number first, so that a damaged state changes nothing.
+  const auto epoch = static_cast<int>(state_integer(meta, kStateEpoch, path, 0, 100000000));
+  const std::int64_t steps = state_integer(meta, kStateSteps, path, 0, std::int64_t{1} << 62);
+  const double best_rmse = state_number(meta, kStateBest, path);
+  const auto best_epoch =
+      meta.count(kStateBestEpoch) ? static_cast<int>(state_integer(meta, kStateBestEpoch, path, 0, epoch)) : 0;
   const std::pair<const char*, NamedTensors*> groups[] = {
       {"", &params_}, {"optimizer.m1.", &moment1_}, {"optimizer.m2.", &moment2_}};
+  std::map<std::string, std::vector<float>> values;
+  bool second_moments = false;  // any non-zero: only Adam writes them
   for (const auto& [prefix, group] : groups) {
     for (auto& [name, t] : *group) {
-      const auto values = file.to_float32(prefix + name);
-      if (static_cast<std::int64_t>(values.size()) != t.numel()) {
-        throw invalid_input(path.string() + ": " + prefix + name + " has the wrong size");
+      const std::string key = prefix + name;
+      if (!file.contains(key)) throw invalid_input(path.string() + " is not a training state of this head (no tensor " + key + ")");
+      if (file.shape(key) != t.shape()) {
+        std::string want, got;
+        for (auto d : t.shape()) want += (want.empty() ? "" : "x") + std::to_string(d);
+        for (auto d : file.shape(key)) got += (got.empty() ? "" : "x") + std::to_string(d);
+        throw invalid_input(path.string() + ": the training state's " + key + " is " + got + ", this head's is " + want);
       }
-      t = Tensor::from_host(*queue_, t.shape(), values);
+      auto v = file.to_float32(key);
+      if (static_cast<std::int64_t>(v.size()) != t.numel()) {
+        throw invalid_input(path.string() + ": " + key + " has the wrong size");
+      }
+      // A NaN or an infinity here would be trained on and written as the next "best" head.
+      const std::size_t bad = first_non_finite(v);
+      if (bad < v.size()) {
+        throw invalid_input(path.string() + ": the training state's " + key + " holds a non-finite value (" +
+                            number(v[bad]) + " at element " + std::to_string(bad) +
+                            "); the file is damaged or comes from a diverged run");
+      }
+      if (prefix == std::string("optimizer.m2.")) {
+        second_moments = second_moments || std::any_of(v.begin(), v.end(), [](float x) { return x != 0.0f; });
+      }
+      values.emplace(key, std::move(v));
     }
   }
-  epoch_ = std::stoi(meta.at(kStateEpoch));
-  steps_ = std::stoll(meta.at(kStateSteps));
-  best_rmse_ = std::stod(meta.at(kStateBest));
+  // SGD keeps its velocity in the first moments and leaves the second at zero; resuming it as Adam
+  // (or the reverse) would read a velocity as a mean gradient: refused, naming both.
+  std::string saved;
+  if (const auto it = meta.find(kStateOptimizer); it != meta.end()) {
+    saved = it->second;
+    if (saved != "sgd" && saved != "adam") {
+      throw invalid_input(path.string() + ": the training state's " + std::string(kStateOptimizer) + " is '" +
+                          saved.substr(0, 40) + "', expected sgd or adam");
+    }
+  } else if (steps > 0) {
+    saved = second_moments ? "adam" : "sgd";  // a state written before the optimiser was recorded
+  }
+  if (!saved.empty() && saved != to_string(options_.optimizer)) {
+    throw invalid_input(path.string() + " was trained with the optimizer " + saved + ", this run asks for " +
+                        to_string(options_.optimizer) + ": their moments mean different things; resume with " +
+                        saved + " or start afresh");
+  }
+  for (const auto& [prefix, group] : groups) {
+    for (auto& [name, t] : *group) t = Tensor::from_host(*queue_, t.shape(), values.at(prefix + name));
+  }
+  epoch_ = epoch;
+  steps_ = steps;
+  best_rmse_ = best_rmse;
+  best_ = EpochReport{};
+  best_.epoch = best_epoch;
+  best_.epochs = options_.epochs;
   queue_->finish();
 }
 

@@ -1,5 +1,6 @@
 #include "inertialnet/train/training_set.hpp"
 
+#include <algorithm>
 #include <cstring>
 #include <fstream>
 #include <iomanip>
@@ -15,6 +16,7 @@
 #include "inertialnet/models/dis_flow.hpp"
 #include "inertialnet/models/flownet.hpp"
 #include "inertialnet/runtime/error.hpp"
+#include "inertialnet/runtime/log.hpp"
 #include "runtime/atomic_file.hpp"
 #include "runtime/hash.hpp"
 
@@ -39,28 +41,77 @@ std::vector<float> resize_flow(const std::vector<float>& flow, int w, int h, int
   return out;
 }
 
+// Everything the cached flows depend on, so that a changed input is a different file, never a
+// stale one: the sequence's folder, every frame's file (name, size, modification time) and
+// timestamp, the flow method with its settings (the FlowNet2 family member and the weights'
+// identity; DIS at its one preset), the resizing, and the head's size. Version 2 of the key
+// (version 1 named frames by count and first/last timestamp only: editing an image kept the key).
 std::string cache_key(const std::filesystem::path& root, const EurocSequence& sequence, const TrainingSetOptions& o) {
   std::ostringstream key;
   std::error_code ec;
   const auto canonical = std::filesystem::weakly_canonical(root, ec);
-  key << "inertialnet.flowcache/1|" << (ec ? root : canonical).string() << '|' << to_string(o.flow) << '|'
-      << o.weights_id << '|' << o.width << 'x' << o.height << '|' << sequence.frames.size() << '|'
-      << sequence.frames.front().t_ns << '|' << sequence.frames.back().t_ns;
+  key << "inertialnet.flowcache/2|" << (ec ? root : canonical).string() << '|' << to_string(o.flow);
+  if (o.flow == FlowMethod::FlowNet && o.flownet_weights) {
+    const auto& kinds = o.flownet_weights->models();
+    key << ':' << to_string(kinds.empty() ? ModelKind::FlowNet2 : kinds.front());
+  } else {
+    key << ":medium";  // DisFlow's preset
+  }
+  key << '|' << o.weights_id << "|resize:area-or-bilinear|" << o.width << 'x' << o.height << '|'
+      << sequence.frames.size();
+  for (const auto& frame : sequence.frames) {
+    std::error_code size_error, time_error;
+    const auto size = std::filesystem::file_size(frame.path, size_error);
+    const auto time = std::filesystem::last_write_time(frame.path, time_error);
+    key << '|' << frame.t_ns << ':' << frame.path.filename().string() << ':'
+        << (size_error ? -1 : static_cast<long long>(size)) << ':'
+        << (time_error ? 0 : static_cast<long long>(time.time_since_epoch().count()));
+  }
   std::ostringstream name;
   name << std::hex << std::setw(16) << std::setfill('0') << detail::fnv1a64(key.str()) << ".flow16";
   return name.str();
 }
 
-// The cached flows of `pairs` pairs, or empty when the file is missing or not what we expect.
-std::vector<std::uint16_t> read_cache(const std::filesystem::path& path, std::size_t floats) {
+bool finite_half(std::uint16_t h) { return (h & 0x7C00u) != 0x7C00u; }  // exponent all ones: Inf or NaN
+
+// The cached flows (`floats` float16 values), or empty with `problem` saying why when the file
+// exists but is not what we expect (a damaged file is recomputed, never trained on).
+std::vector<std::uint16_t> read_cache(const std::filesystem::path& path, std::size_t floats, std::string& problem) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) return {};
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    problem = "it is not a regular file";
+    return {};
+  }
   std::ifstream in(path, std::ios::binary);
-  if (!in) return {};
+  if (!in) {
+    problem = "it cannot be opened";
+    return {};
+  }
   char magic[8];
   std::uint64_t count = 0;
-  if (!in.read(magic, 8) || std::memcmp(magic, kCacheMagic, 8) != 0) return {};
-  if (!in.read(reinterpret_cast<char*>(&count), sizeof count) || count != floats) return {};
+  if (!in.read(magic, 8) || std::memcmp(magic, kCacheMagic, 8) != 0) {
+    problem = "it is not a flow cache file";
+    return {};
+  }
+  if (!in.read(reinterpret_cast<char*>(&count), sizeof count) || count != floats) {
+    problem = "it holds " + std::to_string(count) + " values, expected " + std::to_string(floats);
+    return {};
+  }
   std::vector<std::uint16_t> data(floats);
-  if (!in.read(reinterpret_cast<char*>(data.data()), static_cast<std::streamsize>(floats * sizeof(std::uint16_t)))) return {};
+  if (!in.read(reinterpret_cast<char*>(data.data()), static_cast<std::streamsize>(floats * sizeof(std::uint16_t)))) {
+    problem = "it is shorter than its header says";
+    return {};
+  }
+  if (in.peek() != std::char_traits<char>::eof()) {
+    problem = "it is longer than its header says";
+    return {};
+  }
+  const auto bad = std::find_if_not(data.begin(), data.end(), finite_half);
+  if (bad != data.end()) {
+    problem = "value " + std::to_string(bad - data.begin()) + " is not finite";
+    return {};
+  }
   return data;
 }
 
@@ -69,7 +120,9 @@ void write_cache(const std::filesystem::path& path, const std::vector<std::uint1
   const std::uint64_t count = data.size();
   bytes.append(reinterpret_cast<const char*>(&count), sizeof count);
   bytes.append(reinterpret_cast<const char*>(data.data()), data.size() * sizeof(std::uint16_t));
-  std::filesystem::create_directories(path.parent_path());
+  std::error_code ec;
+  std::filesystem::create_directories(path.parent_path(), ec);
+  if (ec) throw runtime_error("cannot create the folder " + path.parent_path().string() + ": " + ec.message());
   write_file_atomically(path, bytes.data(), bytes.size());
 }
 
@@ -93,10 +146,15 @@ std::vector<std::uint16_t> TrainingSet::pair_flows(const EurocSequence& sequence
   std::filesystem::path cache;
   if (!options_.cache_dir.empty()) {
     cache = options_.cache_dir / cache_key(root, sequence, options_);
-    auto cached = read_cache(cache, floats);
+    std::string problem;
+    auto cached = read_cache(cache, floats, problem);
     if (!cached.empty()) {
       notes_.push_back(sequence.name + ": flows read from the cache " + cache.string());
       return cached;
+    }
+    if (!problem.empty()) {
+      log_message(LogLevel::Warning, "the flow cache " + cache.string() + " of " + sequence.name + " is damaged (" +
+                                         problem + "); computing the flows afresh");
     }
   }
   std::vector<std::uint16_t> out(floats);
@@ -137,14 +195,27 @@ std::vector<std::uint16_t> TrainingSet::pair_flows(const EurocSequence& sequence
     const auto resized = resize_flow(flow, current.width, current.height, options_.width, options_.height);
     std::uint16_t* dst = out.data() + (k - 1) * flow_floats();
     for (std::size_t i = 0; i < resized.size(); ++i) dst[i] = detail::float_to_half(resized[i]);
+    // A non-finite flow (or one beyond float16's range) would turn every loss it enters into NaN.
+    if (!std::all_of(dst, dst + resized.size(), finite_half)) {
+      throw runtime_error("the " + to_string(options_.flow) + " flow between " + sequence.frames[k - 1].path.string() +
+                          " and " + sequence.frames[k].path.string() + " is not finite; it cannot be trained on" +
+                          (dis ? std::string() : std::string(" (are the FlowNet2 weights damaged?)")));
+    }
     if (progress) progress(sequence.name, k, pairs);
     previous = std::move(current);
   }
   if (!cache.empty()) {
     const std::uint64_t bytes = floats * sizeof(std::uint16_t);
     if (bytes <= options_.cache_budget_bytes) {
-      write_cache(cache, out);
-      notes_.push_back(sequence.name + ": flows cached in " + cache.string());
+      // The cache only saves time: a full disk or a read-only folder costs the next run the flows,
+      // never this run its training.
+      try {
+        write_cache(cache, out);
+        notes_.push_back(sequence.name + ": flows cached in " + cache.string());
+      } catch (const std::exception& e) {
+        log_message(LogLevel::Warning, "the flows of " + sequence.name + " were not cached (" + e.what() +
+                                           "); training goes on, a later run recomputes them");
+      }
     } else {
       notes_.push_back(sequence.name + ": flows (" + std::to_string(bytes >> 20) +
                        " MiB) exceed the cache budget; not cached, a later run recomputes them");

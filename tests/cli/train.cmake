@@ -1,6 +1,8 @@
 # `inertialnet train` as a user meets it, on tiny synthetic sequences: the per-epoch report and
 # CSV, the loss plot, best/last checkpoints with training metadata that predict loads, resuming,
-# predict refusing a head of another flow size, and bad usage.
+# predict refusing a head of another flow size, and bad usage; and that no result is lost or
+# falsified (issue 20): a diverging run stops without a NaN head, every output is checked before
+# the flows, resuming a finished or a foreign state, -q and the prefix of every line.
 #   cmake -DCLI=<inertialnet> -DWORK=<scratch dir> -P train.cmake
 file(REMOVE_RECURSE "${WORK}")
 file(MAKE_DIRECTORY "${WORK}")
@@ -36,6 +38,138 @@ expect_match("read from the cache")
 expect_match("resuming after epoch 2")
 expect_match("epoch 3/3")
 
+# Resuming a state that has done every epoch: nothing to do, and nothing claimed as written.
+run(0 ${CLI} train --train a --val b --head-size 64x48 --optimizer adam --lr 1e-3 --epochs 3 -o head.safetensors
+    --cache cache --resume)
+expect_match("inertialnet: nothing to do: head.state.safetensors has finished epoch 3 of --epochs 3")
+expect_no_match("wrote")
+# Another optimiser than the state's (SGD's velocity is not Adam's moment): refused, naming both.
+run(2 ${CLI} train --train a --val b --head-size 64x48 --optimizer sgd --lr 1e-3 --epochs 4 -o head.safetensors
+    --cache cache --resume)
+expect_match("head.state.safetensors was trained with the optimizer adam, this run asks for sgd")
+# A resumed run whose epochs do not beat the state's best (a learning rate too small to move a
+# weight): -o keeps that epoch's head and says so (before: "best epoch 0 … 0.000", "wrote (best)").
+file(SHA256 "${WORK}/head.safetensors" best_before)
+run(0 ${CLI} train --train a --val b --head-size 64x48 --optimizer adam --lr 1e-30 --epochs 4 -o head.safetensors
+    --cache cache --resume)
+expect_match("best epoch 3 \\(before this run\\): mean validation RMSE [0-9.]+ deg/s; no epoch of this run improved")
+expect_match("kept head.safetensors \\(best\\), wrote head.last.safetensors \\(last\\)")
+file(SHA256 "${WORK}/head.safetensors" best_after)
+if(NOT best_before STREQUAL best_after)
+  message(FATAL_ERROR "the best head changed although no epoch improved")
+endif()
+# A state whose epoch is not a number (edited in place, same length, so the file stays readable):
+# exit 2 naming the file and the key (before: "error: stoi", exit 1).
+file(MAKE_DIRECTORY "${WORK}/damaged")
+file(COPY_FILE "${WORK}/head.state.safetensors" "${WORK}/damaged/h.state.safetensors")
+execute_process(COMMAND sed -i -E "s/\"inertialnet\\.train\\.epoch\":\"[0-9]\"/\"inertialnet.train.epoch\":\"x\"/"
+                        "${WORK}/damaged/h.state.safetensors" RESULT_VARIABLE sed_code)
+if(NOT sed_code EQUAL 0)
+  message(FATAL_ERROR "sed could not edit the state")
+endif()
+run(2 ${CLI} train --train a --val b --head-size 64x48 --optimizer adam --epochs 5 -o damaged/h.safetensors
+    --cache cache --resume)
+expect_match("damaged/h.state.safetensors: the training state's inertialnet.train.epoch is 'x', expected a whole number")
+run(2 ${CLI} train --train a --val b --head-size 64x48 --epochs 4 -o nostate.safetensors --cache cache --resume)
+expect_match("--resume: there is no training state nostate.state.safetensors")
+
+# -q: no progress, notes or epoch lines; the result still on standard output. Without -q every
+# line on stderr carries the prefix (only the report lines on stdout do not).
+run(0 ${CLI} train --train a --val b --head-size 64x48 --optimizer adam --lr 1e-3 --epochs 1 -o quiet.safetensors
+    --cache cache -q)
+expect_no_match("epoch 1/1|pairs|read from the cache|Target:")
+expect_match("^best epoch 1: validation RMSE")
+run(0 ${CLI} train --train a --val b --head-size 64x48 --optimizer adam --lr 1e-3 --epochs 1 -o loud.safetensors
+    --cache cache)
+string(REGEX REPLACE "[];[]" "," lines "${output}")  # no list separators or brackets inside a line
+string(REPLACE "\n" ";" lines "${lines}")
+foreach(line IN LISTS lines)
+  if(NOT line MATCHES "^(inertialnet: |best epoch |wrote |kept |$)")
+    message(FATAL_ERROR "a line without the inertialnet: prefix: '${line}'")
+  endif()
+endforeach()
+
+# A diverging learning rate: exit 1 naming the epoch, the mini-batch and the likely cause; no head
+# (before: -nan epochs, "wrote diverged.safetensors (best)", exit 0).
+run(1 ${CLI} train --train a --val b --head-size 64x48 --optimizer adam --lr 1e6 --epochs 2 -o diverged.safetensors
+    --cache cache)
+expect_match("inertialnet: error: training stopped: the loss of epoch 1, mini-batch [0-9]+ of [0-9]+ is (inf|-?nan)")
+expect_match("the learning rate 1e\\+06 is likely too large")
+expect_no_match("wrote|best epoch")
+if(EXISTS "${WORK}/diverged.safetensors")
+  message(FATAL_ERROR "a diverged run wrote a head")
+endif()
+
+# Outputs: missing folders created (as docs/cli.md promises), for -o, --log and --plot alike.
+run(0 ${CLI} train --train a --val b --head-size 64x48 --optimizer adam --lr 1e-3 --epochs 1 --cache cache
+    -o new/heads/h.safetensors --log new/logs/train.csv --plot new/plots/loss.png)
+foreach(f new/heads/h.safetensors new/heads/h.state.safetensors new/logs/train.csv new/plots/loss.png)
+  if(NOT EXISTS "${WORK}/${f}")
+    message(FATAL_ERROR "train did not write ${f}")
+  endif()
+endforeach()
+# Refused before any flow is computed (a fresh cache stays empty): a device node or a FIFO as the
+# log (before: the log lost with exit 0, or a block forever), a folder as -o, an input as an output,
+# two outputs naming one file, a plot that is not PNG.
+set(T0 ${CLI} train --train a --val b --head-size 64x48 --epochs 1)
+set(T ${T0} --cache fresh_cache)
+run(2 ${T} -o h.safetensors --log /dev/null)
+expect_match("--log /dev/null: it exists and is not a regular file")
+execute_process(COMMAND mkfifo "${WORK}/fifo")
+run(2 ${T} -o h.safetensors --log fifo)
+expect_match("--log fifo: it exists and is not a regular file")
+run(2 ${T} -o new)
+expect_match("-o new: it exists and is not a regular file \\(a folder\\)")
+run(2 ${T} -o a/mav0/cam0/data.csv)
+expect_match("-o a/mav0/cam0/data.csv is inside the sequence a")
+run(2 ${T} -o h.safetensors --plot b/mav0/loss.png)
+expect_match("--plot b/mav0/loss.png is inside the sequence b")
+run(2 ${T} -o b/mav0/heads/h.safetensors)
+expect_match("-o b/mav0/heads/h.safetensors is inside the sequence b")
+if(EXISTS "${WORK}/b/mav0/heads")
+  message(FATAL_ERROR "a refused output left a new folder inside a sequence")
+endif()
+run(2 ${T} -o h.safetensors --log h.last.safetensors)
+expect_match("the last head \\(beside -o\\) and --log both name h.last.safetensors")
+run(2 ${T} -o h.safetensors --log l.csv --plot l.csv)
+expect_match("--plot l.csv: the name must end in .png")
+run(2 ${T} -o h.safetensors --log same.png --plot same.png)
+expect_match("--log and --plot both name same.png")
+if(EXISTS "${WORK}/fresh_cache")
+  message(FATAL_ERROR "flows were computed before the outputs were refused")
+endif()
+if(NOT EXISTS "${WORK}/a/mav0/cam0/data.csv")
+  message(FATAL_ERROR "train replaced a sequence's file")
+endif()
+
+# Bad numbers: refused, not wrapped or accepted.
+run(2 ${T} -o h.safetensors --seed -1)
+expect_match("inertialnet: error: --seed '-1': the seed is a whole number")
+run(2 ${T} -o h.safetensors --weight-decay -5)
+expect_match("the weight decay must be a finite number ≥ 0, got -5")
+
+# A flow cache that cannot be written (here its folder cannot be created) is a warning; training goes on.
+file(WRITE "${WORK}/a_file" "x")
+run(0 ${T0} -o uncached.safetensors --cache a_file/cache)
+expect_match("inertialnet: warning: the flows of a were not cached \\(.*\\); training goes on")
+if(NOT EXISTS "${WORK}/uncached.safetensors")
+  message(FATAL_ERROR "train did not write its head without a cache")
+endif()
+
+# The cache key covers every frame: an image replaced after the flows were cached is a new key,
+# not stale flows (before: keyed by path, frame count and first/last timestamp only).
+run(0 ${CLI} synth c --frames 8 --motion general --size 64x48 --seed 34)
+run(0 ${CLI} train --train c --val b --head-size 64x48 --epochs 1 --cache cache -o c_head.safetensors)
+expect_match("c: flows cached in")
+file(GLOB c_frames "${WORK}/c/mav0/cam0/data/*.png")
+list(SORT c_frames)
+list(GET c_frames 4 frame4)
+list(GET c_frames 5 frame5)
+file(COPY_FILE "${frame5}" "${frame4}")
+run(0 ${CLI} train --train c --val b --head-size 64x48 --epochs 1 --cache cache -o c_head.safetensors)
+expect_match("c: flows cached in")
+expect_no_match("c: flows read from the cache")
+
 run(0 ${CLI} predict b --weights head.safetensors --flow dis -o rates.csv)
 run(2 ${CLI} predict big --weights head.safetensors --flow dis -o rates.csv)
 expect_match("built for 64×48 flow")
@@ -49,6 +183,10 @@ expect_match("synthetic")
 expect_match("flows cached in")
 run(0 ${CLI} weights --info fc.safetensors)
 expect_match("\"flow\":\"flownet2\"")
+# The weights are an input: no output may replace them.
+run(2 ${CLI} train --train a --val b --flow flownet2 --weights c.safetensors --head-size 32x24 --epochs 1
+    -o fc.safetensors --log c.safetensors --cache cache)
+expect_match("--log c.safetensors is the weight file c.safetensors, one of the inputs")
 
 run(2 ${CLI} train --train a --val b --head-size 64x48 --optimizer nadam -o x.safetensors)
 expect_match("unknown optimizer 'nadam'")

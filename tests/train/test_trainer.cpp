@@ -8,15 +8,26 @@
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <iterator>
+#include <limits>
 #include <memory>
+
+#include <sys/stat.h>
 
 #include "inertialnet/models/head_backprop.hpp"
 #include "inertialnet/models/inertialnet_head.hpp"
+#include "inertialnet/io/safetensors.hpp"
+#include "inertialnet/io/safetensors_writer.hpp"
 #include "inertialnet/models/weights.hpp"
+#include "inertialnet/runtime/error.hpp"
+#include "inertialnet/runtime/log.hpp"
 #include "inertialnet/synth/synthetic_sequence.hpp"
 #include "inertialnet/train/trainer.hpp"
+#include "inertialnet/train/training_log.hpp"
 #include "inertialnet/train/training_set.hpp"
 #include "support/testing.hpp"
 
@@ -260,6 +271,268 @@ TEST(TrainingSet, ATimeOffsetPutsTheTargetsOnTheImuClock) {
 TEST(TrainingSet, RefusesAFolderWithoutAnImu) {
   const fs::path dir = testing::temporary_directory("trainer_noimu");
   testing::expect_invalid_input([&] { TrainingSet(set_options({})).add_sequence(dir); }, "not a EuRoC sequence");
+}
+
+// --- Never lose or falsify a result (issue 20, item 5) ------------------------------------------
+
+// The warnings the library logs while `call` runs.
+std::vector<std::string> warnings_during(const std::function<void()>& call) {
+  std::vector<std::string> seen;
+  set_log_sink([&seen](LogLevel level, const std::string& message) {
+    if (level == LogLevel::Warning) seen.push_back(message);
+  });
+  try {
+    call();
+  } catch (...) {
+    set_log_sink({});
+    throw;
+  }
+  set_log_sink({});
+  return seen;
+}
+
+// A copy of the state at `from` with `edit` applied to its tensors and metadata.
+void edit_state(const fs::path& from, const fs::path& to,
+                const std::function<void(std::vector<HostTensor>&, std::map<std::string, std::string>&)>& edit) {
+  std::vector<HostTensor> tensors;
+  std::map<std::string, std::string> meta;
+  {
+    const SafetensorsFile file(from.string());
+    meta = file.metadata();
+    for (const auto& name : file.names()) {
+      HostTensor t;
+      t.name = name;
+      t.shape = file.shape(name);
+      t.data = file.to_float32(name);
+      tensors.push_back(std::move(t));
+    }
+  }
+  edit(tensors, meta);
+  write_safetensors(to.string(), tensors, meta);
+}
+
+TEST(Trainer, ADivergingLearningRateStopsNamingTheEpochAndBatchAndSavesNothing) {
+  // Before: the losses went to inf/NaN, the epochs printed -nan and the NaN head was saved as best.
+  Sets& s = sets();
+  TrainerOptions options = small_adam(1);
+  options.lr = 1e6f;
+  Trainer trainer(testing::test_device(), options);
+  int saved = 0;
+  std::string message;
+  try {
+    trainer.train(*s.val, *s.val, {}, [&](const EpochReport&) { ++saved; }, [&](const EpochReport&) { ++saved; });
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Runtime);
+    message = e.what();
+  }
+  EXPECT_TRUE(testing::contains(message, "epoch 1, mini-batch ")) << message;
+  EXPECT_TRUE(testing::contains(message, "learning rate 1e+06 is likely too large")) << message;
+  EXPECT_EQ(saved, 0) << "a checkpoint was written for a diverged epoch";
+  EXPECT_EQ(trainer.epochs_done(), 0);
+  // The step that would have used the non-finite loss was not taken.
+  for (const auto& [name, values] : trainer.parameters()) {
+    EXPECT_TRUE(std::all_of(values.begin(), values.end(), [](float v) { return std::isfinite(v); })) << name;
+  }
+}
+
+TEST(Trainer, RefusesANegativeOrNonFiniteWeightDecayOrMomentum) {
+  TrainerOptions options = small_adam(1);
+  options.weight_decay = -5;
+  testing::expect_invalid_input([&] { Trainer(testing::test_device(), options); }, "weight decay must be a finite number ≥ 0, got -5");
+  options.weight_decay = std::numeric_limits<float>::quiet_NaN();
+  testing::expect_invalid_input([&] { Trainer(testing::test_device(), options); }, "weight decay");
+  options.weight_decay = 0;
+  options.momentum = -1;
+  testing::expect_invalid_input([&] { Trainer(testing::test_device(), options); }, "momentum");
+}
+
+TEST(Trainer, ResumeChecksTheStateBeforeUsingIt) {
+  Sets& s = sets();
+  const fs::path dir = testing::temporary_directory("trainer_resume_checks");
+  // A state one epoch into an Adam run (its second moments are non-zero).
+  TrainerOptions adam = small_adam(2);
+  adam.epochs = 1;
+  Trainer first(testing::test_device(), adam);
+  ASSERT_TRUE(first.train(*s.val, *s.val, {}));
+  const fs::path good = dir / "good.state.safetensors";
+  first.save_state(good);
+  adam.epochs = 2;
+
+  // Bad metadata numbers name the file and the key (before: "stoi", exit 1).
+  const fs::path bad_epoch = dir / "bad_epoch.state.safetensors";
+  edit_state(good, bad_epoch, [](auto&, auto& meta) { meta["inertialnet.train.epoch"] = "one"; });
+  testing::expect_invalid_input([&] { Trainer(testing::test_device(), adam).resume(bad_epoch); },
+                                "bad_epoch.state.safetensors: the training state's inertialnet.train.epoch is 'one'");
+  const fs::path bad_best = dir / "bad_best.state.safetensors";
+  edit_state(good, bad_best, [](auto&, auto& meta) { meta["inertialnet.train.best_rmse"] = "nan"; });
+  testing::expect_invalid_input([&] { Trainer(testing::test_device(), adam).resume(bad_best); },
+                                "inertialnet.train.best_rmse is 'nan'");
+  const fs::path huge_steps = dir / "huge_steps.state.safetensors";
+  edit_state(good, huge_steps, [](auto&, auto& meta) { meta["inertialnet.train.steps"] = "99999999999999999999999"; });
+  testing::expect_invalid_input([&] { Trainer(testing::test_device(), adam).resume(huge_steps); },
+                                "inertialnet.train.steps");
+
+  // A NaN in the parameters or the moments would be trained on and saved as the next best head.
+  const fs::path nan_state = dir / "nan.state.safetensors";
+  edit_state(good, nan_state, [](auto& tensors, auto&) {
+    for (auto& t : tensors)
+      if (t.name == "optimizer.m1.head.fc2.weight") t.data[3] = std::numeric_limits<float>::quiet_NaN();
+  });
+  Trainer victim(testing::test_device(), adam);
+  const auto before = victim.parameters();
+  testing::expect_invalid_input([&] { victim.resume(nan_state); },
+                                "optimizer.m1.head.fc2.weight holds a non-finite value (nan at element 3)");
+  EXPECT_EQ(victim.epochs_done(), 0) << "a refused state changed the trainer";
+  EXPECT_EQ(victim.parameters(), before);
+
+  // Another optimiser than the state's: SGD's velocity is not Adam's mean gradient. Refused with
+  // the optimiser recorded, and for a state written before it was (told by the second moments).
+  TrainerOptions sgd = adam;
+  sgd.optimizer = OptimizerKind::SGD;
+  testing::expect_invalid_input([&] { Trainer(testing::test_device(), sgd).resume(good); },
+                                "was trained with the optimizer adam, this run asks for sgd");
+  const fs::path legacy = dir / "legacy.state.safetensors";
+  edit_state(good, legacy, [](auto&, auto& meta) {
+    meta.erase("inertialnet.train.optimizer");
+    meta.erase("inertialnet.train.best_epoch");
+  });
+  testing::expect_invalid_input([&] { Trainer(testing::test_device(), sgd).resume(legacy); },
+                                "was trained with the optimizer adam, this run asks for sgd");
+  Trainer resumed(testing::test_device(), adam);
+  resumed.resume(legacy);
+  EXPECT_EQ(resumed.epochs_done(), 1);
+  EXPECT_EQ(resumed.best().epoch, 0);  // the legacy state does not say which epoch was best
+  Trainer resumed_new(testing::test_device(), adam);
+  resumed_new.resume(good);
+  EXPECT_EQ(resumed_new.best().epoch, 1);
+  EXPECT_FALSE(resumed_new.finished());
+  adam.epochs = 1;
+  Trainer done(testing::test_device(), adam);
+  done.resume(good);
+  EXPECT_TRUE(done.finished());
+}
+
+// The cache file of a set built from `dir` alone, in `cache`.
+fs::path only_cache_file(const fs::path& cache) {
+  std::vector<fs::path> files;
+  for (const auto& entry : fs::directory_iterator(cache)) files.push_back(entry.path());
+  EXPECT_EQ(files.size(), 1u);
+  return files.empty() ? fs::path() : files.front();
+}
+
+bool note_contains(const TrainingSet& set, const std::string& part) {
+  for (const auto& note : set.notes())
+    if (testing::contains(note, part)) return true;
+  return false;
+}
+
+TEST(TrainingSet, ADamagedCacheFileIsAWarningAndTheFlowsAreRecomputed) {
+  Sets& s = sets();
+  const fs::path cache = fs::path(testing::temporary_directory("trainer_nan_cache"));
+  const fs::path seq = sequence(s.root, 21);
+  TrainingSet{set_options(cache)}.add_sequence(seq);
+  const fs::path file = only_cache_file(cache);
+  {
+    // A float16 NaN (0x7E00) planted in the first flow (after the 8-byte magic and the count).
+    std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(16 + 2 * 100);
+    const unsigned char nan[2] = {0x00, 0x7E};
+    f.write(reinterpret_cast<const char*>(nan), 2);
+  }
+  TrainingSet again(set_options(cache));
+  const auto warnings = warnings_during([&] { again.add_sequence(seq); });
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_TRUE(testing::contains(warnings[0], "is damaged (value 100 is not finite); computing the flows afresh")) << warnings[0];
+  EXPECT_FALSE(note_contains(again, "read from the cache"));
+  std::vector<float> a(again.flow_floats()), b(again.flow_floats());
+  for (std::size_t i = 0; i < again.size(); ++i) {
+    again.flow(i, a.data());
+    s.val->flow(i, b.data());
+    ASSERT_EQ(a, b) << "pair " << i;
+  }
+  // Rewritten whole: the next load reads it.
+  TrainingSet third(set_options(cache));
+  third.add_sequence(seq);
+  EXPECT_TRUE(note_contains(third, "read from the cache"));
+}
+
+TEST(TrainingSet, AChangedFrameIsANewCacheKeyNotStaleFlows) {
+  // Before, the key was the path, frame count and first/last timestamps: new images, old flows.
+  const fs::path dir = fs::path(testing::temporary_directory("trainer_stale_cache"));
+  const fs::path seq = sequence(dir, 41);
+  const fs::path cache = dir / "cache";
+  TrainingSet first(set_options(cache));
+  first.add_sequence(seq);
+  ASSERT_TRUE(note_contains(first, "flows cached in"));
+  // Frame 5 replaced by frame 6's image: pairs 4→5 and 5→6 change.
+  const fs::path images = seq / "mav0" / "cam0" / "data";
+  std::vector<fs::path> frames;
+  for (const auto& entry : fs::directory_iterator(images)) frames.push_back(entry.path());
+  std::sort(frames.begin(), frames.end());
+  fs::copy_file(frames[6], frames[5], fs::copy_options::overwrite_existing);
+  TrainingSet second(set_options(cache));
+  second.add_sequence(seq);
+  EXPECT_FALSE(note_contains(second, "read from the cache"));
+  EXPECT_TRUE(note_contains(second, "flows cached in"));
+  std::vector<float> a(first.flow_floats()), b(first.flow_floats());
+  first.flow(5, a.data());   // pair 5→6 (sample 5 ends at frame 6)
+  second.flow(5, b.data());
+  EXPECT_NE(a, b);
+}
+
+TEST(TrainingSet, ACacheThatCannotBeWrittenIsAWarningNotAFailure) {
+  Sets& s = sets();
+  const fs::path dir = fs::path(testing::temporary_directory("trainer_cache_unwritable"));
+  std::ofstream(dir / "a_file") << "x";
+  TrainingSet set(set_options(dir / "a_file" / "cache"));  // a folder that cannot be created
+  const auto warnings = warnings_during([&] { set.add_sequence(sequence(s.root, 21)); });
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_TRUE(testing::contains(warnings[0], "were not cached")) << warnings[0];
+  EXPECT_TRUE(testing::contains(warnings[0], "training goes on")) << warnings[0];
+  EXPECT_EQ(set.size(), s.val->size() / 2);
+}
+
+TEST(TrainingLog, WritesThroughTheAtomicWriterAndKeepsTheStatesEpochsOnResume) {
+  const fs::path dir = fs::path(testing::temporary_directory("training_log"));
+  // Never a device node or a FIFO: no clobbering, no blocking on a reader.
+  testing::expect_invalid_input([] { TrainingLog log{"/dev/null"}; }, "not a regular file");
+  ASSERT_EQ(::mkfifo((dir / "fifo").c_str(), 0600), 0);
+  testing::expect_invalid_input([&] { TrainingLog log{dir / "fifo"}; }, "not a regular file");
+  testing::expect_invalid_input([&] { TrainingLog log{dir}; }, "not a regular file");
+
+  const fs::path csv = dir / "train.csv";
+  EpochReport r;
+  {
+    TrainingLog log(csv);
+    EXPECT_FALSE(fs::exists(csv)) << "nothing is written before the first epoch";
+    for (int e = 1; e <= 3; ++e) {
+      r.epoch = e;
+      log.append(r);
+    }
+  }
+  auto lines = [&] {
+    std::ifstream in(csv);
+    std::vector<std::string> out;
+    for (std::string line; std::getline(in, line);) out.push_back(line);
+    return out;
+  };
+  ASSERT_EQ(lines().size(), 4u);
+  // Resuming after epoch 2 (epoch 3's checkpoint lost): epoch 3 is not listed twice.
+  {
+    TrainingLog log(csv, 2);
+    r.epoch = 3;
+    log.append(r);
+  }
+  const auto after = lines();
+  ASSERT_EQ(after.size(), 4u);
+  EXPECT_EQ(after[0], TrainingLog::header());
+  EXPECT_EQ(after[3].substr(0, 2), "3,");
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    EXPECT_FALSE(testing::contains(entry.path().filename().string(), ".tmp.")) << entry.path();
+  }
+  // Continuing a file that is not a training log would destroy it.
+  std::ofstream(dir / "notes.csv") << "my,own,data\n1,2,3\n";
+  testing::expect_invalid_input([&] { TrainingLog log{dir / "notes.csv", 2}; }, "is not a training log");
 }
 
 }  // namespace

@@ -2,8 +2,12 @@
 // (include/inertialnet/train/trainer.hpp), on the selected OpenCL device. Writes the best head by
 // validation RMSE (-o), the last one (<stem>.last.safetensors) and a resumable state
 // (<stem>.state.safetensors) after every epoch; Ctrl-C stops after the current mini-batch with
-// both checkpoints valid (exit 1).
+// both checkpoints valid (exit 1). Every output is checked, and the resume state read, before any
+// flow is computed: a mistake costs seconds, not the hours of FlowNet2 flows.
+#include <algorithm>
 #include <atomic>
+#include <cctype>
+#include <charconv>
 #include <csignal>
 #include <cstdio>
 #include <fstream>
@@ -13,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
+#include "console.hpp"
 #include "interrupt.hpp"
 #include "common.hpp"
 #include "progress.hpp"
@@ -22,6 +27,7 @@
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/runtime/program_cache.hpp"
 #include "inertialnet/train/trainer.hpp"
+#include "inertialnet/train/training_log.hpp"
 #include "inertialnet/train/training_set.hpp"
 
 namespace inertialnet::cli {
@@ -35,7 +41,7 @@ struct TrainCliOptions {
   std::string out, log, plot, cache, time_offset;
   int epochs = 20, batch = 10;
   float lr = 1e-6f, momentum = 0.0f, weight_decay = 0.0f;
-  std::uint64_t seed = 1;
+  std::string seed = "1";
   double cache_budget_mb = -1;
   bool resume = false, no_flow_cache = false, augment_flips = false;
 };
@@ -45,6 +51,88 @@ std::filesystem::path sibling(const std::filesystem::path& out, const std::strin
 }
 
 std::string vec3_json(const Vec3& v) { return nlohmann::json(std::vector<double>{v[0], v[1], v[2]}).dump(); }
+
+namespace fs = std::filesystem;
+
+std::uint64_t parse_seed(const std::string& text) {
+  std::uint64_t value = 0;
+  const char* end = text.data() + text.size();
+  const auto [ptr, ec] = std::from_chars(text.data(), end, value);
+  if (text.empty() || ec != std::errc() || ptr != end) {
+    throw invalid_input("--seed '" + text.substr(0, 40) + (text.size() > 40 ? "…" : "") +
+                        "': the seed is a whole number from 0 to 18446744073709551615");
+  }
+  return value;
+}
+
+// One file `train` writes, and the option that names it.
+struct Output {
+  fs::path path;
+  std::string option;
+};
+
+// The path a file would be written at: symbolic links resolved (the atomic writer replaces the
+// file a link names), a missing tail kept as given.
+fs::path resolved(const fs::path& path) {
+  std::error_code ec;
+  const fs::path p = fs::weakly_canonical(fs::absolute(path, ec), ec);
+  return ec ? fs::absolute(path) : p;
+}
+
+bool inside(const fs::path& path, const fs::path& folder) {
+  const auto [f, p] = std::mismatch(folder.begin(), folder.end(), path.begin(), path.end());
+  return f == folder.end();
+}
+
+// The output rules of docs/cli.md, for every file train writes, before any work: missing folders
+// created; a target that exists and is not a regular file (a folder, a device node, a FIFO, a link
+// to nothing) refused; no output one of the inputs (a --weights file, anything in a sequence's
+// mav0 folder); no two outputs the same file.
+void check_outputs(const std::vector<Output>& outputs, const std::vector<std::string>& weights,
+                   const std::vector<std::string>& sequences) {
+  for (const auto& out : outputs) {
+    if (out.path.empty() || out.path.filename().empty()) {
+      throw invalid_input(out.option + " '" + out.path.string() + "': expected a file name.");
+    }
+    std::error_code ec;
+    const fs::file_status link = fs::symlink_status(out.path, ec);
+    const fs::file_status target = fs::status(out.path, ec);
+    if (fs::is_symlink(link) && target.type() == fs::file_type::not_found) {
+      throw invalid_input(out.option + " " + out.path.string() + ": it is a symbolic link that leads nowhere; refusing to write through it.");
+    }
+    // (file_type::none: the status could not be read, e.g. no permission; the writer reports that.)
+    if (target.type() != fs::file_type::not_found && target.type() != fs::file_type::none &&
+        !fs::is_regular_file(target)) {
+      throw invalid_input(out.option + " " + out.path.string() + ": it exists and is not a regular file (" +
+                          (fs::is_directory(target) ? "a folder" : "a device, FIFO or socket") +
+                          "); refusing to replace it.");
+    }
+    const fs::path at = resolved(out.path);
+    for (const auto& w : weights) {
+      if (fs::exists(w, ec) && at == resolved(w)) {
+        throw invalid_input(out.option + " " + out.path.string() + " is the weight file " + w +
+                            ", one of the inputs; refusing to overwrite it.");
+      }
+    }
+    for (const auto& root : sequences) {
+      const fs::path mav0 = fs::is_directory(fs::path(root) / "mav0", ec) ? fs::path(root) / "mav0" : fs::path(root);
+      if (fs::is_directory(mav0, ec) && inside(at, resolved(mav0))) {
+        throw invalid_input(out.option + " " + out.path.string() + " is inside the sequence " + root +
+                            " (its mav0 folder, the training inputs); refusing to write there.");
+      }
+    }
+  }
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    for (std::size_t j = i + 1; j < outputs.size(); ++j) {
+      if (resolved(outputs[i].path) == resolved(outputs[j].path)) {
+        throw invalid_input(outputs[i].option + " and " + outputs[j].option + " both name " + outputs[j].path.string() +
+                            "; each output needs a file of its own.");
+      }
+    }
+  }
+  // Only now, so that a refused output leaves no new folder behind (inside a sequence, say).
+  for (const auto& out : outputs) prepare_output_file(out.path.string(), out.option);
+}
 
 }  // namespace
 
@@ -59,9 +147,12 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
   app.add_option("--lr", o->lr, "learning rate (the paper: 1e-6 with SGD)")->capture_default_str();
   app.add_option("--optimizer", o->optimizer, "sgd or adam")->capture_default_str();
   app.add_option("--momentum", o->momentum, "SGD momentum")->capture_default_str();
-  app.add_option("--weight-decay", o->weight_decay, "L2 weight decay")->capture_default_str();
+  app.add_option("--weight-decay", o->weight_decay, "L2 weight decay (≥ 0)")->capture_default_str();
   app.add_option("--lr-schedule", o->schedule, "constant, step (x0.1 every 10 epochs) or cosine")->capture_default_str();
-  app.add_option("--seed", o->seed, "seed of the initialisation, shuffles and dropout")->capture_default_str();
+  // Read as text and parsed in the command: an unsigned option would take -1 as 2^64 − 1.
+  app.add_option("--seed", o->seed, "seed of the initialisation, shuffles and dropout (a whole number ≥ 0)")
+      ->capture_default_str()
+      ->type_name("UINT");
   app.add_option("--head-size", o->head_size, "the head's flow size WxH (flows are resized to it)")->capture_default_str();
   app.add_option("--target", o->target, "spline (the paper's) or mean")->capture_default_str();
   app.add_option("--time-offset", o->time_offset,
@@ -87,20 +178,60 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
     options.weight_decay = o->weight_decay;
     options.epochs = o->epochs;
     options.batch = o->batch;
-    options.seed = o->seed;
+    options.seed = parse_seed(o->seed);
     options.flip_augmentation = o->augment_flips;
     options.head.validate();
 
-    std::unique_ptr<Device> device = open_device(global);
     TrainingSetOptions set_options;
     set_options.width = static_cast<int>(width);
     set_options.height = static_cast<int>(height);
     set_options.flow = parse_flow_method(o->flow);
     set_options.target = parse_sync_target(o->target);
     if (!o->time_offset.empty()) set_options.time_offset_s = parse_seconds(o->time_offset, "--time-offset");
+    if (set_options.flow == FlowMethod::FlowNet && o->weights.empty()) {
+      throw invalid_input("--flow flownet2 needs FlowNet2 weights (--weights FILE)");
+    }
+
+    // Every output, checked before anything is computed.
+    const fs::path out = o->out;
+    const fs::path last_path = sibling(out, ".last.safetensors");
+    const fs::path state_path = sibling(out, ".state.safetensors");
+    std::vector<Output> outputs{{out, "-o"},
+                                {last_path, "the last head (beside -o)"},
+                                {state_path, "the training state (beside -o)"}};
+    if (!o->log.empty()) outputs.push_back({o->log, "--log"});
+    if (!o->plot.empty()) {
+      std::string extension = fs::path(o->plot).extension().string();
+      for (auto& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      if (extension != ".png") throw invalid_input("--plot " + o->plot + ": the name must end in .png.");
+      outputs.push_back({o->plot, "--plot"});
+    }
+    std::vector<std::string> sequences = o->train;
+    sequences.insert(sequences.end(), o->val.begin(), o->val.end());
+    check_outputs(outputs, o->weights, sequences);
+
+    std::unique_ptr<Device> device = open_device(global);
+    Trainer trainer(*device, options);  // refuses options no run can use
+    if (o->resume) {
+      std::error_code ec;
+      if (!fs::exists(state_path, ec)) {
+        throw invalid_input("--resume: there is no training state " + state_path.string() +
+                            " (train writes it beside -o after every epoch; resume with the -o of that run)");
+      }
+      trainer.resume(state_path);
+      if (trainer.finished()) {
+        info("nothing to do: " + state_path.string() + " has finished epoch " + std::to_string(trainer.epochs_done()) +
+             " of --epochs " + std::to_string(options.epochs) + "; raise --epochs to train on. No file was written.");
+        return 0;
+      }
+      info("resuming after epoch " + std::to_string(trainer.epochs_done()) + " from " + state_path.string());
+    }
+    // Opened (and its target checked by the atomic writer) before the flows.
+    std::unique_ptr<TrainingLog> log;
+    if (!o->log.empty()) log = std::make_unique<TrainingLog>(o->log, o->resume ? trainer.epochs_done() : -1);
+
     WeightSet flownet;
     if (set_options.flow == FlowMethod::FlowNet) {
-      if (o->weights.empty()) throw invalid_input("--flow flownet2 needs FlowNet2 weights (--weights FILE)");
       flownet = WeightSet::load(*device, o->weights);
       warn_if_synthetic(flownet);
       set_options.flownet_weights = &flownet;
@@ -108,12 +239,12 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
       std::string id;
       for (const auto& w : o->weights) {
         std::error_code ec;
-        id += w + ":" + std::to_string(std::filesystem::file_size(w, ec)) + ":" +
-              std::to_string(std::filesystem::last_write_time(w, ec).time_since_epoch().count()) + ";";
+        id += w + ":" + std::to_string(fs::file_size(w, ec)) + ":" +
+              std::to_string(fs::last_write_time(w, ec).time_since_epoch().count()) + ";";
       }
       set_options.weights_id = id;
     }
-    if (!o->no_flow_cache) set_options.cache_dir = o->cache.empty() ? default_cache_directory() / "flows" : std::filesystem::path(o->cache);
+    if (!o->no_flow_cache) set_options.cache_dir = o->cache.empty() ? default_cache_directory() / "flows" : fs::path(o->cache);
     if (o->cache_budget_mb >= 0) set_options.cache_budget_bytes = static_cast<std::uint64_t>(o->cache_budget_mb * 1048576.0);
 
     TrainingSet train_set(set_options), val_set(set_options);
@@ -125,31 +256,13 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
           progress->update(pair);
         });
         progress.reset();
-        std::cerr << what << " " << root << ": " << n << " pairs\n";
+        info(std::string(what) + " " + root + ": " + std::to_string(n) + " pairs");
       }
-      for (const auto& note : set.notes()) std::cerr << "  " << note << "\n";
+      for (const auto& note : set.notes()) info("  " + note);
     };
     load(train_set, o->train, "train");
     load(val_set, o->val, "val");
 
-    Trainer trainer(*device, options);
-    const std::filesystem::path out = o->out;
-    const std::filesystem::path last_path = sibling(out, ".last.safetensors");
-    const std::filesystem::path state_path = sibling(out, ".state.safetensors");
-    if (o->resume) {
-      trainer.resume(state_path);
-      std::cerr << "resuming after epoch " << trainer.epochs_done() << " from " << state_path << "\n";
-    }
-
-    std::ofstream log;
-    if (!o->log.empty()) {
-      log.open(o->log, o->resume ? std::ios::app : std::ios::trunc);
-      if (!log) throw invalid_input("cannot write the log " + o->log);
-      if (!o->resume) {
-        log << "epoch,lr,train_loss,val_loss,rmse_x_deg_s,rmse_y_deg_s,rmse_z_deg_s,zero_rmse_x_deg_s,"
-               "zero_rmse_y_deg_s,zero_rmse_z_deg_s,spread_ratio_x,spread_ratio_y,spread_ratio_z,best,seconds\n";
-      }
-    }
     std::vector<double> plot_epochs, plot_train, plot_val;
 
     auto metadata = [&](const EpochReport& r) {
@@ -197,20 +310,15 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
                     r.epoch, r.epochs, r.lr, r.train_loss, r.val_loss, r.val_rmse_deg_s[0], r.val_rmse_deg_s[1],
                     r.val_rmse_deg_s[2], r.zero_rmse_deg_s[0], r.zero_rmse_deg_s[1], r.zero_rmse_deg_s[2],
                     r.spread_ratio[0], r.spread_ratio[1], r.spread_ratio[2], r.seconds, r.best ? "  best" : "");
-      std::cerr << line << "\n";
+      info(line);
       if (r.collapsed) {
-        std::cerr << "warning: the predictions' spread fell below " << kCollapseRatio
-                  << " of the targets' on some axis: the head is collapsing towards the mean (the paper's "
-                     "\"same-value problem\"); try a larger learning rate, Adam, or more epochs\n";
+        char ratio[16];
+        std::snprintf(ratio, sizeof ratio, "%g", kCollapseRatio);
+        warning(std::string("the predictions' spread fell below ") + ratio +
+                " of the targets' on some axis: the head is collapsing towards the mean (the paper's "
+                "\"same-value problem\"); try a larger learning rate, Adam, or more epochs");
       }
-      if (log) {
-        log << r.epoch << ',' << r.lr << ',' << r.train_loss << ',' << r.val_loss;
-        for (double v : r.val_rmse_deg_s) log << ',' << v;
-        for (double v : r.zero_rmse_deg_s) log << ',' << v;
-        for (double v : r.spread_ratio) log << ',' << v;
-        log << ',' << (r.best ? 1 : 0) << ',' << r.seconds << '\n';
-        log.flush();
-      }
+      if (log) log->append(r);
       plot_epochs.push_back(r.epoch);
       plot_train.push_back(r.train_loss);
       plot_val.push_back(r.val_loss);
@@ -219,7 +327,11 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
                          "InertialNet head training (MSE, rad^2/s^2)");
       }
     };
-    auto on_best = [&](const EpochReport& r) { trainer.save_head(out, metadata(r)); };
+    bool wrote_best = false;
+    auto on_best = [&](const EpochReport& r) {
+      trainer.save_head(out, metadata(r));
+      wrote_best = true;
+    };
     auto on_last = [&](const EpochReport& r) {
       trainer.save_head(last_path, metadata(r));
       trainer.save_state(state_path);
@@ -235,16 +347,24 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
       EpochReport r = trainer.last();
       trainer.save_head(last_path, metadata(r));
       if (trainer.epochs_done() == 0) trainer.save_head(out, metadata(r));
-      std::cerr << "interrupted: " << last_path << " holds the weights so far; " << state_path
-                << " resumes after epoch " << trainer.epochs_done() << "\n";
+      end_progress_line();
+      std::cerr << "inertialnet: interrupted: " << last_path.string() << " holds the weights so far; "
+                << state_path.string() << " resumes after epoch " << trainer.epochs_done() << "\n";
       return 1;
     }
     const EpochReport& best = trainer.best();
-    std::printf("best epoch %d: validation RMSE %.3f %.3f %.3f deg/s (zero predictor %.3f %.3f %.3f), spread %.2f %.2f %.2f\n",
-                best.epoch, best.val_rmse_deg_s[0], best.val_rmse_deg_s[1], best.val_rmse_deg_s[2],
-                best.zero_rmse_deg_s[0], best.zero_rmse_deg_s[1], best.zero_rmse_deg_s[2], best.spread_ratio[0],
-                best.spread_ratio[1], best.spread_ratio[2]);
-    std::printf("wrote %s (best), %s (last)\n", out.string().c_str(), last_path.string().c_str());
+    if (wrote_best) {
+      std::printf("best epoch %d: validation RMSE %.3f %.3f %.3f deg/s (zero predictor %.3f %.3f %.3f), spread %.2f %.2f %.2f\n",
+                  best.epoch, best.val_rmse_deg_s[0], best.val_rmse_deg_s[1], best.val_rmse_deg_s[2],
+                  best.zero_rmse_deg_s[0], best.zero_rmse_deg_s[1], best.zero_rmse_deg_s[2], best.spread_ratio[0],
+                  best.spread_ratio[1], best.spread_ratio[2]);
+      std::printf("wrote %s (best), %s (last)\n", out.string().c_str(), last_path.string().c_str());
+    } else {
+      // Resumed, and no epoch of this run beat the state's best: -o still holds that epoch's head.
+      std::printf("best epoch %d (before this run): mean validation RMSE %.3f deg/s; no epoch of this run improved on it\n",
+                  best.epoch, trainer.best_mean_rmse_deg_s());
+      std::printf("kept %s (best), wrote %s (last)\n", out.string().c_str(), last_path.string().c_str());
+    }
     flush_standard_output();
     return 0;
   };

@@ -89,6 +89,8 @@ class Trainer {
  public:
   // Initialises the head like torch.nn's defaults (uniform ±1/sqrt(fan-in) for weights and
   // biases) from the seed.
+  // invalid_input for options no run can use (epochs or batch < 1, a learning rate ≤ 0, a
+  // negative or non-finite weight decay or momentum).
   Trainer(Device& device, const TrainerOptions& options);
   ~Trainer();
   Trainer(const Trainer&) = delete;
@@ -96,13 +98,20 @@ class Trainer {
 
   const TrainerOptions& options() const noexcept { return options_; }
   int epochs_done() const noexcept { return epoch_; }
+  // The best epoch so far (after resume(): its epoch number only, from the state) and its mean
+  // validation RMSE over the axes, deg/s (negative before the first epoch).
   const EpochReport& best() const noexcept { return best_; }
+  double best_mean_rmse_deg_s() const noexcept { return best_rmse_; }
+  // True when epochs_done() has reached options.epochs: train() has nothing left to do.
+  bool finished() const noexcept { return epoch_ >= options_.epochs; }
   const EpochReport& last() const noexcept { return last_; }
 
   // Runs the remaining epochs (options.epochs − epochs_done()); returns false when stopped.
   // `on_best` / `on_last` are called after an epoch that improved / after every epoch (the
   // checkpoint writers). A stop request ends the epoch after the current mini-batch; the
-  // parameters stay valid, but that epoch does not count.
+  // parameters stay valid, but that epoch does not count. A non-finite loss (a diverging learning
+  // rate, a NaN in the set) is runtime_error naming the epoch, the mini-batch and the likely cause,
+  // thrown before that step and before any callback of the epoch: NaN never reaches a checkpoint.
   bool train(const TrainingSet& train_set, const TrainingSet& val_set, const TrainerCallbacks& callbacks,
              const std::function<void(const EpochReport&)>& on_best = {},
              const std::function<void(const EpochReport&)>& on_last = {});
@@ -112,7 +121,10 @@ class Trainer {
   // The head's tensors (head.*) with `metadata` added to the model kind and head configuration:
   // a file `predict --weights` loads.
   void save_head(const std::filesystem::path& path, const std::map<std::string, std::string>& metadata) const;
-  // Parameters, optimiser state and progress; resume() reads it back (options must match).
+  // Parameters, optimiser state and progress; resume() reads it back (options must match). resume()
+  // checks everything before it changes anything: the head configuration, every tensor's shape and
+  // finiteness, the metadata numbers (invalid_input naming the file and key), and the optimiser
+  // (a state of SGD is not resumed as Adam, nor the reverse).
   void save_state(const std::filesystem::path& path) const;
   void resume(const std::filesystem::path& path);
 

@@ -11,9 +11,13 @@
 // at the frames' size, resized
 // bilinearly to the head's input size with u and v scaled by the size ratio. They are computed
 // once per sequence and kept, float16, in memory and in an on-disk cache keyed by the sequence's
-// path and timestamps, the flow method, the weights' identity and the size: a second run, or the
-// next epoch, never recomputes them. A cache that would exceed the disk budget is not written
-// (the flows are then recomputed on the next run).
+// path, every frame's file (name, size, modification time) and timestamp, the flow method and its
+// settings, the weights' identity and the size: a second run, or the next epoch, never recomputes
+// them, and a changed image is a new key, never stale flows. A cache file is checked when read
+// (header, length, every value finite); a damaged one is a warning and the flows are recomputed.
+// A cache that would exceed the disk budget is not written, and one that cannot be written (a
+// full disk, a read-only folder) is a warning: the run goes on, the next one recomputes them.
+// A computed flow that is not finite is runtime_error naming the two frames.
 #pragma once
 
 #include <cstdint>
