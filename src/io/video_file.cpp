@@ -107,6 +107,8 @@ struct VideoFile::State {
 };
 
 VideoFile::VideoFile(const std::filesystem::path& path) : path_(path), state_(std::make_unique<State>()) {
+  // A FIFO or a device would block FFmpeg's open or read forever: regular, readable files only.
+  open_input_file(path, "The video");
   route_third_party_logs();
   State& s = *state_;
   if (!s.picture || !s.bgr) throw runtime_error("out of memory for an FFmpeg frame");
@@ -124,8 +126,9 @@ VideoFile::VideoFile(const std::filesystem::path& path) : path_(path), state_(st
     int read = 0;
     while ((read = av_read_frame(format.get(), s.packet.get())) >= 0) {
       // An empty packet is no picture (AVI marks a frame the recorder dropped that way): the gap
-      // shows in the times of its neighbours.
-      if (s.packet->stream_index == stream && s.packet->size > 0) {
+      // shows in the times of its neighbours. A packet flagged for discarding (before an MP4 edit
+      // list's start) is decoded as a reference only; the decoder gives no picture of it.
+      if (s.packet->stream_index == stream && s.packet->size > 0 && !(s.packet->flags & AV_PKT_FLAG_DISCARD)) {
         ++index_.frames;
         const std::int64_t t = packet_time(*s.packet);
         if (t == AV_NOPTS_VALUE) timed = false;

@@ -2,6 +2,7 @@
 // gives it, a frame that cannot be decoded reported as that frame while the rest go on, a video
 // cut short said, and FFmpeg's own log kept off stderr.
 #include <gtest/gtest.h>
+#include <sys/stat.h>  // mkfifo
 
 #include <cstdint>
 #include <filesystem>
@@ -186,11 +187,15 @@ TEST(VideoSource, FFmpegsLogGoesThroughOursAtDebugOnly) {
   EXPECT_TRUE(mjpeg) << "no line of the mjpeg decoder among " << lines.size();
 }
 
-// Not a video: named, in our words.
+// Not a video: named, in our words. A FIFO is refused before FFmpeg would wait on it forever.
 TEST(VideoSource, NotAVideoIsInvalidInput) {
   const fs::path text = clip().dir / "notes.txt";
-  it::write_prefix_copy(clip().video, text, 0);
   { std::ofstream(text) << "not a video\n"; }
   const std::string message = invalid_input_message([&] { open_frame_source(text); });
-  EXPECT_TRUE(contains(message, "cannot open \"" + text.string() + "\" as a video")) << message;
+  EXPECT_TRUE(contains(message, "cannot open \"" + text.string() + "\" as a video: it is not in a container format")) << message;
+
+  const fs::path fifo = clip().dir / "fifo.avi";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::string fifo_message = invalid_input_message([&] { open_frame_source(fifo); });
+  EXPECT_TRUE(contains(fifo_message, "The video \"" + fifo.string() + "\" is not a regular file")) << fifo_message;
 }
