@@ -65,7 +65,7 @@ class VideoFrames : public FrameSource {
                        "); give --rate to change it.");
     }
     // A video cut short (a copy that stopped, a recorder that died) is read as far as it goes.
-    if (index.announced > 0 && static_cast<std::size_t>(index.announced) > count_) {
+    if (index.announced > 0) {
       notes_.push_back("The video " + name + " ends after " + std::to_string(count_) + " of the " +
                        std::to_string(index.announced) + " frames its header announces; the rest is missing.");
     }

@@ -119,12 +119,13 @@ VideoFile::VideoFile(const std::filesystem::path& path) : path_(path), state_(st
     const AVCodec* codec = nullptr;
     Format format = open_container(path, stream, codec);
     const AVStream* st = format->streams[stream];
-    index_.announced = st->nb_frames;
     const AVRational rate = st->avg_frame_rate.num > 0 ? st->avg_frame_rate : st->r_frame_rate;
     if (rate.num > 0 && rate.den > 0) index_.nominal_fps = av_q2d(rate);
     bool timed = true;
     int read = 0;
+    std::int64_t packets = 0;  // of the video stream, empty and discarded ones too: what the header counts
     while ((read = av_read_frame(format.get(), s.packet.get())) >= 0) {
+      if (s.packet->stream_index == stream) ++packets;
       // An empty packet is no picture (AVI marks a frame the recorder dropped that way): the gap
       // shows in the times of its neighbours. A packet flagged for discarding (before an MP4 edit
       // list's start) is decoded as a reference only; the decoder gives no picture of it.
@@ -136,6 +137,9 @@ VideoFile::VideoFile(const std::filesystem::path& path) : path_(path), state_(st
       }
       av_packet_unref(s.packet.get());
     }
+    // Only a video with fewer packets than its header announces is cut short (an announced count
+    // of 0 is "unknown").
+    if (st->nb_frames > packets) index_.announced = st->nb_frames;
     if (read != AVERROR_EOF) {
       index_.stopped = "reading it stopped at byte " + std::to_string(avio_tell(format->pb)) + " (" +
                        describe_open_error(read) + ")";
@@ -181,7 +185,7 @@ std::optional<cv::Mat> VideoFile::frame(std::size_t i, std::string& why) {
   auto failure_for = [&](std::int64_t key) {
     const auto found = s.failed.find(key);
     if (found != s.failed.end()) return found->second;
-    if (!s.failed.empty()) return std::string("its data is corrupt (the decoder made no picture of it)");
+    if (s.failures_since_picture > 0) return std::string("its data is corrupt (the decoder made no picture of it)");
     return std::string("the decoder made no picture of it");
   };
 

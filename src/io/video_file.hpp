@@ -25,7 +25,8 @@ struct VideoIndex {
   std::vector<std::int64_t> times_ns;  // their presentation times in ascending order, relative to
                                        // the stream's start; empty when the container gives no
                                        // times or gives two frames one time
-  std::int64_t announced = 0;        // frames the container's header announces (0: it does not say)
+  std::int64_t announced = 0;        // frames the container's header announces when the file holds
+                                     // fewer packets (cut short), else 0
   double nominal_fps = 0;            // the stream's nominal frame rate (0: unknown)
   std::string stopped;               // why reading stopped before the end of the file ("" if it did not)
 };
