@@ -54,7 +54,9 @@ class VideoFrames : public FrameSource {
     const bool timed = !index.times_ns.empty();
     if (rate_hz) {
       period_ns_ = std::llround(1e9 / *rate_hz);
-      if (timed) notes_.push_back("--rate " + format_rate(*rate_hz) + " Hz overrides the frame times the video " + name + " carries.");
+      if (timed) {
+        notes_.push_back("--rate " + format_rate(*rate_hz) + " Hz overrides the frame times the video " + name + " carries.");
+      }
     } else if (timed) {
       stamps_ = index.times_ns;
     } else {

@@ -88,9 +88,7 @@ std::string jpeg_truncation(const Bytes& bytes) {
   return "it ends after " + std::to_string(bytes.size()) + " bytes without the end-of-image marker";
 }
 
-// PNG chunks carry a CRC-32 of their type and data. libpng checks it too, but prints its
-// complaint ("libpng error: IDAT: CRC error") on stderr itself; checked here, a damaged file is
-// named in our message and libpng never sees it. Empty for a file whose every chunk matches.
+// CRC-32 as PNG (and zlib) compute it.
 std::uint32_t crc32_of(const unsigned char* data, std::size_t size) {
   static const auto table = [] {
     std::array<std::uint32_t, 256> t{};
@@ -106,6 +104,9 @@ std::uint32_t crc32_of(const unsigned char* data, std::size_t size) {
   return c ^ 0xFFFFFFFFu;
 }
 
+// PNG chunks carry a CRC-32 of their type and data. libpng checks it too, but prints its
+// complaint ("libpng error: IDAT: CRC error") on stderr itself; checked here, a damaged file is
+// named in our message and libpng never sees it. Empty for a file whose every chunk matches.
 std::string png_corruption(const Bytes& bytes) {
   std::size_t at = 8;
   while (at + 12 <= bytes.size()) {  // complete, as png_truncation found
@@ -138,7 +139,9 @@ std::pair<std::uint64_t, std::uint64_t> header_size(const Bytes& bytes) {
     const std::size_t length = static_cast<std::size_t>(bytes[at + 2]) << 8 | bytes[at + 3];
     const bool sof = marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC;
     if (sof && at + 9 <= bytes.size()) {
-      return {static_cast<std::uint64_t>(bytes[at + 7]) << 8 | bytes[at + 8], static_cast<std::uint64_t>(bytes[at + 5]) << 8 | bytes[at + 6]};
+      const std::uint64_t height = static_cast<std::uint64_t>(bytes[at + 5]) << 8 | bytes[at + 6];
+      const std::uint64_t width = static_cast<std::uint64_t>(bytes[at + 7]) << 8 | bytes[at + 8];
+      return {width, height};
     }
     if (marker == 0xDA) break;  // the scan starts: no frame header before it
     at += 2 + length;
@@ -230,7 +233,8 @@ HostImage load_rgb_image(const fs::path& path) {
     // OpenCV's text is an assertion with its source path: for -v only, our words for the user.
     log_message(LogLevel::Debug, "OpenCV on " + quoted(path) + ": " + e.what());
     if (e.err.find("CV_IO_MAX_IMAGE") != std::string::npos) throw invalid_input(size_limit_message(path, bytes));
-    throw invalid_input("The image " + quoted(path) + " cannot be decoded: OpenCV's decoder refuses it (its own words are in the debug log, -v).");
+    throw invalid_input("The image " + quoted(path) +
+                        " cannot be decoded: OpenCV's decoder refuses it (its own words are in the debug log, -v).");
   }
   if (image.empty()) {
     throw invalid_input("The image " + quoted(path) +

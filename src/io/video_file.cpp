@@ -71,7 +71,9 @@ Format open_container(const std::filesystem::path& path, int& stream, const AVCo
   if (opened < 0) throw invalid_input("cannot open " + quoted(path) + " as a video: " + describe_open_error(opened));
   Format format(raw);
   const int probed = avformat_find_stream_info(format.get(), nullptr);
-  if (probed < 0) throw invalid_input("cannot read the streams of the video " + quoted(path) + ": " + describe_open_error(probed));
+  if (probed < 0) {
+    throw invalid_input("cannot read the streams of the video " + quoted(path) + ": " + describe_open_error(probed));
+  }
   codec = nullptr;
   stream = av_find_best_stream(format.get(), AVMEDIA_TYPE_VIDEO, -1, -1, &codec, 0);
   if (stream == AVERROR_STREAM_NOT_FOUND) throw invalid_input(quoted(path) + " holds no video stream");
@@ -147,7 +149,8 @@ VideoFile::VideoFile(const std::filesystem::path& path) : path_(path), state_(st
     std::sort(s.keys.begin(), s.keys.end());
     if (!timed || std::adjacent_find(s.keys.begin(), s.keys.end()) != s.keys.end()) s.keys.clear();
     if (!s.keys.empty()) {
-      const std::int64_t origin = st->start_time != AV_NOPTS_VALUE ? std::min(st->start_time, s.keys.front()) : s.keys.front();
+      const std::int64_t first = s.keys.front();
+      const std::int64_t origin = st->start_time != AV_NOPTS_VALUE ? std::min(st->start_time, first) : first;
       for (const std::int64_t k : s.keys) {
         index_.times_ns.push_back(av_rescale_q(k - origin, st->time_base, AVRational{1, 1'000'000'000}));
       }

@@ -90,7 +90,8 @@ TEST(VideoSource, UndecodableFramesAreReportedAndTheRestKeepTheirTimes) {
   for (std::size_t i = 0; i < kFrames; ++i) {
     if (i == 15 || i == 16) {
       const std::string message = invalid_input_message([&] { source->decode(i); });
-      EXPECT_TRUE(contains(message, "frame " + std::to_string(i) + " (t = " + std::to_string(i * kPeriodNs) + " ns)")) << message;
+      const std::string named = "frame " + std::to_string(i) + " (t = " + std::to_string(i * kPeriodNs) + " ns)";
+      EXPECT_TRUE(contains(message, named)) << message;
       EXPECT_TRUE(contains(message, damaged.string())) << message;
       EXPECT_TRUE(contains(message, "cannot be decoded")) << message;
       // Asked again (as predict looks at a frame twice), it is the same error.
@@ -99,7 +100,8 @@ TEST(VideoSource, UndecodableFramesAreReportedAndTheRestKeepTheirTimes) {
     }
     const HostImage image = source->decode(i);
     EXPECT_TRUE(same_image(image, c.decoded[i])) << "frame " << i;
-    ASSERT_TRUE(cv::imwrite((folder / (std::to_string(kEpochNs + static_cast<std::int64_t>(i) * kPeriodNs) + ".png")).string(), [&] {
+    const std::string name = std::to_string(kEpochNs + static_cast<std::int64_t>(i) * kPeriodNs) + ".png";
+    ASSERT_TRUE(cv::imwrite((folder / name).string(), [&] {
       cv::Mat m(image.height, image.width, CV_8UC3);
       for (int y = 0; y < image.height; ++y) {
         for (int x = 0; x < image.width; ++x) {
@@ -132,7 +134,8 @@ TEST(VideoSource, TruncatedVideoSaysWhatIsMissing) {
   auto source = open_frame_source(at_chunk);
   ASSERT_EQ(source->size(), 28u);
   ASSERT_EQ(source->notes().size(), 1u);
-  EXPECT_EQ(source->notes()[0], "The video cut_at_chunk.avi ends after 28 of the 40 frames its header announces; the rest is missing.");
+  EXPECT_EQ(source->notes()[0],
+            "The video cut_at_chunk.avi ends after 28 of the 40 frames its header announces; the rest is missing.");
   for (std::size_t i = 0; i < 28; ++i) {
     EXPECT_EQ(source->timestamp_ns(i), static_cast<std::int64_t>(i) * kPeriodNs);
     EXPECT_TRUE(same_image(source->decode(i), c.decoded[i])) << "frame " << i;
@@ -192,7 +195,8 @@ TEST(VideoSource, NotAVideoIsInvalidInput) {
   const fs::path text = clip().dir / "notes.txt";
   { std::ofstream(text) << "not a video\n"; }
   const std::string message = invalid_input_message([&] { open_frame_source(text); });
-  EXPECT_TRUE(contains(message, "cannot open \"" + text.string() + "\" as a video: it is not in a container format")) << message;
+  EXPECT_TRUE(contains(message, "cannot open \"" + text.string() + "\" as a video: it is not in a container format"))
+      << message;
 
   const fs::path fifo = clip().dir / "fifo.avi";
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);

@@ -76,7 +76,8 @@ void write_damaged_copy(const std::filesystem::path& from, const std::filesystem
   for (const std::size_t k : garbled) {
     const AviChunk& c = chunks.at(k);
     // 0xFF 0xFF … inside the scan: a run of fill bytes ending in an unknown marker.
-    for (std::size_t i = c.header + 8 + c.size / 2; i < c.header + 8 + c.size * 3 / 4; ++i) bytes[i] = static_cast<char>(0xFF);
+    const std::size_t data = c.header + 8;
+    for (std::size_t i = data + c.size / 2; i < data + c.size * 3 / 4; ++i) bytes[i] = static_cast<char>(0xFF);
   }
   for (const std::size_t k : zeroed) {
     const AviChunk& c = chunks.at(k);
