@@ -52,7 +52,14 @@ __kernel void im2col_panels(__global const float* restrict in, const int in_offs
   const int p0 = first_pixel + j0;
   const int oy0 = p0 / out_width;
   const int ox0 = p0 - oy0 * out_width;
-  const bool one_row = (STRIDE == 1 || STRIDE == 2) && lanes == WIDTH && ox0 + WIDTH <= out_width;
+  // STRIDE is a build option, so the preprocessor picks the strides with a fast path (in C code
+  // the constant `STRIDE == 1 || STRIDE == 2` is a -Wconstant-logical-operand warning, which PoCL
+  // prints on the user's terminal).
+#if STRIDE == 1 || STRIDE == 2
+  const bool one_row = lanes == WIDTH && ox0 + WIDTH <= out_width;
+#else
+  const bool one_row = false;
+#endif
   __global float* out = dst + dst_offset + panel * depth * WIDTH + c0 * (KH * KW) * WIDTH;
   for (int c = c0; c < c1; ++c) {
     const __global float* plane = in + in_offset + c * height * width;

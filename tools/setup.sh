@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
-# Installs the Debian packages that building, testing and running InertialNet-CL need
-# (OpenCL headers and ICD loader, PoCL for the CPU, CLBlast, OpenCV, Eigen, GoogleTest,
-# Google Benchmark, CLI11, nlohmann-json, CMake and a C++17 compiler; OpenBLAS only as the
-# benchmarks' reference, never linked into the library; python3 and zsh for the CLI's terminal
-# and completion tests; python3-venv and python3-dev for the Python package, whose own build and
-# test tools come from PyPI through tools/python_env.sh; clang with its sanitizer and libFuzzer
-# runtimes (libclang-rt-14-dev, which clang only recommends) and llvm's symbolizer for CI's
-# sanitizer pass, tools/check_sanitizers.sh).
+# Installs the Debian packages that building, testing and running InertialNet-CL need (OpenCL
+# headers and ICD loader, PoCL for the CPU, CLBlast, OpenCV, FFmpeg's libraries for videos,
+# Eigen, GoogleTest, Google Benchmark, CLI11, nlohmann-json, CMake and a C++17 compiler; OpenBLAS
+# only as the benchmarks' reference, never linked into the library; python3 and zsh for the CLI's
+# terminal and completion tests; python3-venv and python3-dev for the Python package, whose own
+# build and test tools come from PyPI through tools/python_env.sh; clang with its sanitizer and
+# libFuzzer runtimes (libclang-rt-14-dev, which clang only recommends) and llvm's symbolizer for
+# CI's sanitizer pass, tools/check_sanitizers.sh).
 # Does nothing when everything is present. Works as root (no sudo needed) or through sudo.
 set -euo pipefail
 
@@ -15,6 +15,7 @@ packages=(
   opencl-headers ocl-icd-opencl-dev pocl-opencl-icd clinfo
   libclblast-dev libopenblas-dev
   libopencv-dev libeigen3-dev libopengv-dev
+  libavformat-dev libavcodec-dev libswscale-dev libavutil-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev
   python3 zsh python3-venv python3-dev

@@ -2,10 +2,10 @@
 
 #include <cmath>
 #include <cstdio>
-#include <opencv2/videoio.hpp>
 
 #include "inertialnet/runtime/error.hpp"
 #include "io/image_mat.hpp"
+#include "io/video_file.hpp"
 
 namespace inertialnet {
 
@@ -42,37 +42,37 @@ class ListedFrames : public FrameSource {
   std::vector<std::string> notes_;
 };
 
+// A video read with FFmpeg (io/video_file.hpp): its frames at the presentation times the
+// container gives them, decoded in order on one thread.
 class VideoFrames : public FrameSource {
  public:
-  VideoFrames(const std::filesystem::path& path, std::optional<double> rate_hz) : path_(path) {
-    open();
-    const double fps = capture_.get(cv::CAP_PROP_FPS);
-    // One pass over the container for its frame times (and a true frame count: the announced
-    // one is an estimate for some containers), then back to the start for decoding.
-    std::vector<std::int64_t> stamps;
-    bool increasing = true;
-    while (capture_.grab()) {
-      const double ms = capture_.get(cv::CAP_PROP_POS_MSEC);
-      const std::int64_t t = std::isfinite(ms) ? std::llround(ms * 1e6) : 0;
-      if (!stamps.empty() && t <= stamps.back()) increasing = false;
-      stamps.push_back(t);
-    }
-    count_ = stamps.size();
+  VideoFrames(const std::filesystem::path& path, std::optional<double> rate_hz) : path_(path), file_(path) {
+    const io_detail::VideoIndex& index = file_.index();
+    count_ = index.frames;
+    const std::string name = path.filename().string();
     if (count_ < 2) throw invalid_input("video '" + path.string() + "' holds fewer than two frames");
-    open();
+    const bool timed = !index.times_ns.empty();
     if (rate_hz) {
       period_ns_ = std::llround(1e9 / *rate_hz);
-      if (increasing) {
-        notes_.push_back("--rate " + format_rate(*rate_hz) + " Hz overrides the frame times the video " +
-                         path.filename().string() + " carries.");
+      if (timed) {
+        notes_.push_back("--rate " + format_rate(*rate_hz) + " Hz overrides the frame times the video " + name + " carries.");
       }
-    } else if (increasing) {
-      stamps_ = std::move(stamps);
+    } else if (timed) {
+      stamps_ = index.times_ns;
     } else {
+      const double fps = index.nominal_fps;
       period_ns_ = std::llround(1e9 / (fps > 0 ? fps : kDefaultRateHz));
-      notes_.push_back("The video " + path.filename().string() + " carries no increasing frame times; frames are " +
-                       "taken to be " + format_rate(fps > 0 ? fps : kDefaultRateHz) + " Hz apart (" +
-                       (fps > 0 ? "its nominal rate" : "assumed") + "); give --rate to change it.");
+      notes_.push_back("The video " + name + " carries no increasing frame times; frames are " + "taken to be " +
+                       format_rate(fps > 0 ? fps : kDefaultRateHz) + " Hz apart (" + (fps > 0 ? "its nominal rate" : "assumed") +
+                       "); give --rate to change it.");
+    }
+    // A video cut short (a copy that stopped, a recorder that died) is read as far as it goes.
+    if (index.announced > 0) {
+      notes_.push_back("The video " + name + " ends after " + std::to_string(count_) + " of the " +
+                       std::to_string(index.announced) + " frames its header announces; the rest is missing.");
+    }
+    if (!index.stopped.empty()) {
+      notes_.push_back("The video " + name + " is damaged: " + index.stopped + "; frames after that point are missing.");
     }
   }
   std::size_t size() const override { return count_; }
@@ -81,18 +81,25 @@ class VideoFrames : public FrameSource {
   }
   bool sequential() const override { return true; }
   HostImage decode(std::size_t i) override {
-    if (i + 1 == next_ && last_) return *last_;
+    if (i + 1 == next_) {  // the frame decoded last, asked for again
+      if (last_) return *last_;
+      throw invalid_input(last_error_);
+    }
     if (i != next_) {
       throw runtime_error("video frames must be decoded in order: frame " + std::to_string(i) + " was asked for after frame " +
                           std::to_string(next_) + " of '" + path_.string() + "'");
     }
-    cv::Mat frame;
-    if (!capture_.read(frame) || frame.empty()) {
-      throw invalid_input("video '" + path_.string() + "' ended at frame " + std::to_string(i) + " of the " +
-                          std::to_string(count_) + " it held when opened");
+    if (i >= count_) throw invalid_input("video '" + path_.string() + "' has no frame " + std::to_string(i));
+    ++next_;  // whatever happens to frame i, the next call is for frame i + 1
+    last_.reset();
+    std::string why;
+    std::optional<cv::Mat> frame = file_.frame(i, why);
+    if (!frame) {
+      last_error_ = "frame " + std::to_string(i) + " (t = " + std::to_string(timestamp_ns(i)) + " ns) of video '" +
+                    path_.string() + "' cannot be decoded: " + why;
+      throw invalid_input(last_error_);
     }
-    ++next_;
-    last_ = host_image_from_mat(frame, "frame " + std::to_string(i) + " of video '" + path_.string() + "'");
+    last_ = host_image_from_mat(*frame, "frame " + std::to_string(i) + " of video '" + path_.string() + "'");
     return *last_;
   }
   std::string description() const override {
@@ -101,18 +108,12 @@ class VideoFrames : public FrameSource {
   std::vector<std::string> notes() const override { return notes_; }
 
  private:
-  void open() {
-    capture_.release();
-    if (!capture_.open(path_.string()) || !capture_.isOpened()) {
-      throw invalid_input("cannot open '" + path_.string() + "' as a video (OpenCV VideoCapture)");
-    }
-  }
-
   std::filesystem::path path_;
-  cv::VideoCapture capture_;
+  io_detail::VideoFile file_;
   std::size_t count_ = 0;
   std::size_t next_ = 0;
-  std::optional<HostImage> last_;   // the frame decoded last, which may be asked for again
+  std::optional<HostImage> last_;     // the frame decoded last, which may be asked for again
+  std::string last_error_;            // or why it could not be decoded
   std::vector<std::int64_t> stamps_;  // the container's frame times, when used
   std::int64_t period_ns_ = 0;
   std::vector<std::string> notes_;

@@ -1,18 +1,23 @@
 #include "inertialnet/io/image_io.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
+#include <cstdlib>
 #include <fstream>
 #include <iterator>
 #include <string>
 #include <system_error>
+#include <utility>
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
 #include "inertialnet/runtime/error.hpp"
+#include "inertialnet/runtime/log.hpp"
 #include "io/input_file.hpp"
 #include "io/image_mat.hpp"
+#include "io/third_party_log.hpp"
 
 namespace fs = std::filesystem;
 
@@ -83,10 +88,90 @@ std::string jpeg_truncation(const Bytes& bytes) {
   return "it ends after " + std::to_string(bytes.size()) + " bytes without the end-of-image marker";
 }
 
-std::string truncation(const Bytes& bytes) {
+// CRC-32 as PNG (and zlib) compute it.
+std::uint32_t crc32_of(const unsigned char* data, std::size_t size) {
+  static const auto table = [] {
+    std::array<std::uint32_t, 256> t{};
+    for (std::uint32_t n = 0; n < 256; ++n) {
+      std::uint32_t c = n;
+      for (int k = 0; k < 8; ++k) c = (c & 1) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
+      t[n] = c;
+    }
+    return t;
+  }();
+  std::uint32_t c = 0xFFFFFFFFu;
+  for (std::size_t i = 0; i < size; ++i) c = table[(c ^ data[i]) & 0xFF] ^ (c >> 8);
+  return c ^ 0xFFFFFFFFu;
+}
+
+// PNG chunks carry a CRC-32 of their type and data. libpng checks it too, but prints its
+// complaint ("libpng error: IDAT: CRC error") on stderr itself; checked here, a damaged file is
+// named in our message and libpng never sees it. Empty for a file whose every chunk matches.
+std::string png_corruption(const Bytes& bytes) {
+  std::size_t at = 8;
+  while (at + 12 <= bytes.size()) {  // complete, as png_truncation found
+    const std::size_t length = load_be32(&bytes[at]);
+    const std::string type(reinterpret_cast<const char*>(&bytes[at + 4]), 4);
+    if (crc32_of(&bytes[at + 4], 4 + length) != load_be32(&bytes[at + 8 + length])) {
+      return "its " + type + " chunk at byte " + std::to_string(at) + " does not match its checksum (CRC)";
+    }
+    if (type == "IEND") return {};
+    at += 12 + length;
+  }
+  return {};
+}
+
+bool is_png(const Bytes& bytes) {
   static const unsigned char png_signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
-  if (bytes.size() >= 8 && std::equal(png_signature, png_signature + 8, bytes.begin())) return png_truncation(bytes);
-  if (bytes.size() >= 3 && bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF) return jpeg_truncation(bytes);
+  return bytes.size() >= 8 && std::equal(png_signature, png_signature + 8, bytes.begin());
+}
+
+bool is_jpeg(const Bytes& bytes) { return bytes.size() >= 3 && bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF; }
+
+// Width and height as the header of a PNG (IHDR) or JPEG (its SOF segment) gives them; 0 × 0
+// when the file is neither or the header is not found.
+std::pair<std::uint64_t, std::uint64_t> header_size(const Bytes& bytes) {
+  if (is_png(bytes) && bytes.size() >= 24) return {load_be32(&bytes[16]), load_be32(&bytes[20])};
+  if (!is_jpeg(bytes)) return {0, 0};
+  std::size_t at = 2;
+  while (at + 4 <= bytes.size() && bytes[at] == 0xFF) {
+    const unsigned char marker = bytes[at + 1];
+    const std::size_t length = static_cast<std::size_t>(bytes[at + 2]) << 8 | bytes[at + 3];
+    const bool sof = marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC;
+    if (sof && at + 9 <= bytes.size()) {
+      const std::uint64_t height = static_cast<std::uint64_t>(bytes[at + 5]) << 8 | bytes[at + 6];
+      const std::uint64_t width = static_cast<std::uint64_t>(bytes[at + 7]) << 8 | bytes[at + 8];
+      return {width, height};
+    }
+    if (marker == 0xDA) break;  // the scan starts: no frame header before it
+    at += 2 + length;
+  }
+  return {0, 0};
+}
+
+// OpenCV refuses to decode an image beyond its size limits (a "decompression bomb": a small file
+// whose header announces billions of pixels) with an assertion text; this says it in our words.
+// The limits are OpenCV's defaults unless its environment variables set them.
+std::string size_limit_message(const fs::path& path, const Bytes& bytes) {
+  auto limit = [](const char* variable, const char* fallback) {
+    const char* set = std::getenv(variable);
+    return set && *set ? std::string(set) + " (" + variable + ")" : std::string(fallback);
+  };
+  const auto [width, height] = header_size(bytes);
+  const std::string size = width > 0 && height > 0 ? " is " + std::to_string(width) + " × " + std::to_string(height) +
+                                                         " pixels (" + std::to_string(width * height) + " in all),"
+                                                   : " is";
+  return "The image " + quoted(path) + size + " larger than OpenCV decodes: at most " +
+         limit("OPENCV_IO_MAX_IMAGE_PIXELS", "1073741824 (2^30)") + " pixels in all and " +
+         limit("OPENCV_IO_MAX_IMAGE_WIDTH", "1048576 (2^20)") + " wide, " +
+         limit("OPENCV_IO_MAX_IMAGE_HEIGHT", "1048576 (2^20)") +
+         " high (the environment variables OPENCV_IO_MAX_IMAGE_PIXELS, _WIDTH and _HEIGHT raise these limits if the "
+         "image is genuine).";
+}
+
+std::string truncation(const Bytes& bytes) {
+  if (is_png(bytes)) return png_truncation(bytes);
+  if (is_jpeg(bytes)) return jpeg_truncation(bytes);
   return {};
 }
 
@@ -133,14 +218,23 @@ HostImage load_rgb_image(const fs::path& path) {
   const Bytes bytes = read_whole_file(path);
   const std::string missing = truncation(bytes);
   if (!missing.empty()) throw invalid_input("The image " + quoted(path) + " is truncated: " + missing + ".");
+  if (is_png(bytes)) {
+    const std::string damage = png_corruption(bytes);
+    if (!damage.empty()) throw invalid_input("The image " + quoted(path) + " is corrupt: " + damage + ".");
+  }
 
+  io_detail::route_third_party_logs();
   cv::Mat image;
   try {
     // UNCHANGED keeps 16-bit depth, gray and alpha visible, so each is handled explicitly below.
     image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U, const_cast<unsigned char*>(bytes.data())),
                          cv::IMREAD_UNCHANGED);
   } catch (const cv::Exception& e) {
-    throw invalid_input("The image " + quoted(path) + " cannot be decoded: " + e.what());
+    // OpenCV's text is an assertion with its source path: for -v only, our words for the user.
+    log_message(LogLevel::Debug, "OpenCV on " + quoted(path) + ": " + e.what());
+    if (e.err.find("CV_IO_MAX_IMAGE") != std::string::npos) throw invalid_input(size_limit_message(path, bytes));
+    throw invalid_input("The image " + quoted(path) +
+                        " cannot be decoded: OpenCV's decoder refuses it (its own words are in the debug log, -v).");
   }
   if (image.empty()) {
     throw invalid_input("The image " + quoted(path) +

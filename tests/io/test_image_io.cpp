@@ -12,6 +12,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "inertialnet/runtime/error.hpp"
+#include "inertialnet/io/frame_source.hpp"
 #include "inertialnet/io/image_io.hpp"
 #include "support/testing.hpp"
 
@@ -27,6 +28,16 @@ using it::invalid_input_message;
 std::vector<char> read_bytes(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
   return std::vector<char>((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+// PNG's CRC-32, to make a hand-edited chunk valid again.
+std::uint32_t png_crc(const unsigned char* data, std::size_t size) {
+  std::uint32_t c = 0xFFFFFFFFu;
+  for (std::size_t i = 0; i < size; ++i) {
+    c ^= data[i];
+    for (int k = 0; k < 8; ++k) c = (c & 1) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
+  }
+  return c ^ 0xFFFFFFFFu;
 }
 
 fs::path write_prefix(const fs::path& from, const fs::path& to, std::size_t bytes) {
@@ -174,8 +185,60 @@ TEST_F(ImageIo, MissingUnreadableAndForeignFilesNameTheFile) {
   auto bytes = read_bytes(dir / "n.png");
   for (std::size_t i = 60; i < 160 && i < bytes.size(); ++i) bytes[i] = static_cast<char>(bytes[i] ^ 0x5A);
   std::ofstream(dir / "corrupt.png", std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  // libpng finds the chunk's checksum wrong too, but prints that on stderr itself: the check is
+  // ours, before libpng sees the file.
+  ::testing::internal::CaptureStderr();
   const std::string corrupt = invalid_input_message([&] { load_rgb_image(dir / "corrupt.png"); });
-  EXPECT_TRUE(contains(corrupt, "corrupt.png")) << corrupt;
+  EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
+  EXPECT_TRUE(contains(corrupt, "corrupt.png") && contains(corrupt, "is corrupt: its IDAT chunk at byte") &&
+              contains(corrupt, "checksum"))
+      << corrupt;
+}
+
+// A decompression bomb: a small PNG whose header announces 100000 × 100000 pixels. OpenCV refuses
+// it with an assertion ("pixels <= CV_IO_MAX_IMAGE_PIXELS"); the message names the file, its size
+// and the limit instead.
+TEST_F(ImageIo, DecompressionBombNamesItsSizeAndTheLimit) {
+  ASSERT_TRUE(cv::imwrite((dir / "small.png").string(), pattern_bgr8()));
+  auto bytes = read_bytes(dir / "small.png");
+  ASSERT_GT(bytes.size(), 33u);
+  auto store_be32 = [&](std::size_t at, std::uint32_t v) {
+    for (int k = 0; k < 4; ++k) bytes[at + k] = static_cast<char>(v >> (24 - 8 * k));
+  };
+  store_be32(16, 100000);  // IHDR's width and height
+  store_be32(20, 100000);
+  store_be32(29, png_crc(reinterpret_cast<const unsigned char*>(&bytes[12]), 17));  // its CRC, made right again
+  std::ofstream(dir / "bomb.png", std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  const std::string m = invalid_input_message([&] { load_rgb_image(dir / "bomb.png"); });
+  EXPECT_TRUE(contains(m, "bomb.png") && contains(m, "100000 × 100000 pixels") && contains(m, "1073741824") &&
+              contains(m, "OPENCV_IO_MAX_IMAGE_PIXELS"))
+      << m;
+  EXPECT_FALSE(contains(m, "OpenCV(")) << m;  // no assertion text
+  EXPECT_FALSE(contains(m, "CV_IO_MAX_IMAGE_PIXELS in function")) << m;
+}
+
+// A folder with one corrupt image: that frame is invalid_input naming the file (the pipeline turns
+// it into a decode_error pair), the others decode, and nothing reaches stderr.
+TEST_F(ImageIo, FolderWithACorruptImageReportsThatFrameOnly) {
+  const fs::path folder = dir / "frames";
+  fs::create_directories(folder);
+  cv::Mat noise(32, 32, CV_8UC3);
+  for (int k = 0; k < 3; ++k) {
+    cv::randu(noise, 0, 255);
+    ASSERT_TRUE(cv::imwrite((folder / ("frame" + std::to_string(k) + ".png")).string(), noise));
+  }
+  auto bytes = read_bytes(folder / "frame1.png");
+  for (std::size_t i = 60; i < 160; ++i) bytes[i] = static_cast<char>(bytes[i] ^ 0x5A);
+  std::ofstream(folder / "frame1.png", std::ios::binary | std::ios::trunc)
+      .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  auto source = open_frame_source(folder);
+  ASSERT_EQ(source->size(), 3u);
+  ::testing::internal::CaptureStderr();
+  EXPECT_EQ(source->decode(0).width, 32);
+  const std::string m = invalid_input_message([&] { source->decode(1); });
+  EXPECT_EQ(source->decode(2).width, 32);
+  EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
+  EXPECT_TRUE(contains(m, (folder / "frame1.png").string()) && contains(m, "is corrupt")) << m;
 }
 
 TEST_F(ImageIo, FloatImagesAreRefused) {

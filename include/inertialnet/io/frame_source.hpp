@@ -23,6 +23,10 @@ class FrameSource {
   // Decodes frame `index`. Thread-safe unless sequential() is true, in which case frames must
   // be asked for in order 0, 1, 2, … from one thread (a video decoder cannot seek cheaply); the
   // frame decoded last may be asked for again (a caller may look at frame 0 to learn the size).
+  // A frame that cannot be decoded (a corrupt image file, a damaged video frame) throws
+  // invalid_input naming the file (or the video, the frame and its time) and why; the source
+  // stays usable: the next frame may be asked for after it (asked again, it throws again).
+  // size() and timestamp_ns() count such frames like any other.
   virtual HostImage decode(std::size_t index) = 0;
   virtual bool sequential() const { return false; }
   // Camera calibration when the source has one (EuRoC's sensor.yaml).
@@ -35,10 +39,12 @@ class FrameSource {
 
 // Opens `path`: a EuRoC folder (mav0/cam0/data.csv), a folder of images (sorted by name;
 // timestamps from `rate_hz` when given, else from the names when they are nanosecond stamps,
-// else 20 Hz), or a video file (timestamps from `rate_hz` when given, else the container's own
-// frame times (CAP_PROP_POS_MSEC, read in one pass over the video when it is opened) when they
-// increase, else its nominal frame rate). notes() says which was used when it was not the
-// sequence's own stamps. Fewer than two frames, an empty or unreadable source are invalid_input.
+// else 20 Hz), or a video file read with FFmpeg (timestamps from `rate_hz` when given, else the
+// presentation timestamps of its frames, read in one pass over the container when it is opened,
+// when they increase, else its nominal frame rate; never renumbered: docs/data_conventions.md).
+// notes() says which was used when it was not the sequence's own stamps, and that a video ends
+// before the frame count its header announces. Fewer than two frames, an empty or unreadable
+// source are invalid_input.
 std::unique_ptr<FrameSource> open_frame_source(const std::filesystem::path& path,
                                                std::optional<double> rate_hz = std::nullopt);
 
