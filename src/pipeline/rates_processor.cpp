@@ -37,7 +37,10 @@ class RatesProcessor : public PairProcessor {
     // Frames that cannot be measured answer the pair for every estimator, before any flow.
     if (!previous.error.empty() || !current.error.empty()) {
       const Frame& bad = previous.error.empty() ? current : previous;
-      return unanswered(result, PairStatus::DecodeError, frame_name(bad) + " could not be decoded: " + bad.error);
+      // The source's message names the file, or the video and the frame; say which frame it was.
+      const std::string name = frame_name(bad);
+      return unanswered(result, PairStatus::DecodeError,
+                        bad.error.find(name) != std::string::npos ? bad.error : name + ": " + bad.error);
     }
     if (const std::string mismatch = size_mismatch(previous, current); !mismatch.empty()) {
       return unanswered(result, PairStatus::DecodeError, mismatch);
