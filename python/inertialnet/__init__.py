@@ -10,13 +10,14 @@ OpenCV's order), ``(H, W, 4)`` with alpha dropped, or batches ``(N, H, W, C)``. 
 ``(H, W, 2)``: u (right) and v (down) in pixels. Rates are float64 rad/s.
 
 Errors keep the library's messages: bad input raises ``ValueError``, a failure of the device or
-driver ``RuntimeError``.
+driver ``RuntimeError``. Ctrl-C stops every long call
+(``predict``, networks and DIS flow on batches) within a pair or a layer: ``KeyboardInterrupt``.
 """
 
 from __future__ import annotations
 
 import os
-from typing import Iterable, Optional, Sequence as _Seq, Union
+from typing import Callable, Iterable, Optional, Sequence as _Seq, Union
 
 import numpy as np
 
@@ -161,6 +162,7 @@ def predict(
     decode_threads: int = 2,
     keep_flow: bool = False,
     flow_check: float = 0.5,
+    progress: Optional[Callable[[int, int], object]] = None,
 ):
     """Angular rates of every frame pair of a sequence, as ``inertialnet predict`` computes them.
 
@@ -171,13 +173,18 @@ def predict(
     arguments are the CLI's options: without weights, DIS flow and the geometric head;
     ``flow_check`` is ``--flow-check`` (the DIS forward-backward check for the geometric head,
     pixels at 752 columns; 0: off). With ``keep_flow=True`` returns ``(rates, flows)``, flows a
-    list of ``(H, W, 2)`` arrays (as computed, without the check's marks)."""
+    list of ``(H, W, 2)`` arrays (as computed, without the check's marks).
+
+    ``progress(done, total)``, if given, is called on the calling thread as pairs complete (at
+    most every 50 ms, and once at the end): ``done`` pairs of ``total``. An exception it raises
+    stops the run and propagates. Ctrl-C stops the run within a pair or two and raises
+    ``KeyboardInterrupt``; the pairs computed so far are dropped."""
     if isinstance(weights, (str, os.PathLike)):
         weights = [weights]
     columns, t_ns, values, flows, statuses = _native._predict(
         os.fspath(sequence), [os.fspath(w) for w in weights], model or "", flow or "", head or "", solver,
-        float(fx), float(fy), float(cx), float(cy), float(rate_hz), device or "", keep_flow, int(max_pairs),
-        int(lanes), int(decode_threads), float(flow_check))
+        float(fx), float(fy), float(cx), float(cy), float(rate_hz), device or "",
+        keep_flow, int(max_pairs), int(lanes), int(decode_threads), float(flow_check), progress)
     # Fields as in the rates CSV: wx,wy,wz,status then wx_geometric,…,status_geometric.
     dtype = [("timestamp_ns", np.int64)]
     status_fields = []

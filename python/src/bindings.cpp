@@ -4,18 +4,26 @@
 //
 // Conventions: images are NumPy uint8 (or uint16) arrays (H, W) gray, (H, W, C) with C = 1, 3 or 4
 // (alpha dropped), or batches (N, H, W, C); flow is float32 (H, W, 2) (u, v in pixels) or
-// (N, H, W, 2); rates are float64 (3,) in rad/s. Device work runs without the GIL. Library errors
-// keep their messages: invalid input becomes ValueError, runtime failures RuntimeError.
+// (N, H, W, 2); rates are float64 (3,) in rad/s. Device work runs without the GIL, and every long
+// call on a worker thread that Ctrl-C stops (run_interruptibly). Library errors keep their
+// messages: invalid input becomes ValueError, runtime failures RuntimeError.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
 #include <cstdint>
+#include <exception>
+#include <functional>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "inertialnet/inertialnet.hpp"
@@ -24,6 +32,63 @@ namespace py = pybind11;
 using namespace inertialnet;
 
 namespace {
+
+// --- long calls --------------------------------------------------------------------------------
+
+// Runs `work` on a worker thread while the calling thread waits without the GIL, waking every
+// 50 ms to take it for a moment: Python's signal handlers run (PyErr_CheckSignals, which Ctrl-C's
+// KeyboardInterrupt comes from; it does nothing outside the main thread), then `poll` (a progress
+// callback), and `poll` once more when the work is done. When either raises, `stop` is set and the
+// worker is waited for (the pipeline checks it between pairs, the networks between layers), and
+// the Python exception propagates instead of the work's result or error. Without this the calling
+// thread sits in the library until the whole call is over and a Ctrl-C waits for it (hours of
+// FlowNet2 pairs). `work` runs without the GIL and must not touch Python objects.
+void run_interruptibly(const std::function<void(const std::atomic<bool>& stop)>& work,
+                       const std::function<void()>& poll = {}) {
+  std::atomic<bool> stop{false};
+  std::mutex mutex;
+  std::condition_variable finished;
+  bool done = false;
+  std::exception_ptr failure;
+  std::thread worker([&] {
+    try {
+      work(stop);
+    } catch (...) {
+      failure = std::current_exception();
+    }
+    const std::lock_guard<std::mutex> lock(mutex);
+    done = true;
+    finished.notify_all();
+  });
+  std::exception_ptr raised;  // from Python: the signal handler or `poll`
+  const auto check = [&](bool signals) {
+    try {
+      if (signals && PyErr_CheckSignals() != 0) throw py::error_already_set();
+      if (poll) poll();
+    } catch (...) {
+      raised = std::current_exception();
+      stop = true;
+    }
+  };
+  for (;;) {
+    {
+      py::gil_scoped_release release;
+      std::unique_lock<std::mutex> lock(mutex);
+      if (finished.wait_for(lock, std::chrono::milliseconds(50), [&] { return done; })) break;
+    }
+    if (!raised) check(true);
+  }
+  worker.join();
+  if (raised) std::rethrow_exception(raised);
+  if (failure) std::rethrow_exception(failure);
+  check(false);  // the last progress report
+  if (raised) std::rethrow_exception(raised);
+}
+
+// --- arguments ---------------------------------------------------------------------------------
+
+// "float", "NoneType", … for messages about an argument of the wrong type.
+std::string type_name(const py::handle& value) { return py::str(py::type::handle_of(value).attr("__name__")); }
 
 // --- arrays ------------------------------------------------------------------------------------
 
@@ -212,8 +277,7 @@ class PyFlowNet {
     const auto n = static_cast<std::int64_t>(a.size());
     const int w = a.front().width, h = a.front().height;
     std::vector<float> result;
-    {
-      py::gil_scoped_release release;
+    run_interruptibly([&](const std::atomic<bool>& stop) {
       std::vector<float> f1, f2;
       for (std::size_t i = 0; i < a.size(); ++i) {
         f1.insert(f1.end(), a[i].data.begin(), a[i].data.end());
@@ -223,8 +287,8 @@ class PyFlowNet {
       const Shape shape{n, 3, h, w};
       const Tensor frame1 = Tensor::from_host(queue, shape, f1);
       const Tensor frame2 = Tensor::from_host(queue, shape, f2);
-      result = net_->compute(queue, frame1, frame2).to_host(queue);
-    }
+      result = net_->compute(queue, frame1, frame2, &stop).to_host(queue);
+    });
     // [N, 2, H, W] planes to (N, H, W, 2).
     py::array_t<float> out(batch ? std::vector<py::ssize_t>{n, h, w, 2} : std::vector<py::ssize_t>{h, w, 2});
     float* p = out.mutable_data();
@@ -255,14 +319,13 @@ py::array_t<float> dis_flow(const py::array& first, const py::array& second, con
   const auto b = images_of(second, order, "img2");
   if (a.size() != b.size()) throw invalid_input("img1 and img2 hold different numbers of images.");
   std::vector<FlowField> flows;
-  {
-    py::gil_scoped_release release;
+  run_interruptibly([&](const std::atomic<bool>& stop) {
     DisFlow dis;
-    for (std::size_t i = 0; i < a.size(); ++i) {
+    for (std::size_t i = 0; i < a.size() && !stop; ++i) {
       flows.push_back(dis.compute(a[i], b[i]));
       dis.check(flows.back(), a[i], b[i], flow_check);
     }
-  }
+  });
   if (first.ndim() != 4) return flow_to_array(flows.front());
   const auto n = static_cast<py::ssize_t>(flows.size());
   py::array_t<float> out({n, static_cast<py::ssize_t>(flows[0].height), static_cast<py::ssize_t>(flows[0].width),
@@ -310,17 +373,16 @@ class PyGeometricHead {
     const FlowField flow = flow_from_array(flow_array);
     const auto r = mat3_of(camera_to_body);
     Vec3 w;
-    {
-      py::gil_scoped_release release;
+    run_interruptibly([&](const std::atomic<bool>& stop) {
       if (!head_ || !same_camera(head_->camera(), camera)) head_ = std::make_unique<GeometricHead>(*device_, camera, options_);
       // The same upload as the pipeline's: the flow as a [1, 2, H, W] tensor.
       Queue& queue = device_->queue();
       std::vector<float> planes(flow.u);
       planes.insert(planes.end(), flow.v.begin(), flow.v.end());
       const Tensor tensor = Tensor::from_host(queue, {1, 2, flow.height, flow.width}, planes);
-      w = head_->estimate(queue, tensor, dt).omega;
+      w = head_->estimate(queue, tensor, dt, &stop).omega;
       if (r) w = mul(*r, w);
-    }
+    });
     return vec3_array(w);
   }
 
@@ -363,12 +425,11 @@ class PyInertialNetHead {
       }
     }
     std::vector<float> omega;
-    {
-      py::gil_scoped_release release;
+    run_interruptibly([&](const std::atomic<bool>& stop) {
       Queue& queue = device_->queue();
       const Tensor flow = Tensor::from_host(queue, {n, 2, h, w}, planar);
-      omega = head_->compute(queue, flow).to_host(queue);
-    }
+      omega = head_->compute(queue, flow, &stop).to_host(queue);
+    });
     py::array_t<double> out(batch ? std::vector<py::ssize_t>{n, 3} : std::vector<py::ssize_t>{3});
     std::copy(omega.begin(), omega.end(), out.mutable_data());
     return out;
@@ -428,23 +489,54 @@ class PySequence {
   std::unique_ptr<FrameSource> source_;
 };
 
+// predict()'s progress callback, progress(done, total), called on the calling thread between
+// the waits of run_interruptibly: once the total is known, then whenever more pairs are done.
+class ProgressReport {
+ public:
+  explicit ProgressReport(py::object callback) : callback_(std::move(callback)) {}
+  // From the worker.
+  void start(std::size_t total) {
+    total_ = total;
+    started_ = true;
+  }
+  void pair_done() { ++done_; }
+  // With the GIL.
+  void report() {
+    if (callback_.is_none() || !started_) return;
+    const std::size_t done = done_;
+    if (reported_ == done) return;
+    reported_ = done;
+    callback_(done, total_.load());
+  }
+
+ private:
+  py::object callback_;
+  std::atomic<bool> started_{false};
+  std::atomic<std::size_t> total_{0};
+  std::atomic<std::size_t> done_{0};
+  std::optional<std::size_t> reported_;
+};
+
 // The rows of predict(): the column names, the timestamps, the values (rows × columns; NaN where
 // a pair has no answer), with keep_flow each pair's flow, and the status words (rows × estimators).
 // The Python side makes the structured array.
-py::tuple predict(const PredictSettings& settings, std::size_t max_pairs, int lanes, int decode_threads) {
+py::tuple predict(const PredictSettings& settings, std::size_t max_pairs, int lanes, int decode_threads,
+                  const py::object& progress) {
   std::vector<std::int64_t> t_ns;
   std::vector<double> values;
   std::vector<FlowField> flows;
   std::vector<std::string> columns;
   std::vector<std::string> statuses;
-  {
-    py::gil_scoped_release release;
+  ProgressReport report(progress);
+  run_interruptibly([&](const std::atomic<bool>& stop) {
     Prediction prediction(settings);
     columns = prediction.columns();
     PipelineOptions options;
     options.lanes_per_device = lanes;
     options.decode_threads = decode_threads;
     options.max_pairs = max_pairs;
+    options.cancel = &stop;
+    report.start(prediction.pairs(max_pairs));
     prediction.run(
         [&](const PairResult& r) {
           t_ns.push_back(r.t1_ns);
@@ -453,9 +545,10 @@ py::tuple predict(const PredictSettings& settings, std::size_t max_pairs, int la
             statuses.emplace_back(to_string(answer.status));
           }
           if (r.flow) flows.push_back(*r.flow);
+          report.pair_done();
         },
         options);
-  }
+  }, [&] { report.report(); });
   py::array_t<std::int64_t> t(static_cast<py::ssize_t>(t_ns.size()));
   std::copy(t_ns.begin(), t_ns.end(), t.mutable_data());
   py::array_t<double> v({static_cast<py::ssize_t>(t_ns.size()), static_cast<py::ssize_t>(columns.size())});
@@ -602,7 +695,11 @@ PYBIND11_MODULE(_inertialnet, m) {
         [](const std::filesystem::path& sequence, const std::vector<std::string>& weights, const std::string& model,
            const std::string& flow, const std::string& head, const std::string& solver, double fx, double fy, double cx,
            double cy, double rate_hz, const std::string& device, bool keep_flow, std::size_t max_pairs, int lanes,
-           int decode_threads, double flow_check) {
+           int decode_threads, double flow_check, const py::object& progress) {
+          if (!progress.is_none() && !PyCallable_Check(progress.ptr())) {
+            throw py::type_error("progress must be a callable taking (done, total), or None, not " +
+                                 type_name(progress));
+          }
           PredictSettings s;
           s.sequence = sequence;
           s.weights = weights;
@@ -619,7 +716,7 @@ PYBIND11_MODULE(_inertialnet, m) {
           s.keep_flow = keep_flow;
           s.flow_check_px = flow_check;
           if (lanes < 1 || decode_threads < 1) throw invalid_input("lanes and decode_threads must be at least 1");
-          return predict(s, max_pairs, lanes, decode_threads);
+          return predict(s, max_pairs, lanes, decode_threads, progress);
         });
   m.def("_evaluate_json", &evaluate_json);
   m.def("_write_rates_csv",
