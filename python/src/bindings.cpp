@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <cstdint>
 #include <exception>
@@ -89,6 +90,10 @@ void run_interruptibly(const std::function<void(const std::atomic<bool>& stop)>&
 
 // "float", "NoneType", … for messages about an argument of the wrong type.
 std::string type_name(const py::handle& value) { return py::str(py::type::handle_of(value).attr("__name__")); }
+
+// The CLI's wording for a number the user gave: "must be …, got -5" with the value as Python
+// prints it, so 1e-12 stays 1e-12.
+std::string got(double value) { return std::string(py::str(py::float_(value))); }
 
 // --- arrays ------------------------------------------------------------------------------------
 
@@ -346,12 +351,36 @@ py::array_t<double> vec3_array(const Vec3& w) {
   return out;
 }
 
+// camera_to_body: a rotation, or the rates come out scaled, mirrored or NaN without a word (2·I
+// doubled them, zeros zeroed them). The check is the one sensor.yaml's T_BS passes
+// (src/io/yaml_util.cpp, check_rigid): rows orthonormal within 1e-3, so that any matrix
+// Sequence.camera_to_body returns is accepted back, and a positive determinant (no mirror image).
+// Written as "not within" so that NaN fails.
 std::optional<Mat3> mat3_of(const py::object& m) {
   if (m.is_none()) return std::nullopt;
   const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(m);
-  if (!a || a.size() != 9) throw invalid_input("camera_to_body must be a 3x3 rotation matrix.");
+  if (!a || a.ndim() != 2 || a.shape(0) != 3 || a.shape(1) != 3) {
+    throw invalid_input("camera_to_body must be a 3x3 rotation matrix (camera to body frame), got " +
+                        (a ? "an array of shape " + std::string(py::str(a.attr("shape")))
+                           : "a " + type_name(m)) + ".");
+  }
   Mat3 r;
   std::copy(a.data(), a.data() + 9, r.begin());
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      double dot = 0;
+      for (int k = 0; k < 3; ++k) dot += r[3 * i + k] * r[3 * j + k];
+      if (!(std::abs(dot - (i == j ? 1.0 : 0.0)) <= 1e-3)) {
+        throw invalid_input("camera_to_body is not a rotation matrix: its rows are not orthonormal within 1e-3 "
+                            "(row " + std::to_string(i) + " · row " + std::to_string(j) + " = " + got(dot) + ").");
+      }
+    }
+  }
+  const double det = r[0] * (r[4] * r[8] - r[5] * r[7]) - r[1] * (r[3] * r[8] - r[5] * r[6]) +
+                     r[2] * (r[3] * r[7] - r[4] * r[6]);
+  if (!(det > 0)) {
+    throw invalid_input("camera_to_body is a reflection (determinant " + got(det) + "), not a rotation.");
+  }
   return r;
 }
 
@@ -420,8 +449,19 @@ class PyInertialNetHead {
     const float* p = a.data();
     for (std::size_t k = 0; k < static_cast<std::size_t>(n); ++k) {
       for (std::size_t i = 0; i < plane; ++i) {
-        planar[2 * k * plane + i] = p[2 * (k * plane + i)];
-        planar[(2 * k + 1) * plane + i] = p[2 * (k * plane + i) + 1];
+        const float u = p[2 * (k * plane + i)], v = p[2 * (k * plane + i) + 1];
+        // The network has no notion of unknown flow: NaN, ±inf or a marker above 1e9 would come
+        // out as NaN or wild rates without a word.
+        if (is_unknown_flow(u, v)) {
+          const std::string at = (batch ? std::to_string(k) + ", " : std::string()) + std::to_string(i / w) + ", " +
+                                 std::to_string(i % w);
+          throw invalid_input("flow[" + at + "] = (" + got(u) + ", " + got(v) +
+                              ") is not a finite flow vector: the learned head needs a known flow at every pixel "
+                              "(NaN, infinity and the unknown-flow marks above 1e9 of dis_flow(flow_check=…) "
+                              "and KITTI files are refused).");
+        }
+        planar[2 * k * plane + i] = u;
+        planar[(2 * k + 1) * plane + i] = v;
       }
     }
     std::vector<float> omega;
@@ -672,7 +712,10 @@ PYBIND11_MODULE(_inertialnet, m) {
       .def("rates", &PyGeometricHead::rates, py::arg("flow"), py::arg("camera"), py::arg("dt"),
            py::arg("camera_to_body") = py::none(),
            "ω (rad/s, (3,)) from the flow (H, W, 2) of a frame pair dt seconds apart; camera frame, or the body "
-           "frame with camera_to_body (3x3).");
+           "frame with camera_to_body (a 3x3 rotation matrix: orthonormal rows within 1e-3, determinant +1; "
+           "anything else is a ValueError). Flow vectors that are NaN, infinite or above 1e9 in magnitude are "
+           "unknown flow (the marks of dis_flow(flow_check=…) and KITTI files) and left out, like vectors that "
+           "leave the image.");
 
   py::class_<PyInertialNetHead>(m, "_InertialNetHead")
       .def(py::init<const py::object&, const py::object&>(), py::arg("weights"), py::arg("device") = py::none())

@@ -1,0 +1,75 @@
+"""Bad arguments get readable Python errors, as the CLI's checks would give them: a matrix that is
+no rotation, a flow the learned head cannot read. None of them is ignored."""
+import numpy as np
+import pytest
+
+import inertialnet
+
+
+@pytest.fixture(scope="module")
+def pair(sequence):
+    seq = inertialnet.Sequence(sequence)
+    return seq, inertialnet.dis_flow(seq[0], seq[1])
+
+
+@pytest.mark.parametrize("matrix, message", [
+    (np.full((3, 3), np.nan), "not orthonormal"),    # NaN rates before
+    (np.zeros((3, 3)), "not orthonormal"),           # zero rates
+    (2 * np.eye(3), "not orthonormal"),              # doubled rates
+    (np.diag([1.0, 1.0, -1.0]), "reflection"),       # a mirror image: one axis turned round
+    (np.eye(4), r"shape \(4, 4\)"),
+    (np.eye(3).ravel(), r"shape \(9,\)"),
+])
+def test_camera_to_body_must_be_a_rotation(pair, matrix, message):
+    seq, flow = pair
+    head = inertialnet.GeometricHead()
+    with pytest.raises(ValueError, match="camera_to_body .*" + message):
+        head.rates(flow, seq.camera, 0.05, camera_to_body=matrix)
+
+
+def test_camera_to_body_accepts_rotations(pair):
+    seq, flow = pair
+    head = inertialnet.GeometricHead()
+    camera = head.rates(flow, seq.camera, 0.05)
+    # The sequence's own calibration, and a rotation written to 6 decimals (as calibration files
+    # hold them): the check's tolerance is the one sensor.yaml's T_BS passes.
+    c, s = np.cos(0.3), np.sin(0.3)
+    rounded = np.round(np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]), 6)
+    np.testing.assert_allclose(head.rates(flow, seq.camera, 0.05, camera_to_body=rounded), rounded @ camera)
+    assert np.isfinite(head.rates(flow, seq.camera, 0.05, camera_to_body=seq.camera_to_body)).all()
+
+
+def test_geometric_head_leaves_out_nan_flow_vectors_as_unknown(pair):
+    # NaN, infinity and values above 1e9 are the library's "unknown flow" (flow_io.hpp): the
+    # geometric head skips such vectors, as it skips dis_flow's flow_check marks. Documented, not
+    # an error.
+    seq, flow = pair
+    head = inertialnet.GeometricHead()
+    marked, nan, inf = flow.copy(), flow.copy(), flow.copy()
+    marked[40, 60] = 1e10
+    nan[40, 60, 0] = np.nan
+    inf[40, 60, 1] = np.inf
+    expected = head.rates(marked, seq.camera, 0.05)
+    assert np.isfinite(expected).all()
+    np.testing.assert_array_equal(head.rates(nan, seq.camera, 0.05), expected)
+    np.testing.assert_array_equal(head.rates(inf, seq.camera, 0.05), expected)
+
+
+@pytest.fixture(scope="module")
+def learned_head(cli, tmp_path_factory):
+    weights = tmp_path_factory.mktemp("head") / "head.safetensors"
+    cli("weights", "--synthetic", "InertialNetHead", "--size", "128x96", "-o", weights)
+    return inertialnet.InertialNetHead.load(weights)
+
+
+@pytest.mark.parametrize("value", [np.nan, np.inf, -np.inf, 1e10])
+def test_learned_head_refuses_non_finite_flow_naming_the_index(pair, learned_head, value):
+    _, flow = pair
+    bad = flow.copy()
+    bad[17, 42, 1] = value
+    with pytest.raises(ValueError, match=r"flow\[17, 42\] = .* not a finite flow vector"):
+        learned_head.rates(bad)
+    batch = np.stack([flow, flow, bad])
+    with pytest.raises(ValueError, match=r"flow\[2, 17, 42\]"):
+        learned_head.rates(batch)
+    assert np.isfinite(learned_head.rates(flow)).all()
