@@ -159,7 +159,7 @@ def predict(
     cx: float = 0.0,
     cy: float = 0.0,
     rate_hz: float = 0.0,
-    device: Optional[str] = None,
+    device: Union[None, str, int] = None,
     max_pairs: int = 0,
     lanes: int = 2,
     decode_threads: int = 2,
@@ -178,6 +178,10 @@ def predict(
     pixels at 752 columns; 0: off). With ``keep_flow=True`` returns ``(rates, flows)``, flows a
     list of ``(H, W, 2)`` arrays (as computed, without the check's marks).
 
+    ``rate_hz``, ``fx`` and ``fy`` are 0 (not given) or what the CLI accepts for ``--rate``,
+    ``--fx``, ``--fy`` (finite, positive, at most 1e6); ``max_pairs`` is 0 (all) or a count:
+    anything else is a ``ValueError``.
+
     ``progress(done, total)``, if given, is called on the calling thread as pairs complete (at
     most every 50 ms, and once at the end): ``done`` pairs of ``total``. An exception it raises
     stops the run and propagates. Ctrl-C stops the run within a pair or two and raises
@@ -186,8 +190,8 @@ def predict(
         weights = [weights]
     columns, t_ns, values, flows, statuses = _native._predict(
         os.fspath(sequence), [os.fspath(w) for w in weights], model or "", flow or "", head or "", solver,
-        float(fx), float(fy), float(cx), float(cy), float(rate_hz), device or "",
-        keep_flow, int(max_pairs), int(lanes), int(decode_threads), float(flow_check), progress)
+        float(fx), float(fy), float(cx), float(cy), float(rate_hz), "" if device is None else str(device),
+        keep_flow, max_pairs, int(lanes), int(decode_threads), float(flow_check), progress)
     # Fields as in the rates CSV: wx,wy,wz,status then wx_geometric,…,status_geometric.
     dtype = [("timestamp_ns", np.int64)]
     status_fields = []

@@ -91,9 +91,55 @@ void run_interruptibly(const std::function<void(const std::atomic<bool>& stop)>&
 // "float", "NoneType", … for messages about an argument of the wrong type.
 std::string type_name(const py::handle& value) { return py::str(py::type::handle_of(value).attr("__name__")); }
 
+// Counts and indices are taken as Python objects and converted here: pybind11's own conversion to
+// an unsigned type answers a negative number with a TypeError listing the function's overloads;
+// the callers say what the number must be instead.
+
+// Any Python integer (numpy's too, through __index__); TypeError naming `name` for anything else.
+py::int_ index_of(const py::handle& value, const char* name) {
+  py::object index = py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr()));
+  if (!index) {
+    PyErr_Clear();
+    throw py::type_error(std::string(name) + " must be an integer, not " +
+                         type_name(value));
+  }
+  return py::reinterpret_borrow<py::int_>(index);
+}
+
+// The same as a signed 64-bit number; ValueError beyond.
+std::int64_t integer_of(const py::handle& value, const char* name) {
+  const py::int_ index = index_of(value, name);
+  int overflow = 0;
+  const long long n = PyLong_AsLongLongAndOverflow(index.ptr(), &overflow);
+  if (overflow != 0) {
+    throw invalid_input(std::string(name) + " must be a number within ±9.2e18, got " + std::string(py::str(index)));
+  }
+  return n;
+}
+
 // The CLI's wording for a number the user gave: "must be …, got -5" with the value as Python
 // prints it, so 1e-12 stays 1e-12.
 std::string got(double value) { return std::string(py::str(py::float_(value))); }
+
+// rate_hz, fx, fy: 0 means "not given" (the source's frame times, the calibration's focal
+// length), anything else must pass the CLI's check of --rate, --fx, --fy (a finite positive
+// number up to 1e6). Without it a negative or NaN value was silently taken as "not given".
+double zero_or_positive(double value, const char* name, const char* unit, const char* zero_means) {
+  if (value == 0) return value;
+  if (!std::isfinite(value) || !(value > 0)) {
+    throw invalid_input(std::string(name) + " must be a finite positive number (" + unit + "), or 0 for " +
+                        zero_means + "; got " + got(value));
+  }
+  if (value > 1e6) throw invalid_input(std::string(name) + " must be at most 1e+06 " + unit + ", got " + got(value));
+  return value;
+}
+
+// The frame rate of Sequence and predict: 0 takes the frame times from the source, as --rate
+// left out does.
+std::optional<double> rate_of(double rate_hz) {
+  if (zero_or_positive(rate_hz, "rate_hz", "Hz", "the source's frame times") == 0) return std::nullopt;
+  return rate_hz;
+}
 
 // --- arrays ------------------------------------------------------------------------------------
 
@@ -494,19 +540,27 @@ class PyInertialNetHead {
 class PySequence {
  public:
   PySequence(const std::filesystem::path& path, double rate_hz)
-      : source_(open_frame_source(path, rate_hz > 0 ? std::optional<double>(rate_hz) : std::nullopt)) {}
+      : source_(open_frame_source(path, rate_of(rate_hz))) {}
   std::size_t size() const { return source_->size(); }
   py::array_t<std::int64_t> timestamps() const {
     py::array_t<std::int64_t> out(static_cast<py::ssize_t>(source_->size()));
     for (std::size_t i = 0; i < source_->size(); ++i) out.mutable_data()[i] = source_->timestamp_ns(i);
     return out;
   }
-  py::array_t<std::uint8_t> frame(std::size_t index) {
-    if (index >= source_->size()) throw py::index_error("frame " + std::to_string(index) + " of " + std::to_string(size()));
+  // Python's indexing: seq[-1] is the last frame.
+  py::array_t<std::uint8_t> frame(const py::object& index_object) {
+    const std::int64_t count = static_cast<std::int64_t>(size());
+    const std::int64_t given = integer_of(index_object, "a frame index");
+    const std::int64_t index = given < 0 ? given + count : given;
+    if (index < 0 || index >= count) {
+      throw py::index_error("frame " + std::to_string(given) + " is out of range: the sequence has " +
+                            std::to_string(count) + " frames (indices 0 to " + std::to_string(count - 1) + ", or -" +
+                            std::to_string(count) + " to -1 from the end)");
+    }
     HostImage image;
     {
       py::gil_scoped_release release;
-      image = source_->decode(index);
+      image = source_->decode(static_cast<std::size_t>(index));
     }
     return to_uint8_rgb(image);
   }
@@ -650,7 +704,17 @@ PYBIND11_MODULE(_inertialnet, m) {
   }, py::arg("spec") = "", "The devices a --device spec selects (\"\": $INERTIALNET_DEVICE, else the default).");
 
   py::class_<PyDevice>(m, "Device", "An opened OpenCL device, chosen by a --device spec string.")
-      .def(py::init<const std::string&>(), py::arg("spec") = "")
+      .def(py::init([](const py::object& spec) {
+             // An int is a device index, as the spec "3": Device(-1) gets the library's message for
+             // "-1" instead of pybind11's list of overloads.
+             if (py::isinstance<py::str>(spec)) return PyDevice(spec.cast<std::string>());
+             if (py::isinstance<py::bool_>(spec) || !PyIndex_Check(spec.ptr())) {
+               throw py::type_error("a device spec is a string (\"0\", \"cpu\", \"pocl\", …) or a device index, not " +
+                                    type_name(spec));
+             }
+             return PyDevice(std::to_string(integer_of(spec, "a device index")));
+           }),
+           py::arg("spec") = "")
       .def_property_readonly("name", [](const PyDevice& d) { return d.device->info().name; })
       .def_property_readonly("info", [](const PyDevice& d) { return device_dict(d.device->info()); })
       .def("__repr__", [](const PyDevice& d) { return "<inertialnet.Device " + d.device->info().name + ">"; });
@@ -737,8 +801,15 @@ PYBIND11_MODULE(_inertialnet, m) {
   m.def("_predict",
         [](const std::filesystem::path& sequence, const std::vector<std::string>& weights, const std::string& model,
            const std::string& flow, const std::string& head, const std::string& solver, double fx, double fy, double cx,
-           double cy, double rate_hz, const std::string& device, bool keep_flow, std::size_t max_pairs, int lanes,
+           double cy, double rate_hz, const std::string& device, bool keep_flow, const py::object& max_pairs, int lanes,
            int decode_threads, double flow_check, const py::object& progress) {
+          // The CLI's checks of --max-pairs, --rate, --fx, --fy: a value they refuse is a ValueError
+          // here, not ignored (a negative rate or focal length was taken as "not given").
+          const std::int64_t pairs = integer_of(max_pairs, "max_pairs");
+          if (pairs < 0) throw invalid_input("max_pairs must be a count of pairs (0 for all), got " + std::to_string(pairs));
+          rate_of(rate_hz);
+          zero_or_positive(fx, "fx", "pixels", "the calibration's focal length");
+          zero_or_positive(fy, "fy", "pixels", "fx");
           if (!progress.is_none() && !PyCallable_Check(progress.ptr())) {
             throw py::type_error("progress must be a callable taking (done, total), or None, not " +
                                  type_name(progress));
@@ -759,7 +830,7 @@ PYBIND11_MODULE(_inertialnet, m) {
           s.keep_flow = keep_flow;
           s.flow_check_px = flow_check;
           if (lanes < 1 || decode_threads < 1) throw invalid_input("lanes and decode_threads must be at least 1");
-          return predict(s, max_pairs, lanes, decode_threads, progress);
+          return predict(s, static_cast<std::size_t>(pairs), lanes, decode_threads, progress);
         });
   m.def("_evaluate_json", &evaluate_json);
   m.def("_write_rates_csv",
@@ -817,12 +888,16 @@ PYBIND11_MODULE(_inertialnet, m) {
         py::arg("path"), py::arg("flow"), py::arg("max_magnitude") = 0.0f, "flow_to_color() saved as a PNG.");
 
   m.def("synth",
-        [](const std::filesystem::path& out, int frames, const std::string& motion, std::uint64_t seed, int width,
+        [](const std::filesystem::path& out, int frames, const std::string& motion, const py::object& seed, int width,
            int height, bool noise, bool overwrite) {
           SynthOptions o;
           o.frames = frames;
           o.motion = parse_synth_motion(motion);
-          o.seed = seed;
+          // A seed is any number from 0 up; pybind11 would answer a negative one with its overloads.
+          const py::int_ given_seed = index_of(seed, "seed");
+          if (given_seed < py::int_(0)) throw invalid_input("seed must be 0 or more, got " + std::string(py::str(given_seed)));
+          o.seed = PyLong_AsUnsignedLongLong(given_seed.ptr());
+          if (PyErr_Occurred()) throw py::error_already_set();  // OverflowError: above 2^64 − 1
           o.width = width;
           o.height = height;
           o.noise = noise;

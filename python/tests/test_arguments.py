@@ -1,5 +1,6 @@
 """Bad arguments get readable Python errors, as the CLI's checks would give them: a matrix that is
-no rotation, a flow the learned head cannot read. None of them is ignored."""
+no rotation, a flow the learned head cannot read, negative counts and indices, a negative rate.
+None of them is ignored, and none is answered with pybind11's list of overloads."""
 import numpy as np
 import pytest
 
@@ -73,3 +74,42 @@ def test_learned_head_refuses_non_finite_flow_naming_the_index(pair, learned_hea
     with pytest.raises(ValueError, match=r"flow\[2, 17, 42\]"):
         learned_head.rates(batch)
     assert np.isfinite(learned_head.rates(flow)).all()
+
+
+def test_sequence_takes_python_indices(sequence):
+    seq = inertialnet.Sequence(sequence)
+    np.testing.assert_array_equal(seq[-1], seq[len(seq) - 1])
+    np.testing.assert_array_equal(seq[-len(seq)], seq[0])
+    np.testing.assert_array_equal(seq[np.int64(2)], seq[2])
+    for index in (len(seq), -len(seq) - 1):
+        with pytest.raises(IndexError, match=f"frame {index} is out of range: the sequence has {len(seq)} frames"):
+            seq[index]
+    with pytest.raises(TypeError, match="frame index must be an integer, not float"):
+        seq[1.5]
+
+
+def test_negative_counts_are_value_errors(sequence, tmp_path):
+    with pytest.raises(ValueError, match="device spec '-1' is not a device index"):
+        inertialnet.Device(-1)
+    assert inertialnet.Device(0).name == inertialnet.Device("0").name
+    with pytest.raises(ValueError, match="device spec '-1' is not a device index"):
+        inertialnet.predict(sequence, device=-1)
+    assert len(inertialnet.predict(sequence, device=0, max_pairs=1)) == 1
+    with pytest.raises(ValueError, match=r"max_pairs must be a count of pairs \(0 for all\), got -1"):
+        inertialnet.predict(sequence, max_pairs=-1)
+    with pytest.raises(ValueError, match="seed must be 0 or more, got -1"):
+        inertialnet.synth(tmp_path / "seq", frames=2, width=64, height=48, seed=-1)
+
+
+@pytest.mark.parametrize("name, value", [("rate_hz", -5), ("rate_hz", float("nan")), ("rate_hz", 1e7),
+                                         ("fx", -458.0)])
+def test_predict_refuses_what_the_cli_refuses(sequence, name, value):
+    # Ignored before (a rate or focal length <= 0 read as "not given"); the CLI says --rate: must
+    # be a finite positive number, got -5.
+    with pytest.raises(ValueError, match=name + " must be"):
+        inertialnet.predict(sequence, **{name: value})
+
+
+def test_sequence_refuses_a_negative_rate(sequence):
+    with pytest.raises(ValueError, match="rate_hz must be a finite positive number"):
+        inertialnet.Sequence(sequence, rate_hz=-5)
