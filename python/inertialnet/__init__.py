@@ -10,7 +10,7 @@ OpenCV's order), ``(H, W, 4)`` with alpha dropped, or batches ``(N, H, W, C)``. 
 ``(H, W, 2)``: u (right) and v (down) in pixels. Rates are float64 rad/s.
 
 Errors keep the library's messages: bad input raises ``ValueError``, a failure of the device or
-driver ``RuntimeError``. Ctrl-C stops every long call
+driver ``RuntimeError``, exhausted host memory ``MemoryError``. Ctrl-C stops every long call
 (``predict``, networks and DIS flow on batches) within a pair or a layer: ``KeyboardInterrupt``.
 """
 

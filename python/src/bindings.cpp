@@ -6,7 +6,8 @@
 // (alpha dropped), or batches (N, H, W, C); flow is float32 (H, W, 2) (u, v in pixels) or
 // (N, H, W, 2); rates are float64 (3,) in rad/s. Device work runs without the GIL, and every long
 // call on a worker thread that Ctrl-C stops (run_interruptibly). Library errors keep their
-// messages: invalid input becomes ValueError, runtime failures RuntimeError.
+// messages: invalid input becomes ValueError, runtime failures RuntimeError, exhausted host memory
+// MemoryError.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -22,6 +23,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <new>
 #include <optional>
 #include <string>
 #include <thread>
@@ -689,6 +691,17 @@ PYBIND11_MODULE(_inertialnet, m) {
       if (p) std::rethrow_exception(p);
     } catch (const Error& e) {
       PyErr_SetString(e.kind() == ErrorKind::InvalidInput ? PyExc_ValueError : PyExc_RuntimeError, e.what());
+    }
+  });
+  // pybind11 turns std::bad_alloc into a MemoryError that says only "std::bad_alloc"; this one
+  // says what ran out, in the CLI's words. Local: other modules' exceptions are not ours to word.
+  py::register_local_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const std::bad_alloc&) {
+      PyErr_SetString(PyExc_MemoryError,
+                      "out of host memory: the images, flows or batch of this call need more memory than the "
+                      "process can allocate; smaller frames or batches need less.");
     }
   });
 

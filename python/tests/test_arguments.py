@@ -1,6 +1,11 @@
 """Bad arguments get readable Python errors, as the CLI's checks would give them: a matrix that is
-no rotation, a flow the learned head cannot read, negative counts and indices, a negative rate.
-None of them is ignored, and none is answered with pybind11's list of overloads."""
+no rotation, a flow the learned head cannot read, negative counts and indices, a negative rate,
+exhausted memory. None of them is ignored, and none is answered with pybind11's list of overloads
+or its raw "std::bad_alloc"."""
+import subprocess
+import sys
+import textwrap
+
 import numpy as np
 import pytest
 
@@ -113,3 +118,22 @@ def test_predict_refuses_what_the_cli_refuses(sequence, name, value):
 def test_sequence_refuses_a_negative_rate(sequence):
     with pytest.raises(ValueError, match="rate_hz must be a finite positive number"):
         inertialnet.Sequence(sequence, rate_hz=-5)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc/self/status")
+def test_out_of_memory_is_a_readable_memory_error():
+    # A child whose address space is capped just above what it holds: converting a 4000x4000
+    # frame (192 MB of floats) cannot be allocated. pybind11 alone said "std::bad_alloc".
+    child = subprocess.run([sys.executable, "-c", textwrap.dedent("""
+        import resource
+        import numpy as np
+        import inertialnet
+        frame = np.zeros((4000, 4000), np.uint8)
+        size_kb = next(int(l.split()[1]) for l in open("/proc/self/status") if l.startswith("VmSize:"))
+        resource.setrlimit(resource.RLIMIT_AS, ((size_kb + 64 * 1024) * 1024, resource.RLIM_INFINITY))
+        try:
+            inertialnet.dis_flow(frame, frame)
+        except MemoryError as e:
+            print("MemoryError:", e)
+        """)], capture_output=True, text=True, timeout=300)
+    assert child.stdout.startswith("MemoryError: out of host memory"), child.stdout + child.stderr
