@@ -99,11 +99,10 @@ std::string type_name(const py::handle& value) { return py::str(py::type::handle
 
 // Any Python integer (numpy's too, through __index__); TypeError naming `name` for anything else.
 py::int_ index_of(const py::handle& value, const char* name) {
-  py::object index = py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr()));
+  const py::object index = py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr()));
   if (!index) {
     PyErr_Clear();
-    throw py::type_error(std::string(name) + " must be an integer, not " +
-                         type_name(value));
+    throw py::type_error(std::string(name) + " must be an integer, not " + type_name(value));
   }
   return py::reinterpret_borrow<py::int_>(index);
 }
@@ -722,8 +721,8 @@ PYBIND11_MODULE(_inertialnet, m) {
              // "-1" instead of pybind11's list of overloads.
              if (py::isinstance<py::str>(spec)) return PyDevice(spec.cast<std::string>());
              if (py::isinstance<py::bool_>(spec) || !PyIndex_Check(spec.ptr())) {
-               throw py::type_error("a device spec is a string (\"0\", \"cpu\", \"pocl\", …) or a device index, not " +
-                                    type_name(spec));
+               throw py::type_error("a device spec is a string (\"0\", \"cpu\", \"pocl\", …) or a device index, "
+                                    "not " + type_name(spec));
              }
              return PyDevice(std::to_string(integer_of(spec, "a device index")));
            }),
@@ -819,7 +818,9 @@ PYBIND11_MODULE(_inertialnet, m) {
           // The CLI's checks of --max-pairs, --rate, --fx, --fy: a value they refuse is a ValueError
           // here, not ignored (a negative rate or focal length was taken as "not given").
           const std::int64_t pairs = integer_of(max_pairs, "max_pairs");
-          if (pairs < 0) throw invalid_input("max_pairs must be a count of pairs (0 for all), got " + std::to_string(pairs));
+          if (pairs < 0) {
+            throw invalid_input("max_pairs must be a count of pairs (0 for all), got " + std::to_string(pairs));
+          }
           rate_of(rate_hz);
           zero_or_positive(fx, "fx", "pixels", "the calibration's focal length");
           zero_or_positive(fy, "fy", "pixels", "fx");
@@ -908,7 +909,9 @@ PYBIND11_MODULE(_inertialnet, m) {
           o.motion = parse_synth_motion(motion);
           // A seed is any number from 0 up; pybind11 would answer a negative one with its overloads.
           const py::int_ given_seed = index_of(seed, "seed");
-          if (given_seed < py::int_(0)) throw invalid_input("seed must be 0 or more, got " + std::string(py::str(given_seed)));
+          if (given_seed < py::int_(0)) {
+            throw invalid_input("seed must be 0 or more, got " + std::string(py::str(given_seed)));
+          }
           o.seed = PyLong_AsUnsignedLongLong(given_seed.ptr());
           if (PyErr_Occurred()) throw py::error_already_set();  // OverflowError: above 2^64 − 1
           o.width = width;
