@@ -10,13 +10,14 @@ OpenCV's order), ``(H, W, 4)`` with alpha dropped, or batches ``(N, H, W, C)``. 
 ``(H, W, 2)``: u (right) and v (down) in pixels. Rates are float64 rad/s.
 
 Errors keep the library's messages: bad input raises ``ValueError``, a failure of the device or
-driver ``RuntimeError``.
+driver ``RuntimeError``, exhausted host memory ``MemoryError``. Ctrl-C stops every long call
+(``predict``, networks and DIS flow on batches) within a pair or a layer: ``KeyboardInterrupt``.
 """
 
 from __future__ import annotations
 
 import os
-from typing import Iterable, Optional, Sequence as _Seq, Union
+from typing import Callable, Iterable, Optional, Sequence as _Seq, Union
 
 import numpy as np
 
@@ -132,8 +133,11 @@ class InertialNetHead:
 
     def rates(self, flow: np.ndarray, camera: Optional[Camera] = None, dt: Optional[float] = None) -> np.ndarray:
         """ω in rad/s: ``(3,)`` for one flow ``(H, W, 2)``, ``(N, 3)`` for a batch. The flow must have
-        the size the head was built for (``config``). ``camera`` and ``dt`` are accepted for symmetry
-        with :class:`GeometricHead` and ignored: the learned head knows its camera and rate."""
+        the size the head was built for (``config``) and a finite, known vector at every pixel: NaN,
+        infinity or an unknown-flow mark (above 1e9, as ``dis_flow(flow_check=…)`` and KITTI files
+        write them) is a ``ValueError`` naming the first such index. ``camera`` and ``dt`` are
+        accepted for symmetry with :class:`GeometricHead` and ignored: the learned head knows its
+        camera and rate."""
         del camera, dt
         return self._head.rates(flow)
 
@@ -155,12 +159,13 @@ def predict(
     cx: float = 0.0,
     cy: float = 0.0,
     rate_hz: float = 0.0,
-    device: Optional[str] = None,
+    device: Union[None, str, int] = None,
     max_pairs: int = 0,
     lanes: int = 2,
     decode_threads: int = 2,
     keep_flow: bool = False,
     flow_check: float = 0.5,
+    progress: Optional[Callable[[int, int], object]] = None,
 ):
     """Angular rates of every frame pair of a sequence, as ``inertialnet predict`` computes them.
 
@@ -171,13 +176,22 @@ def predict(
     arguments are the CLI's options: without weights, DIS flow and the geometric head;
     ``flow_check`` is ``--flow-check`` (the DIS forward-backward check for the geometric head,
     pixels at 752 columns; 0: off). With ``keep_flow=True`` returns ``(rates, flows)``, flows a
-    list of ``(H, W, 2)`` arrays (as computed, without the check's marks)."""
+    list of ``(H, W, 2)`` arrays (as computed, without the check's marks).
+
+    ``rate_hz``, ``fx`` and ``fy`` are 0 (not given) or what the CLI accepts for ``--rate``,
+    ``--fx``, ``--fy`` (finite, positive, at most 1e6); ``max_pairs`` is 0 (all) or a count:
+    anything else is a ``ValueError``.
+
+    ``progress(done, total)``, if given, is called on the calling thread as pairs complete (at
+    most every 50 ms, and once at the end): ``done`` pairs of ``total``. An exception it raises
+    stops the run and propagates. Ctrl-C stops the run within a pair or two and raises
+    ``KeyboardInterrupt``; the pairs computed so far are dropped."""
     if isinstance(weights, (str, os.PathLike)):
         weights = [weights]
     columns, t_ns, values, flows, statuses = _native._predict(
         os.fspath(sequence), [os.fspath(w) for w in weights], model or "", flow or "", head or "", solver,
-        float(fx), float(fy), float(cx), float(cy), float(rate_hz), device or "", keep_flow, int(max_pairs),
-        int(lanes), int(decode_threads), float(flow_check))
+        float(fx), float(fy), float(cx), float(cy), float(rate_hz), "" if device is None else str(device),
+        keep_flow, max_pairs, int(lanes), int(decode_threads), float(flow_check), progress)
     # Fields as in the rates CSV: wx,wy,wz,status then wx_geometric,…,status_geometric.
     dtype = [("timestamp_ns", np.int64)]
     status_fields = []

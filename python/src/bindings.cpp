@@ -4,18 +4,29 @@
 //
 // Conventions: images are NumPy uint8 (or uint16) arrays (H, W) gray, (H, W, C) with C = 1, 3 or 4
 // (alpha dropped), or batches (N, H, W, C); flow is float32 (H, W, 2) (u, v in pixels) or
-// (N, H, W, 2); rates are float64 (3,) in rad/s. Device work runs without the GIL. Library errors
-// keep their messages: invalid input becomes ValueError, runtime failures RuntimeError.
+// (N, H, W, 2); rates are float64 (3,) in rad/s. Device work runs without the GIL, and every long
+// call on a worker thread that Ctrl-C stops (run_interruptibly). Library errors keep their
+// messages: invalid input becomes ValueError, runtime failures RuntimeError, exhausted host memory
+// MemoryError.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
 #include <cstdint>
+#include <exception>
+#include <functional>
 #include <memory>
+#include <mutex>
+#include <new>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "inertialnet/inertialnet.hpp"
@@ -24,6 +35,112 @@ namespace py = pybind11;
 using namespace inertialnet;
 
 namespace {
+
+// --- long calls --------------------------------------------------------------------------------
+
+// Runs `work` on a worker thread while the calling thread waits without the GIL, waking every
+// 50 ms to take it for a moment: Python's signal handlers run (PyErr_CheckSignals, which Ctrl-C's
+// KeyboardInterrupt comes from; it does nothing outside the main thread), then `poll` (a progress
+// callback), and `poll` once more when the work is done. When either raises, `stop` is set and the
+// worker is waited for (the pipeline checks it between pairs, the networks between layers), and
+// the Python exception propagates instead of the work's result or error. Without this the calling
+// thread sits in the library until the whole call is over and a Ctrl-C waits for it (hours of
+// FlowNet2 pairs). `work` runs without the GIL and must not touch Python objects.
+void run_interruptibly(const std::function<void(const std::atomic<bool>& stop)>& work,
+                       const std::function<void()>& poll = {}) {
+  std::atomic<bool> stop{false};
+  std::mutex mutex;
+  std::condition_variable finished;
+  bool done = false;
+  std::exception_ptr failure;
+  std::thread worker([&] {
+    try {
+      work(stop);
+    } catch (...) {
+      failure = std::current_exception();
+    }
+    const std::lock_guard<std::mutex> lock(mutex);
+    done = true;
+    finished.notify_all();
+  });
+  std::exception_ptr raised;  // from Python: the signal handler or `poll`
+  const auto check = [&](bool signals) {
+    try {
+      if (signals && PyErr_CheckSignals() != 0) throw py::error_already_set();
+      if (poll) poll();
+    } catch (...) {
+      raised = std::current_exception();
+      stop = true;
+    }
+  };
+  for (;;) {
+    {
+      py::gil_scoped_release release;
+      std::unique_lock<std::mutex> lock(mutex);
+      if (finished.wait_for(lock, std::chrono::milliseconds(50), [&] { return done; })) break;
+    }
+    if (!raised) check(true);
+  }
+  worker.join();
+  if (raised) std::rethrow_exception(raised);
+  if (failure) std::rethrow_exception(failure);
+  check(false);  // the last progress report
+  if (raised) std::rethrow_exception(raised);
+}
+
+// --- arguments ---------------------------------------------------------------------------------
+
+// "float", "NoneType", … for messages about an argument of the wrong type.
+std::string type_name(const py::handle& value) { return py::str(py::type::handle_of(value).attr("__name__")); }
+
+// Counts and indices are taken as Python objects and converted here: pybind11's own conversion to
+// an unsigned type answers a negative number with a TypeError listing the function's overloads;
+// the callers say what the number must be instead.
+
+// Any Python integer (numpy's too, through __index__); TypeError naming `name` for anything else.
+py::int_ index_of(const py::handle& value, const char* name) {
+  const py::object index = py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr()));
+  if (!index) {
+    PyErr_Clear();
+    throw py::type_error(std::string(name) + " must be an integer, not " + type_name(value));
+  }
+  return py::reinterpret_borrow<py::int_>(index);
+}
+
+// The same as a signed 64-bit number; ValueError beyond.
+std::int64_t integer_of(const py::handle& value, const char* name) {
+  const py::int_ index = index_of(value, name);
+  int overflow = 0;
+  const long long n = PyLong_AsLongLongAndOverflow(index.ptr(), &overflow);
+  if (overflow != 0) {
+    throw invalid_input(std::string(name) + " must be a number within ±9.2e18, got " + std::string(py::str(index)));
+  }
+  return n;
+}
+
+// The CLI's wording for a number the user gave: "must be …, got -5" with the value as Python
+// prints it, so 1e-12 stays 1e-12.
+std::string got(double value) { return std::string(py::str(py::float_(value))); }
+
+// rate_hz, fx, fy: 0 means "not given" (the source's frame times, the calibration's focal
+// length), anything else must pass the CLI's check of --rate, --fx, --fy (a finite positive
+// number up to 1e6). Without it a negative or NaN value was silently taken as "not given".
+double zero_or_positive(double value, const char* name, const char* unit, const char* zero_means) {
+  if (value == 0) return value;
+  if (!std::isfinite(value) || !(value > 0)) {
+    throw invalid_input(std::string(name) + " must be a finite positive number (" + unit + "), or 0 for " +
+                        zero_means + "; got " + got(value));
+  }
+  if (value > 1e6) throw invalid_input(std::string(name) + " must be at most 1e+06 " + unit + ", got " + got(value));
+  return value;
+}
+
+// The frame rate of Sequence and predict: 0 takes the frame times from the source, as --rate
+// left out does.
+std::optional<double> rate_of(double rate_hz) {
+  if (zero_or_positive(rate_hz, "rate_hz", "Hz", "the source's frame times") == 0) return std::nullopt;
+  return rate_hz;
+}
 
 // --- arrays ------------------------------------------------------------------------------------
 
@@ -212,8 +329,7 @@ class PyFlowNet {
     const auto n = static_cast<std::int64_t>(a.size());
     const int w = a.front().width, h = a.front().height;
     std::vector<float> result;
-    {
-      py::gil_scoped_release release;
+    run_interruptibly([&](const std::atomic<bool>& stop) {
       std::vector<float> f1, f2;
       for (std::size_t i = 0; i < a.size(); ++i) {
         f1.insert(f1.end(), a[i].data.begin(), a[i].data.end());
@@ -223,8 +339,8 @@ class PyFlowNet {
       const Shape shape{n, 3, h, w};
       const Tensor frame1 = Tensor::from_host(queue, shape, f1);
       const Tensor frame2 = Tensor::from_host(queue, shape, f2);
-      result = net_->compute(queue, frame1, frame2).to_host(queue);
-    }
+      result = net_->compute(queue, frame1, frame2, &stop).to_host(queue);
+    });
     // [N, 2, H, W] planes to (N, H, W, 2).
     py::array_t<float> out(batch ? std::vector<py::ssize_t>{n, h, w, 2} : std::vector<py::ssize_t>{h, w, 2});
     float* p = out.mutable_data();
@@ -255,14 +371,13 @@ py::array_t<float> dis_flow(const py::array& first, const py::array& second, con
   const auto b = images_of(second, order, "img2");
   if (a.size() != b.size()) throw invalid_input("img1 and img2 hold different numbers of images.");
   std::vector<FlowField> flows;
-  {
-    py::gil_scoped_release release;
+  run_interruptibly([&](const std::atomic<bool>& stop) {
     DisFlow dis;
-    for (std::size_t i = 0; i < a.size(); ++i) {
+    for (std::size_t i = 0; i < a.size() && !stop; ++i) {
       flows.push_back(dis.compute(a[i], b[i]));
       dis.check(flows.back(), a[i], b[i], flow_check);
     }
-  }
+  });
   if (first.ndim() != 4) return flow_to_array(flows.front());
   const auto n = static_cast<py::ssize_t>(flows.size());
   py::array_t<float> out({n, static_cast<py::ssize_t>(flows[0].height), static_cast<py::ssize_t>(flows[0].width),
@@ -283,12 +398,36 @@ py::array_t<double> vec3_array(const Vec3& w) {
   return out;
 }
 
+// camera_to_body: a rotation, or the rates come out scaled, mirrored or NaN without a word (2·I
+// doubled them, zeros zeroed them). The check is the one sensor.yaml's T_BS passes
+// (src/io/yaml_util.cpp, check_rigid): rows orthonormal within 1e-3, so that any matrix
+// Sequence.camera_to_body returns is accepted back, and a positive determinant (no mirror image).
+// Written as "not within" so that NaN fails.
 std::optional<Mat3> mat3_of(const py::object& m) {
   if (m.is_none()) return std::nullopt;
   const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(m);
-  if (!a || a.size() != 9) throw invalid_input("camera_to_body must be a 3x3 rotation matrix.");
+  if (!a || a.ndim() != 2 || a.shape(0) != 3 || a.shape(1) != 3) {
+    throw invalid_input("camera_to_body must be a 3x3 rotation matrix (camera to body frame), got " +
+                        (a ? "an array of shape " + std::string(py::str(a.attr("shape")))
+                           : "a " + type_name(m)) + ".");
+  }
   Mat3 r;
   std::copy(a.data(), a.data() + 9, r.begin());
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      double dot = 0;
+      for (int k = 0; k < 3; ++k) dot += r[3 * i + k] * r[3 * j + k];
+      if (!(std::abs(dot - (i == j ? 1.0 : 0.0)) <= 1e-3)) {
+        throw invalid_input("camera_to_body is not a rotation matrix: its rows are not orthonormal within 1e-3 "
+                            "(row " + std::to_string(i) + " · row " + std::to_string(j) + " = " + got(dot) + ").");
+      }
+    }
+  }
+  const double det = r[0] * (r[4] * r[8] - r[5] * r[7]) - r[1] * (r[3] * r[8] - r[5] * r[6]) +
+                     r[2] * (r[3] * r[7] - r[4] * r[6]);
+  if (!(det > 0)) {
+    throw invalid_input("camera_to_body is a reflection (determinant " + got(det) + "), not a rotation.");
+  }
   return r;
 }
 
@@ -310,17 +449,16 @@ class PyGeometricHead {
     const FlowField flow = flow_from_array(flow_array);
     const auto r = mat3_of(camera_to_body);
     Vec3 w;
-    {
-      py::gil_scoped_release release;
+    run_interruptibly([&](const std::atomic<bool>& stop) {
       if (!head_ || !same_camera(head_->camera(), camera)) head_ = std::make_unique<GeometricHead>(*device_, camera, options_);
       // The same upload as the pipeline's: the flow as a [1, 2, H, W] tensor.
       Queue& queue = device_->queue();
       std::vector<float> planes(flow.u);
       planes.insert(planes.end(), flow.v.begin(), flow.v.end());
       const Tensor tensor = Tensor::from_host(queue, {1, 2, flow.height, flow.width}, planes);
-      w = head_->estimate(queue, tensor, dt).omega;
+      w = head_->estimate(queue, tensor, dt, &stop).omega;
       if (r) w = mul(*r, w);
-    }
+    });
     return vec3_array(w);
   }
 
@@ -358,17 +496,27 @@ class PyInertialNetHead {
     const float* p = a.data();
     for (std::size_t k = 0; k < static_cast<std::size_t>(n); ++k) {
       for (std::size_t i = 0; i < plane; ++i) {
-        planar[2 * k * plane + i] = p[2 * (k * plane + i)];
-        planar[(2 * k + 1) * plane + i] = p[2 * (k * plane + i) + 1];
+        const float u = p[2 * (k * plane + i)], v = p[2 * (k * plane + i) + 1];
+        // The network has no notion of unknown flow: NaN, ±inf or a marker above 1e9 would come
+        // out as NaN or wild rates without a word.
+        if (is_unknown_flow(u, v)) {
+          const std::string at = (batch ? std::to_string(k) + ", " : std::string()) + std::to_string(i / w) + ", " +
+                                 std::to_string(i % w);
+          throw invalid_input("flow[" + at + "] = (" + got(u) + ", " + got(v) +
+                              ") is not a finite flow vector: the learned head needs a known flow at every pixel "
+                              "(NaN, infinity and the unknown-flow marks above 1e9 of dis_flow(flow_check=…) "
+                              "and KITTI files are refused).");
+        }
+        planar[2 * k * plane + i] = u;
+        planar[(2 * k + 1) * plane + i] = v;
       }
     }
     std::vector<float> omega;
-    {
-      py::gil_scoped_release release;
+    run_interruptibly([&](const std::atomic<bool>& stop) {
       Queue& queue = device_->queue();
       const Tensor flow = Tensor::from_host(queue, {n, 2, h, w}, planar);
-      omega = head_->compute(queue, flow).to_host(queue);
-    }
+      omega = head_->compute(queue, flow, &stop).to_host(queue);
+    });
     py::array_t<double> out(batch ? std::vector<py::ssize_t>{n, 3} : std::vector<py::ssize_t>{3});
     std::copy(omega.begin(), omega.end(), out.mutable_data());
     return out;
@@ -393,19 +541,27 @@ class PyInertialNetHead {
 class PySequence {
  public:
   PySequence(const std::filesystem::path& path, double rate_hz)
-      : source_(open_frame_source(path, rate_hz > 0 ? std::optional<double>(rate_hz) : std::nullopt)) {}
+      : source_(open_frame_source(path, rate_of(rate_hz))) {}
   std::size_t size() const { return source_->size(); }
   py::array_t<std::int64_t> timestamps() const {
     py::array_t<std::int64_t> out(static_cast<py::ssize_t>(source_->size()));
     for (std::size_t i = 0; i < source_->size(); ++i) out.mutable_data()[i] = source_->timestamp_ns(i);
     return out;
   }
-  py::array_t<std::uint8_t> frame(std::size_t index) {
-    if (index >= source_->size()) throw py::index_error("frame " + std::to_string(index) + " of " + std::to_string(size()));
+  // Python's indexing: seq[-1] is the last frame.
+  py::array_t<std::uint8_t> frame(const py::object& index_object) {
+    const std::int64_t count = static_cast<std::int64_t>(size());
+    const std::int64_t given = integer_of(index_object, "a frame index");
+    const std::int64_t index = given < 0 ? given + count : given;
+    if (index < 0 || index >= count) {
+      throw py::index_error("frame " + std::to_string(given) + " is out of range: the sequence has " +
+                            std::to_string(count) + " frames (indices 0 to " + std::to_string(count - 1) + ", or -" +
+                            std::to_string(count) + " to -1 from the end)");
+    }
     HostImage image;
     {
       py::gil_scoped_release release;
-      image = source_->decode(index);
+      image = source_->decode(static_cast<std::size_t>(index));
     }
     return to_uint8_rgb(image);
   }
@@ -428,23 +584,54 @@ class PySequence {
   std::unique_ptr<FrameSource> source_;
 };
 
+// predict()'s progress callback, progress(done, total), called on the calling thread between
+// the waits of run_interruptibly: once the total is known, then whenever more pairs are done.
+class ProgressReport {
+ public:
+  explicit ProgressReport(py::object callback) : callback_(std::move(callback)) {}
+  // From the worker.
+  void start(std::size_t total) {
+    total_ = total;
+    started_ = true;
+  }
+  void pair_done() { ++done_; }
+  // With the GIL.
+  void report() {
+    if (callback_.is_none() || !started_) return;
+    const std::size_t done = done_;
+    if (reported_ == done) return;
+    reported_ = done;
+    callback_(done, total_.load());
+  }
+
+ private:
+  py::object callback_;
+  std::atomic<bool> started_{false};
+  std::atomic<std::size_t> total_{0};
+  std::atomic<std::size_t> done_{0};
+  std::optional<std::size_t> reported_;
+};
+
 // The rows of predict(): the column names, the timestamps, the values (rows × columns; NaN where
 // a pair has no answer), with keep_flow each pair's flow, and the status words (rows × estimators).
 // The Python side makes the structured array.
-py::tuple predict(const PredictSettings& settings, std::size_t max_pairs, int lanes, int decode_threads) {
+py::tuple predict(const PredictSettings& settings, std::size_t max_pairs, int lanes, int decode_threads,
+                  const py::object& progress) {
   std::vector<std::int64_t> t_ns;
   std::vector<double> values;
   std::vector<FlowField> flows;
   std::vector<std::string> columns;
   std::vector<std::string> statuses;
-  {
-    py::gil_scoped_release release;
+  ProgressReport report(progress);
+  run_interruptibly([&](const std::atomic<bool>& stop) {
     Prediction prediction(settings);
     columns = prediction.columns();
     PipelineOptions options;
     options.lanes_per_device = lanes;
     options.decode_threads = decode_threads;
     options.max_pairs = max_pairs;
+    options.cancel = &stop;
+    report.start(prediction.pairs(max_pairs));
     prediction.run(
         [&](const PairResult& r) {
           t_ns.push_back(r.t1_ns);
@@ -453,9 +640,10 @@ py::tuple predict(const PredictSettings& settings, std::size_t max_pairs, int la
             statuses.emplace_back(to_string(answer.status));
           }
           if (r.flow) flows.push_back(*r.flow);
+          report.pair_done();
         },
         options);
-  }
+  }, [&] { report.report(); });
   py::array_t<std::int64_t> t(static_cast<py::ssize_t>(t_ns.size()));
   std::copy(t_ns.begin(), t_ns.end(), t.mutable_data());
   py::array_t<double> v({static_cast<py::ssize_t>(t_ns.size()), static_cast<py::ssize_t>(columns.size())});
@@ -504,6 +692,17 @@ PYBIND11_MODULE(_inertialnet, m) {
       PyErr_SetString(e.kind() == ErrorKind::InvalidInput ? PyExc_ValueError : PyExc_RuntimeError, e.what());
     }
   });
+  // pybind11 turns std::bad_alloc into a MemoryError that says only "std::bad_alloc"; this one
+  // says what ran out, in the CLI's words. Local: other modules' exceptions are not ours to word.
+  py::register_local_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const std::bad_alloc&) {
+      PyErr_SetString(PyExc_MemoryError,
+                      "out of host memory: the images, flows or batch of this call need more memory than the "
+                      "process can allocate; smaller frames or batches need less.");
+    }
+  });
 
   m.def("devices", [] {
     py::list out;
@@ -517,7 +716,17 @@ PYBIND11_MODULE(_inertialnet, m) {
   }, py::arg("spec") = "", "The devices a --device spec selects (\"\": $INERTIALNET_DEVICE, else the default).");
 
   py::class_<PyDevice>(m, "Device", "An opened OpenCL device, chosen by a --device spec string.")
-      .def(py::init<const std::string&>(), py::arg("spec") = "")
+      .def(py::init([](const py::object& spec) {
+             // An int is a device index, as the spec "3": Device(-1) gets the library's message for
+             // "-1" instead of pybind11's list of overloads.
+             if (py::isinstance<py::str>(spec)) return PyDevice(spec.cast<std::string>());
+             if (py::isinstance<py::bool_>(spec) || !PyIndex_Check(spec.ptr())) {
+               throw py::type_error("a device spec is a string (\"0\", \"cpu\", \"pocl\", …) or a device index, "
+                                    "not " + type_name(spec));
+             }
+             return PyDevice(std::to_string(integer_of(spec, "a device index")));
+           }),
+           py::arg("spec") = "")
       .def_property_readonly("name", [](const PyDevice& d) { return d.device->info().name; })
       .def_property_readonly("info", [](const PyDevice& d) { return device_dict(d.device->info()); })
       .def("__repr__", [](const PyDevice& d) { return "<inertialnet.Device " + d.device->info().name + ">"; });
@@ -579,7 +788,10 @@ PYBIND11_MODULE(_inertialnet, m) {
       .def("rates", &PyGeometricHead::rates, py::arg("flow"), py::arg("camera"), py::arg("dt"),
            py::arg("camera_to_body") = py::none(),
            "ω (rad/s, (3,)) from the flow (H, W, 2) of a frame pair dt seconds apart; camera frame, or the body "
-           "frame with camera_to_body (3x3).");
+           "frame with camera_to_body (a 3x3 rotation matrix: orthonormal rows within 1e-3, determinant +1; "
+           "anything else is a ValueError). Flow vectors that are NaN, infinite or above 1e9 in magnitude are "
+           "unknown flow (the marks of dis_flow(flow_check=…) and KITTI files) and left out, like vectors that "
+           "leave the image.");
 
   py::class_<PyInertialNetHead>(m, "_InertialNetHead")
       .def(py::init<const py::object&, const py::object&>(), py::arg("weights"), py::arg("device") = py::none())
@@ -601,8 +813,21 @@ PYBIND11_MODULE(_inertialnet, m) {
   m.def("_predict",
         [](const std::filesystem::path& sequence, const std::vector<std::string>& weights, const std::string& model,
            const std::string& flow, const std::string& head, const std::string& solver, double fx, double fy, double cx,
-           double cy, double rate_hz, const std::string& device, bool keep_flow, std::size_t max_pairs, int lanes,
-           int decode_threads, double flow_check) {
+           double cy, double rate_hz, const std::string& device, bool keep_flow, const py::object& max_pairs, int lanes,
+           int decode_threads, double flow_check, const py::object& progress) {
+          // The CLI's checks of --max-pairs, --rate, --fx, --fy: a value they refuse is a ValueError
+          // here, not ignored (a negative rate or focal length was taken as "not given").
+          const std::int64_t pairs = integer_of(max_pairs, "max_pairs");
+          if (pairs < 0) {
+            throw invalid_input("max_pairs must be a count of pairs (0 for all), got " + std::to_string(pairs));
+          }
+          rate_of(rate_hz);
+          zero_or_positive(fx, "fx", "pixels", "the calibration's focal length");
+          zero_or_positive(fy, "fy", "pixels", "fx");
+          if (!progress.is_none() && !PyCallable_Check(progress.ptr())) {
+            throw py::type_error("progress must be a callable taking (done, total), or None, not " +
+                                 type_name(progress));
+          }
           PredictSettings s;
           s.sequence = sequence;
           s.weights = weights;
@@ -619,7 +844,7 @@ PYBIND11_MODULE(_inertialnet, m) {
           s.keep_flow = keep_flow;
           s.flow_check_px = flow_check;
           if (lanes < 1 || decode_threads < 1) throw invalid_input("lanes and decode_threads must be at least 1");
-          return predict(s, max_pairs, lanes, decode_threads);
+          return predict(s, static_cast<std::size_t>(pairs), lanes, decode_threads, progress);
         });
   m.def("_evaluate_json", &evaluate_json);
   m.def("_write_rates_csv",
@@ -677,12 +902,18 @@ PYBIND11_MODULE(_inertialnet, m) {
         py::arg("path"), py::arg("flow"), py::arg("max_magnitude") = 0.0f, "flow_to_color() saved as a PNG.");
 
   m.def("synth",
-        [](const std::filesystem::path& out, int frames, const std::string& motion, std::uint64_t seed, int width,
+        [](const std::filesystem::path& out, int frames, const std::string& motion, const py::object& seed, int width,
            int height, bool noise, bool overwrite) {
           SynthOptions o;
           o.frames = frames;
           o.motion = parse_synth_motion(motion);
-          o.seed = seed;
+          // A seed is any number from 0 up; pybind11 would answer a negative one with its overloads.
+          const py::int_ given_seed = index_of(seed, "seed");
+          if (given_seed < py::int_(0)) {
+            throw invalid_input("seed must be 0 or more, got " + std::string(py::str(given_seed)));
+          }
+          o.seed = PyLong_AsUnsignedLongLong(given_seed.ptr());
+          if (PyErr_Occurred()) throw py::error_already_set();  // OverflowError: above 2^64 − 1
           o.width = width;
           o.height = height;
           o.noise = noise;

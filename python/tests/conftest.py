@@ -40,7 +40,16 @@ def sequence(tmp_path_factory):
 
 
 def read_rates_csv(path):
+    """The header and the rows of a rates CSV (schema inertialnet.rates/2): timestamps as int, the
+    status columns as their words, rates as float (NaN where a pair has no answer: empty cells)."""
     with open(path) as f:
         rows = [r for r in csv.reader(f) if r and not r[0].startswith("#")]  # `# key: value` lines aside
     header, body = rows[0], rows[1:]
-    return header, np.array([[int(r[0])] + [float(v) for v in r[1:]] for r in body], dtype=object)
+    status = [name == "status" or name.startswith("status_") for name in header]
+    return header, np.array([[int(r[0])] + [v if status[i] else float(v or "nan") for i, v in enumerate(r) if i > 0]
+                             for r in body], dtype=object)
+
+
+def csv_text(value):
+    """A cell as the rates CSV writes it: rates to 9 significant digits (%.9g), status words as they are."""
+    return str(value) if isinstance(value, str) else "%.9g" % value

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import inertialnet
-from conftest import read_rates_csv
+from conftest import csv_text, read_rates_csv
 
 
 @pytest.fixture(scope="module")
@@ -58,7 +58,7 @@ def test_inertialnet_head_matches_the_cli(cli, sequence, tmp_path):
     rates = inertialnet.predict(sequence, head_weights, flow="dis", head="both")
     assert list(rates.dtype.names) == header
     for i, name in enumerate(header[1:], start=1):
-        assert ["%.9g" % v for v in rates[name]] == ["%.9g" % v for v in expected[:, i].astype(float)]
+        assert [csv_text(v) for v in rates[name]] == [csv_text(v) for v in expected[:, i]]
     head = inertialnet.InertialNetHead.load(head_weights)
     seq = inertialnet.Sequence(sequence)
     flows = np.stack([inertialnet.dis_flow(seq[k - 1], seq[k]) for k in range(1, len(seq))])

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import inertialnet
-from conftest import read_rates_csv
+from conftest import csv_text, read_rates_csv
 
 
 def cli_rates(cli, sequence, tmp_path, *args):
@@ -21,13 +21,13 @@ def cli_rates(cli, sequence, tmp_path, *args):
 def test_predict_matches_the_cli(cli, sequence, tmp_path):
     header, expected = cli_rates(cli, sequence, tmp_path)
     rates = inertialnet.predict(sequence)
-    assert list(rates.dtype.names) == header == ["timestamp_ns", "wx", "wy", "wz"]
+    assert list(rates.dtype.names) == header == ["timestamp_ns", "wx", "wy", "wz", "status"]
     assert len(rates) == len(expected) == 4
     np.testing.assert_array_equal(rates["timestamp_ns"], expected[:, 0].astype(np.int64))
+    assert list(rates["status"]) == ["ok"] * 4
     for i, name in enumerate(header[1:], start=1):
         # The CSV holds %.9g: the same doubles, printed to 9 significant digits.
-        np.testing.assert_array_equal(np.array(["%.9g" % v for v in rates[name]]),
-                                      np.array(["%.9g" % v for v in expected[:, i].astype(float)]))
+        assert [csv_text(v) for v in rates[name]] == [csv_text(v) for v in expected[:, i]]
 
 
 def test_dis_flow_and_geometric_head_step_by_step_match_the_cli(cli, sequence, tmp_path):
@@ -40,7 +40,7 @@ def test_dis_flow_and_geometric_head_step_by_step_match_the_cli(cli, sequence, t
         flow = inertialnet.dis_flow(seq[k - 1], seq[k], flow_check=0.5)  # predict's default check
         assert flow.shape == (96, 128, 2) and flow.dtype == np.float32
         w = head.rates(flow, camera, dt=(t[k] - t[k - 1]) * 1e-9, camera_to_body=to_body)
-        assert ["%.9g" % v for v in w] == ["%.9g" % v for v in expected[k - 1, 1:].astype(float)]
+        assert [csv_text(v) for v in w] == [csv_text(v) for v in expected[k - 1, 1:4]]
 
 
 def test_cli_flow_dis_matches_dis_flow_bit_for_bit(cli, sequence, tmp_path):
