@@ -2,11 +2,13 @@
 
 #include <clblast.h>
 
+#include <cstdio>
 #include <mutex>
 
 #include "inertialnet/ops/gemm_packed.hpp"
 #include "inertialnet/runtime/device.hpp"
 #include "ops/gemm_support.hpp"
+#include "runtime/clblast_tuning.hpp"
 
 namespace inertialnet {
 
@@ -41,6 +43,25 @@ namespace {
 std::mutex& clblast_mutex() {
   static std::mutex mutex;
   return mutex;
+}
+
+// Runs `call` (one CLBlast routine, returning its status). When it fails and the device's
+// tuning file had overridden CLBlast's Xgemm parameters, those are dropped for the rest of the
+// process with one warning naming the file, and the call is made again on the defaults: a stored
+// set that passed the checks of runtime/device_tuning.cpp but that CLBlast still cannot build
+// must only cost speed (docs/performance.md). Without an override the status is returned as is.
+template <typename Call>
+int call_clblast(Queue& queue, Call call) {
+  int status = static_cast<int>(call());
+  if (status == 0) return status;
+  Device& device = queue.device();
+  if (device.tuning().clblast.empty() || !detail::restore_clblast_parameters(device.info(), "Xgemm")) return status;
+  std::fprintf(stderr,
+               "inertialnet: warning: CLBlast failed (%s) with the Xgemm parameters of the tuning file %s; they are "
+               "dropped and CLBlast's defaults used. `inertialnet tune` rewrites the file\n",
+               clblast_status_name(status).c_str(),
+               device_tuning_file(device.info(), device.programs().directory()).string().c_str());
+  return static_cast<int>(call());
 }
 
 clblast::Transpose to_clblast(Transpose t) { return t == Transpose::Yes ? clblast::Transpose::kYes : clblast::Transpose::kNo; }
@@ -87,18 +108,22 @@ void gemm(Queue& queue, GemmBackend backend, Transpose transpose_a, Transpose tr
   // and free per layer per pair, churn in the host allocator on CPU devices. The queue's pool
   // lends it instead, the same buffer every time a shape repeats. The in-order queue runs the
   // kernels that use it before any later user of the recycled buffer.
-  std::size_t temp_bytes = 0;
-  check_clblast(static_cast<int>(clblast::GemmTempBufferSize<float>(
-                    clblast::Layout::kRowMajor, to_clblast(transpose_a), to_clblast(transpose_b), m, n, k, a.offset,
-                    a.leading_dimension, b.offset, b.leading_dimension, c.offset, c.leading_dimension, &handle,
-                    temp_bytes)),
-                "clblast::GemmTempBufferSize", site);
-  const std::shared_ptr<Buffer> temp = temp_bytes > 0 ? queue.buffers().acquire(temp_bytes) : nullptr;
-  const auto status = clblast::Gemm<float>(clblast::Layout::kRowMajor, to_clblast(transpose_a), to_clblast(transpose_b),
-                                           m, n, k, alpha, a.buffer, a.offset, a.leading_dimension, b.buffer, b.offset,
-                                           b.leading_dimension, beta, c.buffer, c.offset, c.leading_dimension, &handle,
-                                           nullptr, temp ? temp->handle() : nullptr);
-  check_clblast(static_cast<int>(status), "clblast::Gemm", site);
+  std::shared_ptr<Buffer> temp;
+  const auto attempt = [&]() -> int {
+    // The temporary's size depends on the parameters in use: asked again after a fallback.
+    std::size_t temp_bytes = 0;
+    const auto sized = clblast::GemmTempBufferSize<float>(
+        clblast::Layout::kRowMajor, to_clblast(transpose_a), to_clblast(transpose_b), m, n, k, a.offset,
+        a.leading_dimension, b.offset, b.leading_dimension, c.offset, c.leading_dimension, &handle, temp_bytes);
+    if (sized != clblast::StatusCode::kSuccess) return static_cast<int>(sized);
+    temp = temp_bytes > 0 ? queue.buffers().acquire(temp_bytes) : nullptr;
+    return static_cast<int>(clblast::Gemm<float>(
+        clblast::Layout::kRowMajor, to_clblast(transpose_a), to_clblast(transpose_b), m, n, k, alpha, a.buffer,
+        a.offset, a.leading_dimension, b.buffer, b.offset, b.leading_dimension, beta, c.buffer, c.offset,
+        c.leading_dimension, &handle, nullptr, temp ? temp->handle() : nullptr));
+  };
+  const int status = call_clblast(queue, attempt);
+  check_clblast(status, "clblast::Gemm", site);
 }
 
 void gemm_strided_batched(Queue& queue, Transpose transpose_a, Transpose transpose_b, std::size_t m, std::size_t n,
@@ -121,11 +146,13 @@ void gemm_strided_batched(Queue& queue, Transpose transpose_a, Transpose transpo
   }
   cl_command_queue handle = queue.handle();
   std::lock_guard<std::mutex> lock(clblast_mutex());
-  const auto status = clblast::GemmStridedBatched<float>(
-      clblast::Layout::kRowMajor, to_clblast(transpose_a), to_clblast(transpose_b), m, n, k, alpha, a.buffer, a.offset,
-      a.leading_dimension, stride_a, b.buffer, b.offset, b.leading_dimension, stride_b, beta, c.buffer, c.offset,
-      c.leading_dimension, stride_c, batch, &handle, nullptr);
-  check_clblast(static_cast<int>(status), "clblast::GemmStridedBatched", queue.device().site("clblast/XgemmStridedBatched"));
+  const int status = call_clblast(queue, [&] {
+    return clblast::GemmStridedBatched<float>(
+        clblast::Layout::kRowMajor, to_clblast(transpose_a), to_clblast(transpose_b), m, n, k, alpha, a.buffer,
+        a.offset, a.leading_dimension, stride_a, b.buffer, b.offset, b.leading_dimension, stride_b, beta, c.buffer,
+        c.offset, c.leading_dimension, stride_c, batch, &handle, nullptr);
+  });
+  check_clblast(status, "clblast::GemmStridedBatched", queue.device().site("clblast/XgemmStridedBatched"));
 }
 
 }  // namespace inertialnet
