@@ -71,18 +71,20 @@ struct TuneSetup {
   int runs;
 };
 
-// The smallest frame side tuned: FlowNet2 halves the frame six times, so below 64 pixels its
-// deepest layers have no pixel left and its GEMMs are degenerate; parameters found on them would
-// replace the stored tuning of every later run (issue 20, item 9).
-constexpr std::int64_t kMinimumTuneSide = 64;
+// The smallest frame side tuned. The network pads a frame to its 64-pixel grid
+// (models/gemm_shapes.cpp), so below 32 pixels a side most of what would be timed is padding, and
+// parameters found on it would replace the stored tuning of every later run (issue 20, item 9:
+// `--size 1x1` did).
+constexpr std::int64_t kMinimumTuneSide = 32;
 
 TuneSetup tune_setup(const TuneOptions& o) {
   const ModelKind kind = model_kind_from_string(o.model);
   const auto [width, height] = parse_size(o.size.empty() ? (o.quick ? "256x192" : "512x384") : o.size);
   if (width < kMinimumTuneSide || height < kMinimumTuneSide) {
     throw invalid_input("tune --size " + std::to_string(width) + "x" + std::to_string(height) +
-                        ": too small to tune on; the network's deepest layers need at least " +
-                        std::to_string(kMinimumTuneSide) + " pixels a side (default 512x384, 256x192 with --quick)");
+                        ": too small to tune on; at least " + std::to_string(kMinimumTuneSide) +
+                        " pixels a side, below which the timed frame is mostly padding (default 512x384, 256x192 "
+                        "with --quick)");
   }
   return {kind, width, height, heaviest_gemm_shapes(model_gemm_shapes(kind, width, height), o.quick ? 2 : 6),
           o.quick ? 1 : 3};
