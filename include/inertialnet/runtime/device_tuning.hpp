@@ -25,7 +25,8 @@
 // work-group and local-memory limits; docs/performance.md) is reported once on stderr, naming
 // the file and the key in our words, and ignored (defaults apply); one that names another device
 // or driver is ignored silently (a copied cache). A set that passes the checks yet fails in
-// CLBlast is dropped at its first failing call (ops/gemm.cpp). With the disk cache off
+// CLBlast is dropped by a probe before the first CLBlast call, or at any failing call
+// (ops/gemm.cpp). With the disk cache off
 // ($INERTIALNET_NO_CACHE, --no-cache) the file is neither read nor written.
 #pragma once
 
