@@ -170,6 +170,20 @@ TEST_F(TimeOffset, NoRotationOnEitherSideLeavesTheOffsetUndetermined) {
 
   // The same data with the range around it: determined, as before.
   EXPECT_TRUE(estimate_time_offset(from, to, moving.w, seq.imu).determined);
+
+  // eval --time-offset auto applies nothing it cannot determine, and says so.
+  EvalOptions options;
+  options.choose_target = true;
+  options.estimate_time_offset = true;
+  options.time_offset_search = narrow;
+  const EvalReport report = evaluate(moving, seq, options);
+  ASSERT_TRUE(report.time_offset_estimate.has_value());
+  EXPECT_FALSE(report.time_offset_estimate->determined);
+  EXPECT_EQ(report.time_offset_s, 0.0);
+  bool said = false;
+  for (const auto& n : report.notes) said = said || n.find("not determined") != std::string::npos;
+  EXPECT_TRUE(said);
+  EXPECT_NE(report.json().find("\"determined\": false"), std::string::npos) << report.json();
 }
 
 // Issue 20, item 9: only decimal seconds; a pasted number is not echoed whole.
