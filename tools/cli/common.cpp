@@ -2,6 +2,7 @@
 
 #include <sys/stat.h>
 
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -136,6 +137,24 @@ void check_distinct_outputs(const std::vector<OutputPath>& outputs, const std::v
     }
     seen.emplace_back(identity, &output);
   }
+}
+
+std::string excerpt_long_numbers(const std::string& text) {
+  const auto numeric = [](char c) {
+    return std::isdigit(static_cast<unsigned char>(c)) || c == '.' || c == 'e' || c == 'E' || c == '+' || c == '-';
+  };
+  std::string out;
+  for (std::size_t i = 0; i < text.size();) {
+    if (!numeric(text[i])) {
+      out += text[i++];
+      continue;
+    }
+    std::size_t end = i;
+    while (end < text.size() && numeric(text[end])) ++end;
+    out += excerpt(text.substr(i, end - i));
+    i = end;
+  }
+  return out;
 }
 
 void flush_standard_output() {

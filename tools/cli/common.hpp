@@ -55,6 +55,12 @@ struct OutputPath {
 // with an empty path (not requested) are skipped. The message names both options and the path.
 void check_distinct_outputs(const std::vector<OutputPath>& outputs, const std::vector<std::string>& inputs);
 
+// `text` with every number in it longer than 40 characters (a run of digits, '.', 'e', 'E', '+',
+// '-') cut to its first 40 and "…" (runtime/excerpt.hpp): for messages written by others (CLI11's
+// "--frames: Value 999… not in range") that quote a pasted 300-digit value whole. Paths and words
+// are left alone.
+std::string excerpt_long_numbers(const std::string& text);
+
 // Pushes what is buffered for standard output to it; runtime_error when it cannot be written
 // (a full disk, a closed pipe, /dev/full), so that no command reports success with its output lost.
 void flush_standard_output();
