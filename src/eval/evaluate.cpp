@@ -133,9 +133,15 @@ EvalReport evaluate(const RatesTable& all_rates, const EurocSequence& seq, const
       imu_frame.push_back(r_cs ? mul_transposed(*r_cs, predicted[i]) : predicted[i]);
     }
     const TimeOffsetEstimate estimate = estimate_time_offset(from, to, imu_frame, seq.imu, options.time_offset_search);
-    sync.time_offset_s = estimate.offset_s;
     r.time_offset_estimate = estimate;
-    notes.push_back("Estimated " + estimate.summary() + "; applied (it includes any readout shift).");
+    if (estimate.determined) {
+      sync.time_offset_s = estimate.offset_s;
+      notes.push_back("Estimated " + estimate.summary() + "; applied (it includes any readout shift).");
+    } else {
+      // Nothing the data fix: the offset stays as it was (the readout shift alone).
+      notes.push_back("The camera-IMU time offset is not determined (" + estimate.undetermined_reason +
+                      "); no offset applied.");
+    }
   }
   r.time_offset_s = sync.time_offset_s;
 
@@ -361,7 +367,9 @@ std::string EvalReport::json(bool include_series) const {
     j["time_offset_estimate"] = {{"offset_s", e.offset_s},       {"std_error_s", e.std_error_s},
                                  {"contrast", e.contrast},       {"confidence", e.confidence()},
                                  {"at_range_edge", e.at_range_edge}, {"pairs", e.pairs},
-                                 {"rmse_deg_s", e.rmse_deg_s},   {"rmse_at_zero_deg_s", e.rmse_at_zero_deg_s}};
+                                 {"rmse_deg_s", e.rmse_deg_s},   {"rmse_at_zero_deg_s", e.rmse_at_zero_deg_s},
+                                 {"determined", e.determined}};
+    if (!e.determined) j["time_offset_estimate"]["undetermined_reason"] = e.undetermined_reason;
   }
   j["bias"] = {{"source", to_string(bias_source)}};
   if (bias_source != BiasSource::None) j["bias"]["imu_frame_rad_s"] = vec_json(bias_imu_frame);

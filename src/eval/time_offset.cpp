@@ -6,10 +6,12 @@
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
+#include <regex>
 
 #include "inertialnet/eval/metrics.hpp"
 #include "inertialnet/eval/spline.hpp"
 #include "inertialnet/runtime/error.hpp"
+#include "inertialnet/runtime/excerpt.hpp"
 
 namespace inertialnet {
 
@@ -32,15 +34,30 @@ double centred_cost(const std::vector<Vec3>& predicted, const std::vector<Vec3>&
   return cost;
 }
 
+// Rotation below this RMS (rad/s, about 0.006 deg/s, far under any gyro's noise) is no motion:
+// the predictions of constant frames, or a zero gyro.
+constexpr double kNoMotionRadS = 1e-4;
+
+// RMS over the three axes of `values` after removing each axis's mean.
+double centred_rms(const std::vector<Vec3>& values) {
+  const std::vector<Vec3> zeros(values.size(), Vec3{0, 0, 0});
+  return std::sqrt(centred_cost(values, zeros) / (3.0 * static_cast<double>(values.size())));
+}
+
 }  // namespace
 
 std::string TimeOffsetEstimate::confidence() const {
+  if (!determined) return "none";
   if (at_range_edge || !std::isfinite(std_error_s) || contrast > 0.9) return "low";
   if (std_error_s < 0.002 && contrast < 0.5) return "high";
   return "medium";
 }
 
 std::string TimeOffsetEstimate::summary() const {
+  if (!determined) {
+    return "camera-IMU time offset not determined: " + undetermined_reason + " (" + std::to_string(pairs) +
+           " frame pairs)";
+  }
   char buf[320];
   std::snprintf(buf, sizeof buf,
                 "camera-IMU time offset %+.2f ms (t_imu = t_cam + offset) +- %.2f ms (1 sigma), confidence %s "
@@ -129,6 +146,34 @@ TimeOffsetEstimate estimate_time_offset(const std::vector<std::int64_t>& from, c
   const double n3 = 3.0 * static_cast<double>(pred.size());
   e.rmse_deg_s = std::sqrt(cost_min / n3) * kDegreesPerRadian;
   e.rmse_at_zero_deg_s = std::sqrt(cost[static_cast<std::size_t>(steps)] / n3) * kDegreesPerRadian;
+
+  // Whether the data fix an offset at all (see the header); the first reason that applies.
+  std::vector<Vec3> gyro(pred.size());
+  for (std::size_t i = 0; i < pred.size(); ++i) {
+    for (int k = 0; k < 3; ++k) gyro[i][k] = spline[k].mean(a[i], b[i]);
+  }
+  const auto not_determined = [&](const std::string& why) {
+    e.determined = false;
+    e.undetermined_reason = why;
+  };
+  char range[32];
+  std::snprintf(range, sizeof range, "%g", options.range_s);
+  if (!(centred_rms(pred) >= kNoMotionRadS)) {
+    not_determined("the predicted rates show no rotation (constant or textureless frames?), so the images carry no "
+                   "timing to align");
+  } else if (!(centred_rms(gyro) >= kNoMotionRadS)) {
+    not_determined("the gyro shows no rotation over these frames (a still platform or a zero gyro), so there is "
+                   "nothing to align with");
+  } else if (e.at_range_edge) {
+    not_determined(std::string("the best alignment lies on the edge of the +-") + range +
+                   " s search range; the offset may lie beyond it (widen the range)");
+  } else if (!std::isfinite(e.std_error_s)) {
+    not_determined("the alignment cost has no distinct minimum");
+  }
+  if (!e.determined) {
+    e.offset_s = 0;
+    e.std_error_s = std::numeric_limits<double>::infinity();
+  }
   return e;
 }
 
@@ -142,10 +187,13 @@ double parse_seconds(const std::string& text, const std::string& what) {
   } else if (t.size() > 1 && t.back() == 's') {
     t.pop_back();
   }
-  char* end = nullptr;
-  const double v = std::strtod(t.c_str(), &end);
-  if (t.empty() || *end != '\0' || !std::isfinite(v)) {
-    throw invalid_input(what + " should be a number of seconds (e.g. 0.04 or 40ms), found \"" + text + "\".");
+  // Decimal only: strtod alone would also read "0x10" as 16 s, "inf" and "nan".
+  static const std::regex decimal(R"(^[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?$)");
+  const bool is_decimal = std::regex_match(t, decimal);
+  const double v = is_decimal ? std::strtod(t.c_str(), nullptr) : 0.0;
+  if (!is_decimal || !std::isfinite(v) || std::abs(v * scale) > 1e6) {
+    throw invalid_input(what + " should be a number of seconds (e.g. 0.04 or 40ms), in decimal and at most 1e6 s, found \"" +
+                        excerpt(text) + "\".");
   }
   return v * scale;
 }

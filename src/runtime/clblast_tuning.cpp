@@ -86,16 +86,43 @@ std::string apply_clblast_tuning(const DeviceInfo& device) {
 
 namespace inertialnet::detail {
 
-std::vector<std::string> apply_clblast_parameters(const DeviceInfo& device, const ClblastParameters& parameters) {
+namespace {
+
+using KernelKey = std::pair<cl_device_id, std::string>;
+
+std::mutex& parameters_mutex() {
   static std::mutex mutex;
-  static std::map<std::pair<cl_device_id, std::string>, std::map<std::string, std::size_t>> last_applied;
-  std::lock_guard<std::mutex> lock(mutex);
+  return mutex;
+}
+// What apply_clblast_parameters applied last, per device and kernel family.
+std::map<KernelKey, std::map<std::string, std::size_t>>& last_applied() {
+  static std::map<KernelKey, std::map<std::string, std::size_t>> sets;
+  return sets;
+}
+// The set in use before apply_clblast_parameters first overrode it (the shipped table's or
+// CLBlast's database): what restore_clblast_parameters goes back to.
+std::map<KernelKey, std::unordered_map<std::string, std::size_t>>& before_override() {
+  static std::map<KernelKey, std::unordered_map<std::string, std::size_t>> sets;
+  return sets;
+}
+
+}  // namespace
+
+std::vector<std::string> apply_clblast_parameters(const DeviceInfo& device, const ClblastParameters& parameters) {
+  std::lock_guard<std::mutex> lock(parameters_mutex());
   std::vector<std::string> accepted;
   for (const auto& [kernel, values] : parameters) {
-    auto& last = last_applied[{device.device_id, kernel}];
+    auto& last = last_applied()[{device.device_id, kernel}];
     if (last == values) {
       accepted.push_back(kernel);
       continue;
+    }
+    if (!before_override().count({device.device_id, kernel})) {
+      std::unordered_map<std::string, std::size_t> current;
+      if (clblast::RetrieveParameters(device.device_id, kernel, clblast::Precision::kSingle, current) ==
+          clblast::StatusCode::kSuccess) {
+        before_override()[{device.device_id, kernel}] = std::move(current);
+      }
     }
     const std::unordered_map<std::string, std::size_t> map(values.begin(), values.end());
     const auto status = clblast::OverrideParameters(device.device_id, kernel, clblast::Precision::kSingle, map);
@@ -109,6 +136,17 @@ std::vector<std::string> apply_clblast_parameters(const DeviceInfo& device, cons
     accepted.push_back(kernel);
   }
   return accepted;
+}
+
+bool restore_clblast_parameters(const DeviceInfo& device, const std::string& kernel) {
+  std::lock_guard<std::mutex> lock(parameters_mutex());
+  auto& last = last_applied()[{device.device_id, kernel}];
+  const auto before = before_override().find({device.device_id, kernel});
+  if (last.empty() || before == before_override().end()) return false;
+  const auto status = clblast::OverrideParameters(device.device_id, kernel, clblast::Precision::kSingle, before->second);
+  if (status != clblast::StatusCode::kSuccess) return false;
+  last.clear();
+  return true;
 }
 
 std::map<std::string, std::size_t> current_clblast_parameters(const DeviceInfo& device, const std::string& kernel) {

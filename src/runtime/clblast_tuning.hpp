@@ -49,6 +49,12 @@ using ClblastParameters = std::map<std::string, std::map<std::string, std::size_
 // Returns the kernel families CLBlast accepted; a refused set is reported on stderr and left out.
 std::vector<std::string> apply_clblast_parameters(const DeviceInfo& device, const ClblastParameters& parameters);
 
+// Undoes apply_clblast_parameters for `kernel` on `device`: the set in use before its first
+// override (the shipped table's, or CLBlast's database) applies again. For a stored set that
+// CLBlast accepted but cannot compile (ops/gemm.cpp falls back to the defaults). Returns whether
+// there was an override to undo.
+bool restore_clblast_parameters(const DeviceInfo& device, const std::string& kernel);
+
 // The parameters CLBlast uses for `kernel` on `device` now (its database, or the last override).
 std::map<std::string, std::size_t> current_clblast_parameters(const DeviceInfo& device, const std::string& kernel);
 

@@ -1,10 +1,12 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdlib>
+#include <limits>
 #include <sstream>
 
 #include "inertialnet/runtime/device_selection.hpp"
 #include "inertialnet/runtime/error.hpp"
+#include "inertialnet/runtime/excerpt.hpp"
 
 namespace inertialnet {
 
@@ -25,8 +27,16 @@ std::string trim(std::string_view text) {
 }
 
 bool is_number(std::string_view text) {
-  return !text.empty() && text.size() <= 6 &&
-         std::all_of(text.begin(), text.end(), [](unsigned char c) { return std::isdigit(c); });
+  return !text.empty() && std::all_of(text.begin(), text.end(), [](unsigned char c) { return std::isdigit(c); });
+}
+
+// An index of any length: one past any int is no device, which resolve() says as for any other
+// missing index (no machine has a billion devices, so the value is never taken for a real one).
+int index_value(const std::string& digits) {
+  const auto first = digits.find_first_not_of('0');
+  if (first == std::string::npos) return 0;
+  if (digits.size() - first > 9) return std::numeric_limits<int>::max();
+  return std::stoi(digits.substr(first));
 }
 
 DeviceSpec parse_one(const std::string& text) {
@@ -40,19 +50,19 @@ DeviceSpec parse_one(const std::string& text) {
     spec.type = key == "cpu" ? DeviceType::CPU : key == "gpu" ? DeviceType::GPU : DeviceType::Accelerator;
   } else if (is_number(key)) {
     spec.kind = DeviceSpec::Kind::Index;
-    spec.index = std::stoi(key);
+    spec.index = index_value(key);
   } else if (const auto colon = key.find(':'); colon != std::string::npos) {
     const std::string platform = key.substr(0, colon);
     const std::string device = key.substr(colon + 1);
     if (!is_number(platform) || !is_number(device)) {
-      throw invalid_input("device spec '" + text +
+      throw invalid_input("device spec '" + excerpt(text) +
                           "' is not of the form P:D with two non-negative numbers (e.g. 0:1)");
     }
     spec.kind = DeviceSpec::Kind::PlatformDevice;
-    spec.platform = std::stoi(platform);
-    spec.device = std::stoi(device);
+    spec.platform = index_value(platform);
+    spec.device = index_value(device);
   } else if (key.front() == '-' || std::isdigit(static_cast<unsigned char>(key.front()))) {
-    throw invalid_input("device spec '" + text + "' is not a device index (a non-negative number)");
+    throw invalid_input("device spec '" + excerpt(text) + "' is not a device index (a non-negative number)");
   } else {
     spec.kind = DeviceSpec::Kind::Name;
     spec.name = key;
@@ -71,6 +81,13 @@ DeviceSpec parse_one(const std::string& text) {
             << format_device_table(devices);
   }
   throw invalid_input(message.str());
+}
+
+// " (there are 3 devices, 0 to 2)" for a message about a missing index.
+std::string device_count(const std::vector<DeviceInfo>& devices) {
+  if (devices.empty()) return " (there are no devices)";
+  if (devices.size() == 1) return " (there is 1 device, index 0)";
+  return " (there are " + std::to_string(devices.size()) + " devices, 0 to " + std::to_string(devices.size() - 1) + ")";
 }
 
 std::vector<DeviceInfo> resolve(const DeviceSpec& spec, const std::vector<DeviceInfo>& devices) {
@@ -92,12 +109,12 @@ std::vector<DeviceInfo> resolve(const DeviceSpec& spec, const std::vector<Device
       for (const auto& d : devices) {
         if (d.index == spec.index) return {d};
       }
-      fail("There is no device with index " + std::to_string(spec.index), devices);
+      fail("There is no device with index " + excerpt(spec.text) + device_count(devices), devices);
     case Kind::PlatformDevice:
       for (const auto& d : devices) {
         if (d.platform_index == spec.platform && d.device_index == spec.device) return {d};
       }
-      fail("There is no device " + spec.text, devices);
+      fail("There is no device " + excerpt(spec.text) + device_count(devices), devices);
     case Kind::Type:
       for (const auto& d : devices) {
         if (d.type == spec.type) return {d};
@@ -114,10 +131,10 @@ std::vector<DeviceInfo> resolve(const DeviceSpec& spec, const std::vector<Device
           matches.push_back(d);
         }
       }
-      if (matches.empty()) fail("No device or platform name contains '" + spec.text + "'", devices);
+      if (matches.empty()) fail("No device or platform name contains '" + excerpt(spec.text) + "'", devices);
       for (const auto& m : matches) {
         if (m.name != matches.front().name || m.platform_name != matches.front().platform_name) {
-          fail("Device spec '" + spec.text + "' is ambiguous: it matches " + std::to_string(matches.size()) +
+          fail("Device spec '" + excerpt(spec.text) + "' is ambiguous: it matches " + std::to_string(matches.size()) +
                    " different devices; use an index (N or P:D) or a longer name",
                devices);
         }
@@ -138,7 +155,7 @@ std::vector<DeviceSpec> parse_device_specs(std::string_view text) {
   while (start <= all.size()) {
     const auto comma = all.find(',', start);
     const std::string part = trim(std::string_view(all).substr(start, comma == std::string::npos ? std::string::npos : comma - start));
-    if (part.empty()) throw invalid_input("device spec '" + all + "' has an empty item");
+    if (part.empty()) throw invalid_input("device spec '" + excerpt(all) + "' has an empty item");
     specs.push_back(parse_one(part));
     if (comma == std::string::npos) break;
     start = comma + 1;
@@ -167,7 +184,7 @@ std::vector<DeviceInfo> select_devices(const std::string& spec, const std::vecto
 DeviceInfo select_device(const std::string& spec, const std::vector<DeviceInfo>& devices) {
   auto selected = select_devices(spec, devices);
   if (selected.size() > 1) {
-    fail("Device spec '" + spec + "' selects " + std::to_string(selected.size()) +
+    fail("Device spec '" + excerpt(spec) + "' selects " + std::to_string(selected.size()) +
              " devices, but this command runs on one device",
          devices);
   }

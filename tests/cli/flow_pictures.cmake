@@ -58,3 +58,28 @@ expect_match("neither a Middlebury .flo file")
 run(2 ${CLI} viz ${first})
 expect_match("not a KITTI flow PNG")
 run(2 ${CLI} viz dis.flo --max-magnitude 2 --shared-scale)
+
+# 4. Two outputs that are one file, or an output that is an input, are refused before any work
+#    (issue 20, item 9): exit 2, both named, nothing overwritten.
+file(MAKE_DIRECTORY "${WORK}/other")
+file(COPY_FILE "${WORK}/dis.flo" "${WORK}/other/dis.flo")
+file(SHA256 "${WORK}/pictures/dis_color.png" before)
+run(2 ${CLI} viz dis.flo other/dis.flo -o pictures)
+expect_match("the picture of dis.flo and the picture of other/dis.flo name one file")
+file(SHA256 "${WORK}/pictures/dis_color.png" after)
+if(NOT before STREQUAL after)
+  message(FATAL_ERROR "viz rewrote pictures/dis_color.png although it refused")
+endif()
+file(COPY_FILE "${WORK}/dis_kitti.png" "${WORK}/other/dis.png")
+run(2 ${CLI} viz other/dis.flo other/dis.png)  # .flo and KITTI .png of one stem
+expect_match("name one file \\(other/dis_color.png\\)")
+file(COPY_FILE "${WORK}/dis_kitti.png" "${WORK}/other/dis_color.png")
+run(2 ${CLI} viz other/dis.flo ./other/../other/dis_color.png)  # an input that is an output
+expect_match("the picture of other/dis.flo \\(other/dis_color.png\\) would overwrite the input ./other/../other/dis_color.png")
+run(2 ${CLI} flow ${first} ${second} -o same.png --png ./same.png)
+expect_match("-o and --png name one file")
+file(CREATE_LINK "${WORK}/dis.png" "${WORK}/link.png" SYMBOLIC)
+run(2 ${CLI} flow ${first} ${second} --png dis.png --kitti link.png)
+expect_match("--png and --kitti name one file \\(dis.png and link.png\\)")
+run(2 ${CLI} flow ${first} ${second} --kitti ${second})
+expect_match("--kitti \\(.*\\) would overwrite the input")

@@ -79,3 +79,50 @@ file(WRITE "${stored}" "{\"schema\": \"inertialnet.tu")
 run(0 ${CLI} tune --show)
 expect_match("warning: ignoring the tuning file .*cache/tuning/")
 expect_match("no tuning stored")
+
+# 5. Damaged CLBlast parameters (issue 20, item 6): CLBlast takes any full set and only fails when
+#    it compiles, which broke every CLBlast run. They are checked when read: one warning naming the
+#    file and the key in our words, and a CLBlast run goes on with the defaults.
+set(xgemm [=[{"GEMMK": 0, "KREG": 1, "KWG": 16, "KWI": 2, "MDIMA": 16, "MDIMC": 8, "MWG": 128, "NDIMB": 32,
+  "NDIMC": 16, "NWG": 128, "SA": 0, "SB": 0, "STRM": 1, "STRN": 1, "VWM": 3, "VWN": 4}]=])
+string(JSON damaged SET "${doc}" clblast parameters "${xgemm}")
+file(WRITE "${stored}" "${damaged}")
+run(0 ${CLI} --plan clblast bench --model FlowNet2-C --size 64x64 --pairs 1)
+expect_match("warning: ignoring the tuning file .*cache/tuning/.*VWM is 3")
+expect_no_match("json\\.exception")
+expect_no_match("OpenCL compiler")
+string(JSON damaged SET "${doc}" clblast parameters "{\"MWG\": -1}")
+file(WRITE "${stored}" "${damaged}")
+run(0 ${CLI} tune --show)
+expect_match("'clblast.parameters.MWG' should be a whole number")
+expect_no_match("json\\.exception")
+
+# 6. `tune --show` does not present a stored value the packed GEMM does not support as applied.
+string(JSON unsupported SET "${doc}" packed parameters MR 3)
+file(WRITE "${stored}" "${unsupported}")
+run(0 ${CLI} tune --show)
+expect_match("not applied: packed MR=3 \\(MR takes 1, 2, 4")
+expect_no_match("\napplied: [^\n]*MR=3")
+
+# 7. Frame sizes too small to tune on are refused before anything is measured or stored.
+file(WRITE "${stored}" "${doc}")
+run(2 ${CLI} tune --quick --size 1x1)
+expect_match("tune --size 1x1: too small to tune on")
+file(READ "${stored}" after)
+if(NOT after STREQUAL doc)
+  message(FATAL_ERROR "tune --size 1x1 replaced ${stored}")
+endif()
+
+# 8. A cache folder that cannot be written: said so, naming it, and no exit 0 with nothing stored
+#    (a path under a regular file: unwritable even for root). $INERTIALNET_CACHE_DIR is the
+#    user's choice, so exit 2; --no-cache stays a note with exit 0.
+file(WRITE "${WORK}/not-a-folder" "")
+set(ENV{INERTIALNET_CACHE_DIR} "${WORK}/not-a-folder/cache")
+run(2 ${CLI} tune --quick)
+expect_match("the cache folder .*not-a-folder/cache cannot be written")
+expect_no_match("--no-cache\\)")
+set(ENV{INERTIALNET_NO_CACHE} 1)
+run(0 ${CLI} tune --quick)
+expect_match("the disk cache is off \\(INERTIALNET_NO_CACHE\\): nothing was stored")
+unset(ENV{INERTIALNET_NO_CACHE})
+set(ENV{INERTIALNET_CACHE_DIR} "${WORK}/cache")

@@ -125,7 +125,9 @@ TEST_F(TimeOffset, StillCameraHasLowConfidenceAndBadInputsAreRefused) {
     to.push_back(s.frames[k].t_ns);
     w.push_back({k % 2 ? 0.01 : -0.01, 0, 0});
   }
-  EXPECT_EQ(estimate_time_offset(from, to, w, s.imu).confidence(), "low");
+  const TimeOffsetEstimate still_estimate = estimate_time_offset(from, to, w, s.imu);
+  EXPECT_FALSE(still_estimate.determined) << still_estimate.summary();
+  EXPECT_EQ(still_estimate.confidence(), "none");
   EXPECT_THROW(estimate_time_offset(from, to, {}, s.imu), Error);
   TimeOffsetOptions wide;
   wide.range_s = 100;
@@ -133,6 +135,73 @@ TEST_F(TimeOffset, StillCameraHasLowConfidenceAndBadInputsAreRefused) {
   EXPECT_NEAR(parse_seconds("40ms", "x"), 0.04, 1e-15);
   EXPECT_NEAR(parse_seconds("-0.0125", "x"), -0.0125, 1e-15);
   EXPECT_THROW(parse_seconds("soon", "x"), Error);
+}
+
+// Issue 20, item 9: constant frames (no predicted rotation) or a zero gyro fix no offset; the
+// estimate says so with the reason instead of a range edge or an infinite error to apply.
+TEST_F(TimeOffset, NoRotationOnEitherSideLeavesTheOffsetUndetermined) {
+  std::vector<std::int64_t> from, to;
+  for (std::size_t k = 1; k < seq.frames.size(); ++k) {
+    from.push_back(seq.frames[k - 1].t_ns);
+    to.push_back(seq.frames[k].t_ns);
+  }
+  const std::vector<Vec3> constant_frames(from.size(), Vec3{0, 0, 0});
+  const TimeOffsetEstimate blind = estimate_time_offset(from, to, constant_frames, seq.imu);
+  EXPECT_FALSE(blind.determined);
+  EXPECT_NE(blind.undetermined_reason.find("predicted rates show no rotation"), std::string::npos) << blind.summary();
+  EXPECT_NE(blind.summary().find("not determined"), std::string::npos) << blind.summary();
+  EXPECT_EQ(blind.offset_s, 0.0);
+  EXPECT_EQ(blind.confidence(), "none");
+
+  std::vector<ImuSample> zero_gyro = seq.imu;
+  for (auto& sample : zero_gyro) sample.gyro = {0, 0, 0};
+  const RatesTable moving = inter_frame_rows(seq, fast_rate(), 0.04);
+  const TimeOffsetEstimate still = estimate_time_offset(from, to, moving.w, zero_gyro);
+  EXPECT_FALSE(still.determined);
+  EXPECT_NE(still.undetermined_reason.find("gyro shows no rotation"), std::string::npos) << still.summary();
+
+  // The true offset outside the searched range: the minimum is on the edge, not an answer.
+  TimeOffsetOptions narrow;
+  narrow.range_s = 0.01;
+  narrow.step_s = 0.001;
+  const TimeOffsetEstimate edge = estimate_time_offset(from, to, moving.w, seq.imu, narrow);
+  EXPECT_FALSE(edge.determined);
+  EXPECT_NE(edge.undetermined_reason.find("edge of the +-0.01 s search range"), std::string::npos) << edge.summary();
+
+  // The same data with the range around it: determined, as before.
+  EXPECT_TRUE(estimate_time_offset(from, to, moving.w, seq.imu).determined);
+
+  // eval --time-offset auto applies nothing it cannot determine, and says so.
+  EvalOptions options;
+  options.choose_target = true;
+  options.estimate_time_offset = true;
+  options.time_offset_search = narrow;
+  const EvalReport report = evaluate(moving, seq, options);
+  ASSERT_TRUE(report.time_offset_estimate.has_value());
+  EXPECT_FALSE(report.time_offset_estimate->determined);
+  EXPECT_EQ(report.time_offset_s, 0.0);
+  bool said = false;
+  for (const auto& n : report.notes) said = said || n.find("not determined") != std::string::npos;
+  EXPECT_TRUE(said);
+  EXPECT_NE(report.json().find("\"determined\": false"), std::string::npos) << report.json();
+}
+
+// Issue 20, item 9: only decimal seconds; a pasted number is not echoed whole.
+TEST(ParseSeconds, DecimalOnlyAndTheEchoIsCapped) {
+  EXPECT_NEAR(parse_seconds("4e-2", "x"), 0.04, 1e-15);
+  EXPECT_NEAR(parse_seconds(".5s", "x"), 0.5, 1e-15);
+  for (const char* text : {"0x10", "inf", "nan", "1e400", "0x1p4", "1e7"}) {
+    EXPECT_THROW(parse_seconds(text, "--time-offset"), Error) << text;
+  }
+  try {
+    parse_seconds(std::string(300, '9'), "--time-offset");
+    ADD_FAILURE() << "a 300-digit number was accepted";
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("--time-offset"), std::string::npos) << message;
+    EXPECT_EQ(message.find(std::string(41, '9')), std::string::npos) << message;
+    EXPECT_NE(message.find(std::string(40, '9') + "\xE2\x80\xA6"), std::string::npos) << message;
+  }
 }
 
 // One file in the body frame, compared in the body frame and in the camera frame: the errors are

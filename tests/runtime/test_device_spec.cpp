@@ -108,6 +108,33 @@ TEST(DeviceSelect, UnknownSpecsListTheDevices) {
   }
 }
 
+// Issue 20, item 9: an index of any length is an index ("1234567" was "not a device index"), and
+// the message says how many devices there are; a pasted 300-character spec is not echoed whole.
+TEST(DeviceSelect, ALargeIndexIsAMissingDeviceAndLongSpecsAreCut) {
+  for (const char* spec : {"1234567", "99999999999999999999", "0:1234567"}) {
+    try {
+      select_devices(spec, machine());
+      FAIL() << spec << " selected something";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::InvalidInput);
+      const std::string message = e.what();
+      EXPECT_NE(message.find(std::string("There is no device ") + (spec[1] == ':' ? "" : "with index ") + spec),
+                std::string::npos)
+          << message;
+      EXPECT_NE(message.find("there are 4 devices, 0 to 3"), std::string::npos) << message;
+    }
+  }
+  const std::string long_spec(300, '7');
+  try {
+    select_devices(long_spec + "x", machine());
+    FAIL() << "a 301-character spec selected something";
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    EXPECT_EQ(message.find(std::string(41, '7')), std::string::npos) << message;
+    EXPECT_NE(message.find(std::string(40, '7') + "\xE2\x80\xA6"), std::string::npos) << message;
+  }
+}
+
 TEST(DeviceSelect, NameMatchingDifferentDevicesIsAmbiguous) {
   // "i" occurs in every name here; "a" in NVIDIA and in Arc.
   try {

@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "common.hpp"
 #include "console.hpp"
 #include "input_options.hpp"
 #include "inertialnet/eval/evaluate.hpp"
@@ -86,6 +87,14 @@ Command register_calibrate_time(CLI::App& app, const GlobalOptions& global) {
     const EvalReport report = evaluate(rates, seq, options);
     const TimeOffsetEstimate& e = *report.time_offset_estimate;
     std::cout << e.summary() << "\n";
+    if (!e.determined) {
+      // No number to apply: a range edge or an infinitely uncertain offset is not an estimate.
+      std::cout << "confidence none\n";
+      for (const auto& w : report.warnings) warning(w);
+      flush_standard_output();
+      throw runtime_error("the camera-IMU time offset is not determined: " + e.undetermined_reason +
+                          "; nothing to apply");
+    }
     if (options.input.camera_imu && options.input.camera_imu->timeshift_cam_imu_s) {
       std::printf("the camchain states timeshift_cam_imu %+.3f ms (same sign: t_imu = t_cam + shift)\n",
                   *options.input.camera_imu->timeshift_cam_imu_s * 1e3);

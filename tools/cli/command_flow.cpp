@@ -78,6 +78,7 @@ Command register_flow(CLI::App& app, const GlobalOptions& global) {
   app.add_option("--kitti", o->kitti, "write the flow as a KITTI 16-bit flow PNG (folders created as needed)");
   app.add_flag("--profile", o->profile, "print the device time of every layer (after one warm-up run)");
   return [o, &global]() {
+    check_distinct_outputs({{o->flo, "-o"}, {o->png, "--png"}, {o->kitti, "--kitti"}}, {o->image1, o->image2});
     const HostImage first = load_rgb_image(o->image1);
     const HostImage second = load_rgb_image(o->image2);
     if (first.width != second.width || first.height != second.height) {

@@ -15,9 +15,13 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cerrno>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -30,6 +34,7 @@
 #include "inertialnet/models/gemm_shapes.hpp"
 #include "inertialnet/ops/clblast_gemm_tuner.hpp"
 #include "inertialnet/ops/gemm_backend.hpp"
+#include "inertialnet/ops/gemm_packed.hpp"
 #include "inertialnet/ops/gemm_packed_search.hpp"
 #include "inertialnet/runtime/device_tuning.hpp"
 #include "inertialnet/runtime/error.hpp"
@@ -66,9 +71,21 @@ struct TuneSetup {
   int runs;
 };
 
+// The smallest frame side tuned. The network pads a frame to its 64-pixel grid
+// (models/gemm_shapes.cpp), so below 32 pixels a side most of what would be timed is padding, and
+// parameters found on it would replace the stored tuning of every later run (issue 20, item 9:
+// `--size 1x1` did).
+constexpr std::int64_t kMinimumTuneSide = 32;
+
 TuneSetup tune_setup(const TuneOptions& o) {
   const ModelKind kind = model_kind_from_string(o.model);
   const auto [width, height] = parse_size(o.size.empty() ? (o.quick ? "256x192" : "512x384") : o.size);
+  if (width < kMinimumTuneSide || height < kMinimumTuneSide) {
+    throw invalid_input("tune --size " + std::to_string(width) + "x" + std::to_string(height) +
+                        ": too small to tune on; at least " + std::to_string(kMinimumTuneSide) +
+                        " pixels a side, below which the timed frame is mostly padding (default 512x384, 256x192 "
+                        "with --quick)");
+  }
   return {kind, width, height, heaviest_gemm_shapes(model_gemm_shapes(kind, width, height), o.quick ? 2 : 6),
           o.quick ? 1 : 3};
 }
@@ -85,7 +102,29 @@ int show(Device& device, bool json) {
   } else {
     std::cout << "tuning file: " << file.string() << "\n";
   }
-  std::cout << "applied: " << (device.gemm_tuning().empty() ? "CLBlast's defaults" : device.gemm_tuning()) << "\n";
+  std::string applied = device.gemm_tuning().empty() ? "CLBlast's defaults" : device.gemm_tuning();
+  // The packed GEMM runs its default for a stored value it does not support
+  // (packed_gemm_setting); say so where the device's description lists the stored value.
+  std::vector<std::string> not_applied;
+  for (const auto& [name, value] : tuning.packed) {
+    const auto known = std::find_if(packed_gemm_parameters().begin(), packed_gemm_parameters().end(),
+                                    [&](const PackedGemmParameter& p) { return name == p.name; });
+    std::string why;
+    if (known == packed_gemm_parameters().end()) {
+      why = "the packed GEMM has no parameter " + name;
+    } else if (std::find(known->candidates.begin(), known->candidates.end(), value) == known->candidates.end()) {
+      std::string values;
+      for (const int c : known->candidates) values += (values.empty() ? "" : ", ") + std::to_string(c);
+      why = name + " takes " + values + "; the default " + name + "=" + std::to_string(known->default_value) + " runs";
+    } else {
+      continue;
+    }
+    const std::string token = " " + name + "=" + std::to_string(value);
+    if (const auto at = applied.find(token); at != std::string::npos) applied.erase(at, token.size());
+    not_applied.push_back("packed " + name + "=" + std::to_string(value) + " (" + why + ")");
+  }
+  std::cout << "applied: " << applied << "\n";
+  for (const auto& line : not_applied) std::cout << "not applied: " << line << "\n";
   return 0;
 }
 
@@ -209,7 +248,38 @@ nlohmann::json search_clblast(const GlobalOptions& global, const TuneOptions& o,
   return clblast;
 }
 
+// Whether the user turned the disk cache off (--no-cache, $INERTIALNET_NO_CACHE): then `tune`
+// measures and stores nothing, as asked.
+std::string cache_turned_off(const GlobalOptions& global) {
+  if (global.no_cache) return "--no-cache";
+  if (disk_cache_turned_off_by_environment()) return std::string(kNoCacheEnvironmentVariable);
+  return {};
+}
+
+// Checked before the search (minutes): a cache folder that cannot be written would leave the
+// result nowhere, and `tune` storing nothing must not end in exit 0. A folder the user chose
+// ($INERTIALNET_CACHE_DIR) is their input (exit 2); the default one a runtime failure (exit 1).
+void check_tuning_destination(Device& device, const GlobalOptions& global) {
+  if (!cache_turned_off(global).empty()) return;
+  const std::filesystem::path folder = device_tuning_file(device.info(), device.programs().directory()).parent_path();
+  std::error_code error;
+  if (device.programs().disk_cache_enabled()) {
+    std::filesystem::create_directories(folder, error);
+    if (!error && std::filesystem::is_directory(folder, error) && ::access(folder.c_str(), W_OK) == 0) return;
+  } else {
+    std::filesystem::create_directories(device.programs().directory(), error);
+  }
+  const std::string reason = error ? error.message() : std::string(std::strerror(errno));
+  const char* chosen = std::getenv(kCacheDirEnvironmentVariable);
+  const std::string message = "the cache folder " + device.programs().directory().string() +
+                              " cannot be written (" + reason + "), so the tuning could not be stored. Set " +
+                              kCacheDirEnvironmentVariable + " to a writable folder, or pass --no-cache to only measure.";
+  if (chosen && *chosen) throw invalid_input(message);
+  throw runtime_error(message);
+}
+
 int tune(Device& device, const GlobalOptions& global, const TuneOptions& o) {
+  check_tuning_destination(device, global);
   const TuneSetup setup = tune_setup(o);
   const ModelKind kind = setup.kind;
   const std::int64_t width = setup.width, height = setup.height;
@@ -263,7 +333,7 @@ int tune(Device& device, const GlobalOptions& global, const TuneOptions& o) {
     const auto file = store_device_tuning(info, device.programs().directory(), text);
     std::cerr << "inertialnet: stored " << file.string() << "; later starts on this device apply it\n";
   } else {
-    std::cerr << "inertialnet: note: the disk cache is off (--no-cache): nothing was stored\n";
+    std::cerr << "inertialnet: note: the disk cache is off (" << cache_turned_off(global) << "): nothing was stored\n";
   }
   if (o.json) {
     std::cout << text;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "common.hpp"
 #include "inertialnet/io/flow_io.hpp"
 #include "inertialnet/runtime/error.hpp"
 
@@ -45,6 +46,11 @@ Command register_viz(CLI::App& app, const GlobalOptions&) {
   app.add_flag("--shared-scale", o->shared_scale, "one scale for all files: the largest flow among them")
       ->excludes(fixed);
   return [o]() {
+    // Two inputs of one stem (a/x.flo and b/x.flo with -o, or x.flo beside a KITTI x.png) would
+    // write one picture twice, and an input named <stem>_color.png would be overwritten.
+    std::vector<OutputPath> outputs;
+    for (const auto& input : o->inputs) outputs.push_back({output_for(input, o->output_dir).string(), "the picture of " + input});
+    check_distinct_outputs(outputs, o->inputs);
     std::vector<FlowField> flows;
     float shared = 0;
     for (const auto& input : o->inputs) {

@@ -1,5 +1,8 @@
 #include "common.hpp"
 
+#include <sys/stat.h>
+
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -10,6 +13,7 @@
 #include "inertialnet/runtime/device_selection.hpp"
 #include "inertialnet/models/parameters.hpp"
 #include "inertialnet/runtime/error.hpp"
+#include "inertialnet/runtime/excerpt.hpp"
 #include "console.hpp"
 #include "suggest.hpp"
 
@@ -28,12 +32,12 @@ std::pair<std::int64_t, std::int64_t> parse_size(const std::string& text) {
   static const std::regex pattern("^([0-9]+)(?:x|X|\xC3\x97)([0-9]+)$");
   std::smatch m;
   if (!std::regex_match(text, m, pattern)) {
-    throw invalid_input("size '" + text + "' is not of the form WIDTHxHEIGHT (e.g. 752x480)");
+    throw invalid_input("size '" + excerpt(text) + "' is not of the form WIDTHxHEIGHT (e.g. 752x480)");
   }
   auto dimension = [&](const std::string& digits) -> std::int64_t {
     const auto first = digits.find_first_not_of('0');
     if (first == std::string::npos || digits.size() - first > 5) {
-      throw invalid_input("size '" + text + "': width and height must be from 1 to 99999 pixels");
+      throw invalid_input("size '" + excerpt(text) + "': width and height must be from 1 to 99999 pixels");
     }
     return std::stoll(digits);
   };
@@ -95,6 +99,62 @@ void prepare_output_file(const std::string& path, const std::string& option) {
     throw invalid_input(option + " " + path + ": cannot create the folder " + parent.string() + " (" +
                         (error ? error.message() : std::string("it exists and is not a folder")) + ").");
   }
+}
+
+namespace {
+
+// What identifies the file `path` names: device and inode for one that exists (links and hard
+// links resolved), else its absolute path with the existing part's links resolved.
+std::string file_identity(const std::string& path) {
+  struct stat info {};
+  if (::stat(path.c_str(), &info) == 0) {
+    return "inode " + std::to_string(info.st_dev) + ":" + std::to_string(info.st_ino);
+  }
+  std::error_code error;
+  const std::filesystem::path resolved = std::filesystem::weakly_canonical(std::filesystem::absolute(path, error), error);
+  return "path " + (error ? std::filesystem::absolute(path).lexically_normal().string() : resolved.string());
+}
+
+}  // namespace
+
+void check_distinct_outputs(const std::vector<OutputPath>& outputs, const std::vector<std::string>& inputs) {
+  std::vector<std::pair<std::string, const OutputPath*>> seen;
+  for (const OutputPath& output : outputs) {
+    if (output.path.empty()) continue;
+    const std::string identity = file_identity(output.path);
+    for (const std::string& input : inputs) {
+      if (file_identity(input) == identity) {
+        throw invalid_input(output.option + " (" + output.path + ") would overwrite the input " + input +
+                            "; choose another output.");
+      }
+    }
+    for (const auto& [other_identity, other] : seen) {
+      if (other_identity == identity) {
+        const std::string both = other->path == output.path ? output.path : other->path + " and " + output.path;
+        throw invalid_input(other->option + " and " + output.option + " name one file (" + both +
+                            "): one would overwrite the other; give each its own file.");
+      }
+    }
+    seen.emplace_back(identity, &output);
+  }
+}
+
+std::string excerpt_long_numbers(const std::string& text) {
+  const auto numeric = [](char c) {
+    return std::isdigit(static_cast<unsigned char>(c)) || c == '.' || c == 'e' || c == 'E' || c == '+' || c == '-';
+  };
+  std::string out;
+  for (std::size_t i = 0; i < text.size();) {
+    if (!numeric(text[i])) {
+      out += text[i++];
+      continue;
+    }
+    std::size_t end = i;
+    while (end < text.size() && numeric(text[end])) ++end;
+    out += excerpt(text.substr(i, end - i));
+    i = end;
+  }
+  return out;
 }
 
 void flush_standard_output() {

@@ -41,6 +41,26 @@ std::vector<std::string> model_names();
 void prepare_output_file(const std::string& path, const std::string& option);
 void prepare_output_folder(const std::string& path, const std::string& option);
 
+// One output a command is about to write: its path and the option that named it ("-o", "--png").
+struct OutputPath {
+  std::string path;
+  std::string option;
+};
+
+// One rule for every command with several outputs: refuses (invalid_input, exit 2) two outputs
+// that are one file, and an output that is one of `inputs` (a file or folder the command reads),
+// before any work. Paths are compared as the file system resolves them: "./a.png", "dir/../a.png",
+// a symbolic link to a.png and a hard link of it all name a.png; outputs that do not exist yet
+// are compared by their absolute path with links in existing parent folders resolved. Outputs
+// with an empty path (not requested) are skipped. The message names both options and the path.
+void check_distinct_outputs(const std::vector<OutputPath>& outputs, const std::vector<std::string>& inputs);
+
+// `text` with every number in it longer than 40 characters (a run of digits, '.', 'e', 'E', '+',
+// '-') cut to its first 40 and "…" (runtime/excerpt.hpp): for messages written by others (CLI11's
+// "--frames: Value 999… not in range") that quote a pasted 300-digit value whole. Paths and words
+// are left alone.
+std::string excerpt_long_numbers(const std::string& text);
+
 // Pushes what is buffered for standard output to it; runtime_error when it cannot be written
 // (a full disk, a closed pipe, /dev/full), so that no command reports success with its output lost.
 void flush_standard_output();

@@ -1,26 +1,41 @@
 #include "input_options.hpp"
 
 #include <cmath>
+#include <regex>
 #include <sstream>
 
 #include "inertialnet/io/camera_imu.hpp"
 #include "inertialnet/runtime/error.hpp"
+#include "inertialnet/runtime/excerpt.hpp"
 
 namespace inertialnet::cli {
+
+namespace {
+
+// Whether `text` is written in decimal ("12", "-0.5", "4e-2"): strtold, under CLI11's
+// lexical_cast, also reads hexadecimal ("0x10" as 16) and "inf"/"nan".
+bool is_decimal(const std::string& text) {
+  static const std::regex decimal(R"(^[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?$)");
+  return std::regex_match(text, decimal);
+}
+
+}  // namespace
 
 CLI::Validator finite_positive_up_to(double limit, const char* unit) {
   return CLI::Validator(
       [limit, unit](std::string& text) {
         double value = 0;
         if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || !(value > 0)) {
-          return "must be a finite positive number, got " + text;
+          return "must be a finite positive number, got " + excerpt(text);
         }
+        if (!is_decimal(text)) return "must be written in decimal, got " + excerpt(text);
+        std::ostringstream s;
         if (value > limit) {
-          std::ostringstream s;
-          s << "must be at most " << limit << " " << unit << ", got " << text;
-          return s.str();
+          s << "must be at most " << limit << " " << unit << ", got " << excerpt(text);
+        } else if (value < kMinimumPositive) {
+          s << "must be at least " << kMinimumPositive << " " << unit << ", got " << excerpt(text);
         }
-        return std::string();
+        return s.str();
       },
       "POSITIVE");
 }
@@ -29,8 +44,11 @@ CLI::Validator finite_pixel_coordinate() {
   return CLI::Validator(
       [](std::string& text) {
         double value = 0;
-        if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value)) return "must be a finite number, got " + text;
-        if (std::abs(value) > 1e6) return "must be at most 1e+06 pixels from the origin, got " + text;
+        if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value)) {
+          return "must be a finite number, got " + excerpt(text);
+        }
+        if (!is_decimal(text)) return "must be written in decimal, got " + excerpt(text);
+        if (std::abs(value) > 1e6) return "must be at most 1e+06 pixels from the origin, got " + excerpt(text);
         return std::string();
       },
       "NUMBER");

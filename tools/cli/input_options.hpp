@@ -13,7 +13,12 @@
 namespace inertialnet::cli {
 
 // NaN passes "> 0" tests as false and was then taken for "not given": refuse it where it is read.
-// The upper bounds are far beyond any camera yet keep later products (fx·dt, 1/rate) finite.
+// The upper bounds are far beyond any camera yet keep later products (fx·dt, 1/rate) finite; the
+// lower bound of a positive quantity, kMinimumPositive (1e-6 Hz: a frame every 11.6 days), keeps
+// 1/rate in nanoseconds inside int64 (`--rate 1e-12` overflowed into a negative frame interval).
+// Decimal numbers only: the parser underneath (strtold) would also read "0x10" as 16. Messages
+// quote at most 40 characters of what was given (runtime/excerpt.hpp).
+inline constexpr double kMinimumPositive = 1e-6;
 CLI::Validator finite_positive_up_to(double limit, const char* unit);  // "must be a finite positive number, got …"
 CLI::Validator finite_pixel_coordinate();                              // within 1e6 pixels of the origin
 

@@ -87,6 +87,10 @@ int main(int argc, char** argv) {
     sub->footer(footer(sub->get_name()));
   }
 
+  // CLI11's own messages quote a value whole: a pasted 300-digit number is cut (issue 20, item 9).
+  app.failure_message([](const CLI::App* failed, const CLI::Error& e) {
+    return cli::excerpt_long_numbers(CLI::FailureMessage::simple(failed, e));
+  });
   try {
     app.parse(argc, argv);
   } catch (const CLI::Success& e) {  // --help, --help-all, --version

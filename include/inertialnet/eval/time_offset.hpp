@@ -19,6 +19,13 @@
 // sqrt(2σ² / c). `contrast` is cost_min over the median cost of the grid: near 0 for a sharp,
 // well-defined minimum, near 1 for a flat curve (a still camera carries no timing information).
 // An estimate at the edge of the range is flagged.
+//
+// Not determined: when the predictions show no rotation (constant or textureless frames), the
+// gyro shows none (a still platform or a zero gyro), the cost has no interior minimum (it lies on
+// the edge of the search range, where the true offset may lie beyond) or no curvature there, the
+// data cannot say when the camera's frames were taken. The estimate then says so
+// (`determined` false, `undetermined_reason` in words, offset_s 0, std_error_s infinite) rather
+// than offering a range edge or an infinitely uncertain value to apply (issue 20, item 9).
 #pragma once
 
 #include <cstddef>
@@ -44,8 +51,11 @@ struct TimeOffsetEstimate {
   std::size_t pairs = 0;       // frame pairs used
   double rmse_deg_s = 0;       // per-axis-mean-removed RMS residual at the estimate (over 3 axes)
   double rmse_at_zero_deg_s = 0;  // the same with no offset
+  bool determined = true;         // false: the data fix no offset; nothing to apply
+  std::string undetermined_reason;  // why not, in words ("the gyro shows no rotation …")
   std::string summary() const; // one line for reports
-  // A rough verdict: "high" (σ < 2 ms and contrast < 0.5), "low" (flat or at the edge), else "medium".
+  // A rough verdict: "none" (not determined), "high" (σ < 2 ms and contrast < 0.5), "low" (flat),
+  // else "medium".
   std::string confidence() const;
 };
 
@@ -58,7 +68,9 @@ TimeOffsetEstimate estimate_time_offset(const std::vector<std::int64_t>& pairs_f
                                         const std::vector<Vec3>& predicted, const std::vector<ImuSample>& imu,
                                         const TimeOffsetOptions& options = {});
 
-// "0.04" (seconds) → 0.04; "40ms", "-12.5 ms" also accepted; throws invalid_input naming `what`.
+// "0.04" (seconds) → 0.04; "40ms", "-12.5 ms", "4e-2" also accepted. Decimal numbers only (no
+// "0x10", "inf" or "nan") of at most 1e6 s; anything else is invalid_input naming `what` and
+// quoting at most 40 characters of `text`.
 double parse_seconds(const std::string& text, const std::string& what);
 
 }  // namespace inertialnet

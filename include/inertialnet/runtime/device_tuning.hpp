@@ -19,10 +19,15 @@
 //                 "trials": [ { "MR", "PANELS_FIRST", "seconds" } ] } }
 //
 // The shipped CLBlast table (src/runtime/clblast_tuning.cpp) stays the default for a machine
-// class; a stored file wins where present. A file that does not parse, has another schema or
-// holds values of the wrong type is reported once on stderr and ignored (defaults apply); one
-// that names another device or driver is ignored silently (a copied cache). With the disk cache
-// off ($INERTIALNET_NO_CACHE, --no-cache) the file is neither read nor written.
+// class; a stored file wins where present. A file that does not parse, has another schema,
+// holds values of the wrong type or CLBlast parameters that CLBlast could not build (checked
+// when read: the full Xgemm set, its flags, vector widths and tile rules, the device's
+// work-group and local-memory limits; docs/performance.md) is reported once on stderr, naming
+// the file and the key in our words, and ignored (defaults apply); one that names another device
+// or driver is ignored silently (a copied cache). A set that passes the checks yet fails in
+// CLBlast is dropped by a probe before the first CLBlast call, or at any failing call
+// (ops/gemm.cpp). With the disk cache off
+// ($INERTIALNET_NO_CACHE, --no-cache) the file is neither read nor written.
 #pragma once
 
 #include <filesystem>
@@ -50,7 +55,8 @@ struct DeviceTuning {
 std::filesystem::path device_tuning_file(const DeviceInfo& device, const std::filesystem::path& cache_directory);
 
 // The parameters of a "inertialnet.tune/1" document, checked against `device`. nullopt for a
-// document of another device or driver; invalid_input naming the problem for anything malformed.
+// document of another device or driver; invalid_input naming the key and the problem for
+// anything malformed (never nlohmann's "[json.exception…]" text).
 std::optional<DeviceTuning> parse_device_tuning(const std::string& document, const DeviceInfo& device);
 
 // The stored file of `device`, if there is one that applies. A malformed file gives a warning on
