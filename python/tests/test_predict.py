@@ -99,3 +99,22 @@ def test_devices_and_selection():
     assert devices and {"index", "address", "name", "platform", "type"} <= set(devices[0])
     assert inertialnet.select_devices("0")[0]["index"] == 0
     assert inertialnet.Device("0").name == devices[0]["name"]
+
+
+def test_a_frame_without_texture_costs_its_pairs_not_the_run(cli, tmp_path):
+    """Every pair has a row: a uniform frame makes its two pairs `no_texture` with NaN rates, as
+    in the CLI's CSV, and evaluate() leaves them out (it used to end predict() with an error)."""
+    out = tmp_path / "flat"
+    assert inertialnet.synth(out, frames=6, width=128, height=96, seed=7) == 6
+    frames = sorted((out / "mav0" / "cam0" / "data").glob("*.png"))
+    # A binary PGM under the PNG's name: OpenCV reads an image by its content.
+    frames[3].write_bytes(b"P5\n128 96\n255\n" + bytes([128]) * (128 * 96))
+    rates = inertialnet.predict(out)
+    assert len(rates) == 5
+    assert list(rates["status"]) == ["ok", "ok", "no_texture", "no_texture", "ok"]
+    assert np.isnan(rates["wx"][2:4]).all() and np.isfinite(rates["wx"][[0, 1, 4]]).all()
+    header, expected = cli_rates(cli, out, tmp_path)
+    assert list(expected[:, header.index("status")]) == list(rates["status"])
+    report = inertialnet.evaluate(rates, out)["estimators"][0]
+    assert report["rows_not_ok"] == 2 and report["not_ok_by_status"] == {"no_texture": 2}
+    assert report["frames_evaluated"] == 3

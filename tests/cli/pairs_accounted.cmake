@@ -147,9 +147,9 @@ endif()
 
 # 5. -o never names an input: the sequence's own files, the weights.
 run(2 ${CLI} predict small -o small/mav0/cam0/data.csv)
-expect_match("is a file of the sequence small; refusing to replace an input")
+expect_match("-o small/mav0/cam0/data.csv is inside the sequence small \\(its mav0 folder, the recording itself\\)")
 run(2 ${CLI} predict small -w c.safetensors -w head.safetensors -o head.safetensors)
-expect_match("is the weights file head.safetensors")
+expect_match("-o \\(head.safetensors\\) would overwrite the input head.safetensors")
 
 # 6. kill -9 in the middle of a run (kill_during_predict.py says what it checks).
 run(0 ${PYTHON} ${CMAKE_CURRENT_LIST_DIR}/kill_during_predict.py ${CLI} "${WORK}" "${WORK}/clean")

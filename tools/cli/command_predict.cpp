@@ -6,7 +6,6 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <algorithm>
 #include <memory>
 
 #include "commands.hpp"
@@ -84,36 +83,24 @@ void save_flow(const std::filesystem::path& folder, const std::string& format, s
   }
 }
 
-// -o must name something a rates CSV can go to, and never a file the run reads: the video, a
-// file of the sequence's folder (a EuRoC folder's cam0/data.csv, an image) or a weights file.
-// Checked before the weights load, so that a mistake costs nothing.
-void refuse_input_as_output(const std::string& output, const std::string& option, const std::string& sequence,
-                            const std::vector<std::string>& weights) {
+// -o must name something a rates CSV can go to (a file, or a FIFO or device it streams to), never a
+// file the run reads (docs/cli.md, "Output paths"). Checked before the weights load, so that a
+// mistake costs nothing.
+void check_predict_outputs(const PredictOptions& o) {
   namespace fs = std::filesystem;
   std::error_code ec;
-  const fs::file_status status = fs::status(output, ec);
-  if (fs::exists(status)) {
-    if (!fs::is_regular_file(status) && !fs::is_fifo(status) && !fs::is_character_file(status)) {
-      throw invalid_input(option + " " + output + ": it exists and is not a file; give the path of a rates CSV.");
-    }
-    const auto same = [&](const std::string& input) {
-      std::error_code e;
-      return fs::equivalent(output, input, e) && !e;
-    };
-    for (const auto& w : weights) {
-      if (same(w)) throw invalid_input(option + " " + output + " is the weights file " + w + "; refusing to replace an input.");
-    }
-    if (same(sequence)) throw invalid_input(option + " " + output + " is the sequence itself; refusing to replace an input.");
-    if (fs::is_directory(sequence, ec) && fs::is_regular_file(status)) {
-      const fs::path folder = fs::weakly_canonical(sequence, ec);
-      const fs::path file = fs::weakly_canonical(output, ec);
-      const auto [end, ignored] = std::mismatch(folder.begin(), folder.end(), file.begin(), file.end());
-      if (end == folder.end()) {
-        throw invalid_input(option + " " + output + " is a file of the sequence " + sequence +
-                            "; refusing to replace an input (write the rates next to the sequence, or give a new name).");
-      }
-    }
+  const fs::file_status status = fs::status(o.output, ec);
+  if (!o.output.empty() && fs::exists(status) && !fs::is_regular_file(status) && !fs::is_fifo(status) &&
+      !fs::is_character_file(status)) {
+    throw invalid_input("-o " + o.output + ": it exists and is not a file; give the path of a rates CSV.");
   }
+  const std::vector<OutputPath> outputs = {{o.output, "-o"}, {o.save_flow, "--save-flow"}};
+  check_outputs_outside_sequence(outputs, o.sequence);
+  std::vector<std::string> inputs = o.weights;
+  inputs.push_back(o.sequence);
+  check_distinct_outputs(outputs, inputs);
+  if (!o.save_flow.empty()) prepare_output_folder(o.save_flow, "--save-flow");
+  if (!o.output.empty()) prepare_output_file(o.output, "-o");
 }
 
 }  // namespace
@@ -189,12 +176,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
     settings.no_cache = global.no_cache;
     settings.keep_flow = !o->save_flow.empty();
     if (o->profile) settings.profiler = &profiler;
-    // Outputs are checked before the weights load and any pair is computed.
-    if (!o->save_flow.empty()) prepare_output_folder(o->save_flow, "--save-flow");
-    if (!o->output.empty()) {
-      prepare_output_file(o->output, "-o");
-      refuse_input_as_output(o->output, "-o", o->sequence, o->weights);
-    }
+    check_predict_outputs(*o);  // before the weights load and any pair is computed
     Prediction prediction(settings);
     for (const auto& note : prediction.notes()) info("note: " + note);
     if (const WeightSet* weights = prediction.weights()) warn_if_synthetic(*weights);

@@ -71,25 +71,13 @@ struct Output {
   std::string option;
 };
 
-// The path a file would be written at: symbolic links resolved (the atomic writer replaces the
-// file a link names), a missing tail kept as given.
-fs::path resolved(const fs::path& path) {
-  std::error_code ec;
-  const fs::path p = fs::weakly_canonical(fs::absolute(path, ec), ec);
-  return ec ? fs::absolute(path) : p;
-}
-
-bool inside(const fs::path& path, const fs::path& folder) {
-  const auto [f, p] = std::mismatch(folder.begin(), folder.end(), path.begin(), path.end());
-  return f == folder.end();
-}
-
 // The output rules of docs/cli.md, for every file train writes, before any work: missing folders
 // created; a target that exists and is not a regular file (a folder, a device node, a FIFO, a link
 // to nothing) refused; no output one of the inputs (a --weights file, anything in a sequence's
 // mav0 folder); no two outputs the same file.
 void check_outputs(const std::vector<Output>& outputs, const std::vector<std::string>& weights,
                    const std::vector<std::string>& sequences) {
+  std::vector<OutputPath> paths;
   for (const auto& out : outputs) {
     if (out.path.empty() || out.path.filename().empty()) {
       throw invalid_input(out.option + " '" + out.path.string() + "': expected a file name.");
@@ -107,29 +95,10 @@ void check_outputs(const std::vector<Output>& outputs, const std::vector<std::st
                           (fs::is_directory(target) ? "a folder" : "a device, FIFO or socket") +
                           "); refusing to replace it.");
     }
-    const fs::path at = resolved(out.path);
-    for (const auto& w : weights) {
-      if (fs::exists(w, ec) && at == resolved(w)) {
-        throw invalid_input(out.option + " " + out.path.string() + " is the weight file " + w +
-                            ", one of the inputs; refusing to overwrite it.");
-      }
-    }
-    for (const auto& root : sequences) {
-      const fs::path mav0 = fs::is_directory(fs::path(root) / "mav0", ec) ? fs::path(root) / "mav0" : fs::path(root);
-      if (fs::is_directory(mav0, ec) && inside(at, resolved(mav0))) {
-        throw invalid_input(out.option + " " + out.path.string() + " is inside the sequence " + root +
-                            " (its mav0 folder, the training inputs); refusing to write there.");
-      }
-    }
+    paths.push_back({out.path.string(), out.option});
   }
-  for (std::size_t i = 0; i < outputs.size(); ++i) {
-    for (std::size_t j = i + 1; j < outputs.size(); ++j) {
-      if (resolved(outputs[i].path) == resolved(outputs[j].path)) {
-        throw invalid_input(outputs[i].option + " and " + outputs[j].option + " both name " + outputs[j].path.string() +
-                            "; each output needs a file of its own.");
-      }
-    }
-  }
+  for (const auto& sequence : sequences) check_outputs_outside_sequence(paths, sequence);
+  check_distinct_outputs(paths, weights);
   // Only now, so that a refused output leaves no new folder behind (inside a sequence, say).
   for (const auto& out : outputs) prepare_output_file(out.path.string(), out.option);
 }

@@ -3,6 +3,7 @@
 #include <sys/stat.h>
 
 #include <cctype>
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -136,6 +137,29 @@ void check_distinct_outputs(const std::vector<OutputPath>& outputs, const std::v
       }
     }
     seen.emplace_back(identity, &output);
+  }
+}
+
+void check_outputs_outside_sequence(const std::vector<OutputPath>& outputs, const std::string& sequence) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::is_directory(sequence, ec)) return;  // a video: check_distinct_outputs covers it
+  const auto resolved = [](const fs::path& path) {
+    std::error_code e;
+    const fs::path p = fs::weakly_canonical(fs::absolute(path, e), e);
+    return e ? fs::absolute(path).lexically_normal() : p;
+  };
+  const fs::path mav0 = fs::path(sequence) / "mav0";
+  const bool euroc = fs::is_directory(mav0, ec);
+  const fs::path data = resolved(euroc ? mav0 : fs::path(sequence));
+  for (const OutputPath& output : outputs) {
+    if (output.path.empty()) continue;
+    const fs::path at = resolved(output.path);
+    const auto [end, ignored] = std::mismatch(data.begin(), data.end(), at.begin(), at.end());
+    if (end != data.end() || (!euroc && !fs::exists(at, ec))) continue;
+    throw invalid_input(output.option + " " + output.path + " is inside the sequence " + sequence +
+                        (euroc ? " (its mav0 folder, the recording itself)" : " (one of its files)") +
+                        "; refusing to write there.");
   }
 }
 

@@ -55,6 +55,12 @@ struct OutputPath {
 // with an empty path (not requested) are skipped. The message names both options and the path.
 void check_distinct_outputs(const std::vector<OutputPath>& outputs, const std::vector<std::string>& inputs);
 
+// Refuses (invalid_input, exit 2) an output inside a sequence's own data: anything under a EuRoC
+// sequence's mav0/ folder (its frames, data.csv, sensor.yaml, IMU), or an existing file in a
+// folder of images (a frame). An output beside the sequence, or a new file in an image folder,
+// is fine. The message names the option, the path and the sequence.
+void check_outputs_outside_sequence(const std::vector<OutputPath>& outputs, const std::string& sequence);
+
 // `text` with every number in it longer than 40 characters (a run of digits, '.', 'e', 'E', '+',
 // '-') cut to its first 40 and "…" (runtime/excerpt.hpp): for messages written by others (CLI11's
 // "--frames: Value 999… not in range") that quote a pasted 300-digit value whole. Paths and words
