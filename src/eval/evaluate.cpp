@@ -31,13 +31,13 @@ nlohmann::json stats_json(const ErrorStats& s) {
           {"rms_t_deg_s", {{"mean", s.rms_t_mean}, {"median", s.rms_t_median}, {"max", s.rms_t_max}}}};
 }
 
+}  // namespace
+
 std::filesystem::path histogram_path(const std::filesystem::path& plot) {
   std::filesystem::path p = plot;
   p.replace_filename(plot.stem().string() + "_hist" + plot.extension().string());
   return p;
 }
-
-}  // namespace
 
 EvalReport evaluate(const RatesTable& all_rates, const EurocSequence& seq, const EvalOptions& options) {
   all_rates.validate();

@@ -195,3 +195,13 @@ run(2 ${CLI} predict seq -o rates_folder.csv)
 expect_match("-o rates_folder.csv: it exists and is not a file")
 run(1 ${CLI} predict seq -o /dev/full)
 expect_match("Cannot write /dev/full: No space left on device")
+
+# eval --plot never replaces what eval reads: the rates file as the plot is refused before any
+# work, and the rates file is kept.
+file(READ "${WORK}/new/deeper/rates.csv" rates_before)
+run(2 ${CLI} eval new/deeper/rates.csv seq --plot new/deeper/rates.csv)
+expect_match("--plot \\(new/deeper/rates.csv\\) would overwrite the input new/deeper/rates.csv")
+file(READ "${WORK}/new/deeper/rates.csv" rates_after)
+if(NOT rates_after STREQUAL rates_before)
+  message(FATAL_ERROR "eval --plot onto its rates file changed it")
+endif()

@@ -12,6 +12,17 @@ function(run expect_code)
   set(output "${out}${err}" PARENT_SCOPE)
 endfunction()
 
+# run_json(<variable> <command>...): runs it (exit 0) and stores its standard output alone.
+function(run_json variable)
+  execute_process(COMMAND ${ARGN} WORKING_DIRECTORY "${WORK}" RESULT_VARIABLE code OUTPUT_VARIABLE out
+                  ERROR_VARIABLE err TIMEOUT 600)
+  message("$ ${ARGN}\n${out}${err}(exit ${code})")
+  if(NOT code EQUAL 0)
+    message(FATAL_ERROR "expected exit code 0, got ${code}")
+  endif()
+  set(${variable} "${out}" PARENT_SCOPE)
+endfunction()
+
 function(expect_match regex)
   if(NOT output MATCHES "${regex}")
     message(FATAL_ERROR "output does not match '${regex}'")

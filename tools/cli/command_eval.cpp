@@ -70,7 +70,16 @@ Command register_eval(CLI::App& app, const GlobalOptions&) {
     }
     options.input = imu_sequence_options(o->input);
     options.plot = o->plot;
-    if (!o->plot.empty()) prepare_output_file(o->plot, "--plot");
+    if (!o->plot.empty()) {
+      // The plot and its histogram beside it never replace what eval reads.
+      const std::string hist = histogram_path(o->plot).string();
+      std::vector<std::string> inputs = {o->rates, o->sequence};
+      for (const std::string& file : {o->input.imu, o->input.camchain}) {
+        if (!file.empty()) inputs.push_back(file);
+      }
+      check_distinct_outputs({{o->plot, "--plot"}, {hist, "--plot's histogram"}}, inputs);
+      prepare_output_file(o->plot, "--plot");
+    }
     // A CSV from `predict --head both` holds two estimators: without --head, report both.
     std::vector<std::string> suffixes;
     if (!o->head.empty()) {

@@ -132,6 +132,9 @@ struct EvalReport {
 inline constexpr const char* kEvalJsonSchema = "inertialnet.eval/1";
 std::string format_eval_json(const std::vector<EvalReport>& reports, bool include_series = false);
 
+// Where the histogram plot goes beside the rate plot `plot`: out.png → out_hist.png.
+std::filesystem::path histogram_path(const std::filesystem::path& plot);
+
 // Throws invalid_input when no rates row matches a frame with ground truth.
 EvalReport evaluate(const RatesTable& rates, const EurocSequence& sequence, const EvalOptions& options = {});
 // Reads both (the sequence with read_sequence_with_imu and options.input); the images themselves
