@@ -30,6 +30,28 @@ const char* kNoWeightsHelp =
     "`inertialnet weights --synthetic FlowNet2 -o flownet2.safetensors` and `inertialnet weights --synthetic "
     "InertialNetHead --size WxH -o head.safetensors`";
 
+// The first two consecutive frames of a fresh copy of the source that decode (a damaged frame 0 of a
+// recording costs its pairs, not the run), or the first frame's error when no two do. A fresh copy,
+// because a video decodes in order from its start and the pipeline starts at frame 0 again.
+std::pair<Frame, Frame> first_decodable_pair(const PredictSettings& s) {
+  auto source = open_frame_source(s.sequence, s.rate_hz > 0 ? std::optional<double>(s.rate_hz) : std::nullopt);
+  std::optional<Frame> previous;
+  std::optional<Error> first_error;
+  for (std::size_t i = 0; i < source->size(); ++i) {
+    try {
+      Frame frame{i, source->timestamp_ns(i), source->decode(i), {}};
+      if (previous) return {std::move(*previous), std::move(frame)};
+      previous = std::move(frame);
+    } catch (const Error& e) {
+      if (e.kind() != ErrorKind::InvalidInput) throw;
+      if (!first_error) first_error = e;
+      previous.reset();
+    }
+  }
+  if (first_error) throw *first_error;
+  throw invalid_input(source->description() + " has no two consecutive frames that decode");
+}
+
 }  // namespace
 
 Prediction::Prediction(const PredictSettings& s) : settings_(s) {
@@ -67,7 +89,7 @@ Prediction::Prediction(const PredictSettings& s) : settings_(s) {
     const bool given = s.fx > 0 || s.fy > 0;
     if (given) {
       CameraIntrinsics camera;
-      const HostImage first = source_->decode(0);
+      const HostImage first = first_decodable_pair(s).first.image;
       camera.width = first.width;
       camera.height = first.height;
       camera.fx = s.fx;
@@ -86,7 +108,7 @@ Prediction::Prediction(const PredictSettings& s) : settings_(s) {
       }
       // The geometric head allocates per pixel of the calibrated size: compare it with the
       // images before, so that a wrong resolution is a clear message, not gigabytes asked for.
-      const HostImage first = source_->decode(0);
+      const HostImage first = first_decodable_pair(s).first.image;
       if (first.width != processor_.camera->width || first.height != processor_.camera->height) {
         throw invalid_input(source_->description() + ": cam0/sensor.yaml gives the resolution " +
                             std::to_string(processor_.camera->width) + "x" + std::to_string(processor_.camera->height) +
@@ -167,10 +189,7 @@ std::vector<std::pair<std::string, std::string>> Prediction::csv_metadata() cons
 }
 
 void Prediction::warm_up(const std::function<void(const DeviceInfo& device, double seconds)>& report) {
-  auto source = open_frame_source(settings_.sequence,
-                                  settings_.rate_hz > 0 ? std::optional<double>(settings_.rate_hz) : std::nullopt);
-  const Frame first{0, source->timestamp_ns(0), source->decode(0), {}};
-  const Frame second{1, source->timestamp_ns(1), source->decode(1), {}};
+  const auto [first, second] = first_decodable_pair(settings_);
   const std::atomic<bool> keep_going{false};
   const auto factory = rates_processor(weights_of_, processor_);
   for (const auto& device : devices_) {

@@ -136,6 +136,23 @@ if(NOT count EQUAL 7)
   message(FATAL_ERROR "rates.csv.partial holds ${count} rows without an answer, expected 7")
 endif()
 
+# A damaged first frame costs pair 1 only: the camera's size comes from the first frames that
+# decode, with --fx and with a sensor.yaml alike, and the run goes on.
+run(0 ${CLI} synth first_bad --frames 5 --size 96x64 --seed 3)
+file(GLOB first_bad_frames "${WORK}/first_bad/mav0/cam0/data/*.png")
+list(SORT first_bad_frames)
+list(GET first_bad_frames 0 frame0)
+file(WRITE "${frame0}" "not an image")
+run(0 ${CLI} predict first_bad -o first_bad.csv --stats)
+expect_match("pair 1 \\(frames 0 → 1, [^\n]*decode_error: ")
+not_ok(first_bad.csv first_bad_rows)
+list(LENGTH first_bad_rows count)
+if(NOT count EQUAL 1)
+  message(FATAL_ERROR "first_bad.csv holds ${count} rows without an answer, expected 1 (pair 1)")
+endif()
+run(0 ${CLI} predict first_bad --fx 80)
+expect_match("1 of 4 pairs without an answer \\(decode_error 1\\)")
+
 # 5. -o never names an input: the sequence's own files, the weights.
 run(2 ${CLI} predict small -o small/mav0/cam0/data.csv)
 expect_match("-o small/mav0/cam0/data.csv is inside the sequence small \\(its mav0 folder, the recording itself\\)")
