@@ -467,11 +467,13 @@ std::string format_rates_row(const RatesLayout& layout, const RatesRow& row) {
     }
     return nullptr;
   };
-  for (const std::string* word : {&row.status}) {
-    if (!is_status_word(*word)) throw invalid_input("Rates row for timestamp " + std::to_string(row.t_ns) + ": \"" + word->substr(0, 64) + "\" is no status word.");
-  }
-  for (const auto& word : row.statuses) {
-    if (!is_status_word(word)) throw invalid_input("Rates row for timestamp " + std::to_string(row.t_ns) + ": \"" + word.substr(0, 64) + "\" is no status word.");
+  std::vector<const std::string*> words = {&row.status};
+  for (const auto& word : row.statuses) words.push_back(&word);
+  for (const std::string* word : words) {
+    if (!is_status_word(*word)) {
+      throw invalid_input("Rates row for timestamp " + std::to_string(row.t_ns) + ": \"" + word->substr(0, 64) +
+                          "\" is no status word (ok, no_texture, …).");
+    }
   }
   char buf[48];
   std::string text = std::to_string(row.t_ns);
@@ -488,7 +490,7 @@ std::string format_rates_row(const RatesLayout& layout, const RatesRow& row) {
     std::snprintf(buf, sizeof buf, ",%.9g", v);
     text += buf;
   };
-  std::vector<std::string> columns = layout.columns();
+  const std::vector<std::string> columns = layout.columns();
   std::size_t extra = 0, status = 0;
   for (const auto& name : columns) {
     if (name == "wx" || name == "wy" || name == "wz") {
