@@ -50,7 +50,12 @@ Group read_group(const RatesTable& table, const RatesExportOptions& options, con
                  RatesExportSummary& summary) {
   Group g;
   const std::string& s = options.head_suffix;
-  g.w = table.rates(s);  // names the columns when the group does not exist
+  try {
+    g.w = table.rates(s);  // names the columns when the group does not exist
+  } catch (const Error& e) {
+    if (e.kind() != ErrorKind::InvalidInput) throw;
+    throw invalid_input(source + ": " + e.what());
+  }
   g.status = table.status(s);
   g.frame = table.meta("frame" + s);
   if (!g.frame) g.frame = table.meta("frame");

@@ -239,7 +239,7 @@ TEST(RatesExport, SecondHeadAndTimestampsBeforeTheEpoch) {
   RatesExportOptions nosuch;
   nosuch.head_suffix = "_network";
   RatesExportSummary s4;
-  expect_invalid_input([&] { rates_to_tum(table, nosuch, "both.csv", s4); }, "wx_network");
+  expect_invalid_input([&] { rates_to_tum(table, nosuch, "both.csv", s4); }, "both.csv: Rates table has no column wx_network");
 }
 
 TEST(RatesExport, NoOkRowIsRefusedAndTheOutputLeftAsItWas) {
