@@ -1,7 +1,9 @@
 # inertialnet export (docs/cli.md, "export"): synth → predict → export in each format, the lines
 # checked against the rates file they come from; a pair without an answer left out (gyroflow,
 # euroc-imu) or held (tum); bad inputs refused with exit 2 before anything is written.
-#   cmake -DCLI=<inertialnet> -DWORK=<scratch dir> -P export.cmake
+# With -DPYTHON, read_exports.py reads the three files back independently (the formats as their
+# documentation describes them; the TUM orientation integrated anew with rotation matrices).
+#   cmake -DCLI=<inertialnet> -DWORK=<scratch dir> [-DPYTHON=<python3>] -P export.cmake
 cmake_policy(VERSION 3.25)
 file(REMOVE_RECURSE "${WORK}")
 file(MAKE_DIRECTORY "${WORK}")
@@ -101,6 +103,11 @@ expect_equal("${at_gap}" "${before_gap}" "orientation over the gap")
 list(GET poses 10 last)
 if(last MATCHES " 0 0 0 1$")
   message(FATAL_ERROR "the trajectory never turned: ${last}")
+endif()
+
+if(PYTHON)
+  run(0 ${PYTHON} ${CMAKE_CURRENT_LIST_DIR}/read_exports.py gap.csv out/clip.gcsv virtual/mav0/imu0/data.csv traj.txt)
+  expect_match("independent reader: gcsv 10 rows, euroc-imu 10 rows, tum 11 poses agree")
 endif()
 
 # 4. The frame: EuRoC's columns are the IMU frame; camera-frame rates only when asked for.
