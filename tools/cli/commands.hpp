@@ -31,5 +31,6 @@ Command register_calibrate_time(CLI::App& app, const GlobalOptions& global);
 Command register_viz(CLI::App& app, const GlobalOptions& global);
 Command register_train(CLI::App& app, const GlobalOptions& global);
 Command register_tune(CLI::App& app, const GlobalOptions& global);
+Command register_export(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace inertialnet::cli

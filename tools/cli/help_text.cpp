@@ -31,6 +31,10 @@ std::string help_examples(const std::string& subcommand) {
        "  inertialnet eval rates.csv data/seq --time-offset auto --gyro-bias auto\n"
        "  inertialnet eval rates.csv clip.mp4 --imu imu.csv --camchain camchain-imucam.yaml  # Kalibr's calibration\n"
        "  inertialnet eval rates.csv frames/ --imu imu.csv --T-cam-imu '0 -1 0 0  1 0 0 0  0 0 1 0  0 0 0 1'\n"},
+      {"export",
+       "  inertialnet export rates.csv --format gyroflow -o clip.gcsv            # Gyroflow's gyro log\n"
+       "  inertialnet export rates.csv --format euroc-imu -o virtual/imu0/data.csv # a gyro for a VIO to replay\n"
+       "  inertialnet export rates.csv --format tum --head geometric -o orientation.txt  # evo_traj tum orientation.txt\n"},
       {"calibrate-time",
        "  inertialnet calibrate-time data/seq                  # predicts weight-free, then estimates\n"
        "  inertialnet calibrate-time data/seq rates.csv --range 0.3\n"

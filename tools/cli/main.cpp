@@ -57,6 +57,8 @@ int main(int argc, char** argv) {
       {"eval", "the paper's metrics for a rates CSV against a sequence's gyro (EuRoC, or --imu FILE)", cli::register_eval},
       {"calibrate-time", "estimate the camera-IMU time offset of a sequence from its images and gyro",
        cli::register_calibrate_time},
+      {"export", "the rates as a Gyroflow gyro log, a EuRoC imu0 virtual gyro or a TUM orientation trajectory",
+       cli::register_export},
       {"viz", "flow files (.flo, KITTI PNG) as colour-wheel pictures", cli::register_viz},
       {"synth", "render a EuRoC-layout sequence from a known camera motion", cli::register_synth},
       {"bench", "pairs per second, stage split and per-layer profile (synthetic weights)", cli::register_bench},
