@@ -79,10 +79,15 @@ fs::path find_mav0(const fs::path& root) {
   return {};
 }
 
+// The still-image formats that cameras and recording tools write and that the library's OpenCV
+// decodes (load_rgb_image): a folder of .bmp or .tif frames was refused as "no images" although
+// OpenCV reads them. Other files in the folder (timestamps, notes) are left out.
 bool is_image_extension(const fs::path& p) {
+  static const std::set<std::string> extensions = {".png", ".jpg",  ".jpeg", ".bmp", ".tif", ".tiff",
+                                                   ".pgm", ".ppm", ".pnm",  ".webp"};
   std::string ext = p.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  return ext == ".png" || ext == ".jpg" || ext == ".jpeg";
+  return extensions.count(ext) != 0;
 }
 
 // Natural order: digit runs compare by value, so frame2.png sorts before frame10.png.
@@ -293,7 +298,7 @@ ImageFolder list_image_folder(const fs::path& dir, std::optional<double> rate_hz
     }
     if (regular) names.push_back(entry.path().filename().string());
   }
-  if (names.empty()) throw invalid_input("Image folder " + dir.string() + " holds no .png or .jpg images.");
+  if (names.empty()) throw invalid_input("Image folder " + dir.string() + " holds no images (.png, .jpg, .jpeg, .bmp, .tif, .tiff, .pgm, .ppm, .pnm or .webp).");
   std::sort(names.begin(), names.end(), natural_less);
 
   ImageFolder folder;

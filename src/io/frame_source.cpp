@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "inertialnet/io/kitti_timestamps.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "io/image_mat.hpp"
 #include "io/video_file.hpp"
@@ -141,11 +142,30 @@ std::unique_ptr<FrameSource> open_frame_source(const std::filesystem::path& path
     std::vector<std::string> notes;
     const std::string name = path.filename().string();
     if (rate_hz) {
-      if (folder.timestamps_known) {
+      if (!kitti_timestamps_beside(path).empty()) {
+        notes.push_back("--rate " + format_rate(*rate_hz) + " Hz overrides the frame times in " +
+                        kitti_timestamps_beside(path).string() + ".");
+      } else if (folder.timestamps_known) {
         notes.push_back("--rate " + format_rate(*rate_hz) + " Hz overrides the nanosecond timestamps in the file names of " +
                         name + ".");
       }
       folder = list_image_folder(path, rate_hz);
+    } else if (const std::filesystem::path stamps = kitti_timestamps_beside(path); !stamps.empty()) {
+      // KITTI raw: image_02/data/ beside image_02/timestamps.txt, one time per image (≈ 10 Hz,
+      // not the 20 Hz assumed otherwise). A count that differs is refused: the images could
+      // not be matched to their times.
+      std::vector<std::string> gaps;
+      const std::vector<std::int64_t> t = read_kitti_timestamps(stamps, &gaps);
+      if (t.size() != folder.frames.size()) {
+        throw invalid_input(stamps.string() + " lists " + std::to_string(t.size()) + " times but " + path.string() +
+                            " holds " + std::to_string(folder.frames.size()) +
+                            " images: each image needs its time (KITTI raw's layout), or give --rate to ignore the file.");
+      }
+      for (std::size_t i = 0; i < t.size(); ++i) folder.frames[i].t_ns = t[i];
+      folder.timestamps_known = true;
+      notes.push_back("Frame times of " + name + " from " + stamps.string() +
+                      " (KITTI raw), read as nanoseconds since 1970 in UTC.");
+      notes.insert(notes.end(), gaps.begin(), gaps.end());
     } else if (!folder.timestamps_known) {
       folder = list_image_folder(path, kDefaultRateHz);
       notes.push_back("The file names in " + name + " are not nanosecond timestamps: frames are taken to be " +
