@@ -100,6 +100,35 @@ rmse_of(replaced "${output}")
 expect_same_rmse("${reference}" "${replaced}" "EuRoC with --imu")
 expect_match("instead of [^\n]*imu0/data.csv, taken to be in imu0's frame")
 
+# The same gyro as a gyro-only CSV in seconds (the time unit named by the header, t_s) and as
+# Gyroflow's .gcsv (t in milliseconds with tscale 0.001, the accelerometer left out): the same
+# samples to the nanosecond, so the same RMSE as the EuRoC path.
+file(STRINGS "${WORK}/seq/mav0/imu0/data.csv" imu_rows REGEX "^[0-9]")
+set(seconds_csv "t_s,gx,gy,gz\n")
+set(gcsv "GYROFLOW IMU LOG\nversion,1.3\nid,inertialnet_test\norientation,XYZ\ntscale,0.001\ngscale,1\nt,gx,gy,gz\n")
+foreach(row IN LISTS imu_rows)
+  if(NOT row MATCHES "^([0-9]+)([0-9][0-9][0-9])([0-9][0-9][0-9][0-9][0-9][0-9]),([^,]+,[^,]+,[^,]+),")
+    message(FATAL_ERROR "unexpected imu0 row: ${row}")
+  endif()
+  string(APPEND seconds_csv "${CMAKE_MATCH_1}.${CMAKE_MATCH_2}${CMAKE_MATCH_3},${CMAKE_MATCH_4}\n")
+  string(APPEND gcsv "${CMAKE_MATCH_1}${CMAKE_MATCH_2}.${CMAKE_MATCH_3},${CMAKE_MATCH_4}\n")
+endforeach()
+file(WRITE "${WORK}/gyro_seconds.csv" "${seconds_csv}")
+file(WRITE "${WORK}/gyro.gcsv" "${gcsv}")
+run(0 ${CLI} eval euroc.csv seq --json)
+rmse_of(reference "${output}")
+foreach(log gyro_seconds.csv gyro.gcsv)
+  run(0 ${CLI} eval folder.csv seq/mav0/cam0/data --imu ${log} --camchain camchain.yaml --json)
+  rmse_of(from_log "${output}")
+  expect_same_rmse("${reference}" "${from_log}" "--imu ${log}")
+endforeach()
+# --imu-time-unit reads a file whose header names no unit.
+string(REPLACE "t_s,gx,gy,gz" "time,gx,gy,gz" unnamed "${seconds_csv}")
+file(WRITE "${WORK}/gyro_unnamed.csv" "${unnamed}")
+run(0 ${CLI} eval folder.csv seq/mav0/cam0/data --imu gyro_unnamed.csv --imu-time-unit s --camchain camchain.yaml --json)
+rmse_of(from_option "${output}")
+expect_same_rmse("${reference}" "${from_option}" "--imu-time-unit s")
+
 # calibrate-time on the folder: predicts with --fx …, and finds a 40 ms offset as on EuRoC input.
 run(0 ${CLI} synth late --frames 60 --size 188x120 --seed 5 --time-offset 0.04)
 run(0 ${CLI} calibrate-time late/mav0/cam0/data --imu late/mav0/imu0/data.csv --T-cam-imu seq/mav0/cam0/sensor.yaml ${intrinsics})

@@ -28,9 +28,9 @@ struct IntrinsicsCliOptions {
 };
 void add_intrinsics_options(CLI::App& app, IntrinsicsCliOptions& o);
 
-// --imu FILE, --T-cam-imu M|FILE, --camchain FILE, --rate HZ.
+// --imu FILE, --imu-time-unit s|ms|us|ns, --T-cam-imu M|FILE, --camchain FILE, --rate HZ.
 struct ImuCliOptions {
-  std::string imu, T_cam_imu, camchain;
+  std::string imu, imu_time_unit, T_cam_imu, camchain;
   double rate_hz = 0;
 };
 void add_imu_options(CLI::App& app, ImuCliOptions& o);
