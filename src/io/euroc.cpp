@@ -264,6 +264,20 @@ EurocSequence read_euroc(const fs::path& root, const EurocReadOptions& options) 
   if (seq.name.empty()) seq.name = fs::absolute(parent).lexically_normal().parent_path().filename().string();
 
   const fs::path cam = mav0 / options.camera;
+  // A camera that the sequence does not have (cam1 of a monocular recording) is named with the
+  // ones it has, before its data.csv is looked for.
+  std::error_code error;
+  if (!fs::exists(cam / "data.csv", error)) {
+    std::set<std::string> cameras;
+    for (const auto& entry : fs::directory_iterator(mav0, error)) {
+      const std::string n = entry.path().filename().string();
+      if (n.rfind("cam", 0) == 0 && fs::exists(entry.path() / "data.csv")) cameras.insert(n);
+    }
+    std::string list;
+    for (const auto& c : cameras) list += (list.empty() ? "" : ", ") + c;
+    throw invalid_input(root.string() + " has no camera " + options.camera + " (no " + (cam / "data.csv").string() +
+                        "); its cameras: " + (list.empty() ? std::string("none") : list) + ".");
+  }
   seq.frames = read_camera_csv(cam / "data.csv", cam / "data", options.check_images, &seq.warnings);
   if (fs::exists(cam / "sensor.yaml")) seq.camera = read_camera_yaml(cam / "sensor.yaml");
 

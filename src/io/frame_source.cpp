@@ -122,19 +122,26 @@ class VideoFrames : public FrameSource {
 
 }  // namespace
 
-std::unique_ptr<FrameSource> open_frame_source(const std::filesystem::path& path, std::optional<double> rate_hz) {
+std::unique_ptr<FrameSource> open_frame_source(const std::filesystem::path& path, std::optional<double> rate_hz,
+                                               const std::string& camera) {
   std::error_code error;
   if (!std::filesystem::exists(path, error)) throw invalid_input("sequence '" + path.string() + "' does not exist");
   std::unique_ptr<FrameSource> source;
   if (is_euroc_folder(path)) {
     EurocReadOptions options;
+    options.camera = camera;
     options.read_imu = false;  // predicting needs the frames only
     options.read_ground_truth = false;
     EurocSequence sequence = read_euroc(path, options);
-    const std::string description = "EuRoC sequence " + sequence.name + " (" + std::to_string(sequence.frames.size()) + " frames)";
+    const std::string description = "EuRoC sequence " + sequence.name + (camera == "cam0" ? "" : " " + camera) + " (" +
+                                    std::to_string(sequence.frames.size()) + " frames)";
     std::vector<std::string> notes;
-    if (rate_hz) notes.push_back("--rate is ignored: the EuRoC sequence's cam0/data.csv gives every frame's timestamp.");
+    if (rate_hz) notes.push_back("--rate is ignored: the EuRoC sequence's " + camera + "/data.csv gives every frame's timestamp.");
     source = std::make_unique<ListedFrames>(std::move(sequence.frames), sequence.camera, description, std::move(notes));
+  } else if (camera != "cam0") {
+    throw invalid_input("--camera " + camera + " picks a camera of a EuRoC sequence (mav0/" + camera + "); " +
+                        path.string() + " is " + (std::filesystem::is_directory(path, error) ? "an image folder" : "a video") +
+                        ", with one camera.");
   } else if (std::filesystem::is_directory(path, error)) {
     // Nanosecond stamps in the file names win over an assumed rate; a given rate wins over both,
     // and either choice that is not the names' own stamps is said.

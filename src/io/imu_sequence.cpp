@@ -28,13 +28,15 @@ void read_imu_file(const ImuSequenceOptions& options, EurocSequence& seq) {
 EurocSequence read_euroc_with_imu(const fs::path& path, const ImuSequenceOptions& options) {
   if (options.camera_imu) {
     throw invalid_input(options.camera_imu->source + ": " + path.string() + " is a EuRoC sequence, whose camera "
-                        "rotation comes from mav0/cam0/sensor.yaml's T_BS (predict's body-frame rates use it too); "
+                        "rotation comes from mav0/" + options.camera + "/sensor.yaml's T_BS (predict's body-frame rates use it too); "
                         "--T-cam-imu and --camchain are for image folders and videos. Edit T_BS to change it.");
   }
   EurocReadOptions read;
   read.check_images = false;
+  read.camera = options.camera;
   // As open_frame_source says it to predict: the listed stamps are the frame times.
-  const std::string rate_note = "--rate is ignored: the EuRoC sequence's cam0/data.csv gives every frame's timestamp.";
+  const std::string rate_note =
+      "--rate is ignored: the EuRoC sequence's " + options.camera + "/data.csv gives every frame's timestamp.";
   if (options.imu_csv.empty()) {
     EurocSequence seq = read_euroc(path, read);
     if (options.rate_hz) seq.notes.push_back(rate_note);
@@ -73,7 +75,7 @@ EurocSequence read_sequence_with_imu(const fs::path& path, const ImuSequenceOpti
   }
   EurocSequence seq;
   seq.name = name_of(path);
-  const auto source = open_frame_source(path, options.rate_hz);
+  const auto source = open_frame_source(path, options.rate_hz, options.camera);
   seq.frames.resize(source->size());
   for (std::size_t i = 0; i < source->size(); ++i) seq.frames[i] = {source->timestamp_ns(i), std::string(), path};
   seq.notes = source->notes();

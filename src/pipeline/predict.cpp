@@ -61,7 +61,7 @@ Prediction::Prediction(const PredictSettings& s) : settings_(s) {
   processor_.geometric.readout_time_s = s.readout_time_s;
   require_flow_check_setting(s.flow_check_px);
   processor_.flow_check_px = s.flow_check_px;
-  source_ = open_frame_source(s.sequence, s.rate_hz > 0 ? std::optional<double>(s.rate_hz) : std::nullopt);
+  source_ = open_frame_source(s.sequence, s.rate_hz > 0 ? std::optional<double>(s.rate_hz) : std::nullopt, s.camera);
   notes_ = source_->notes();
   if (processor_.geometric_head) {
     const bool given = s.fx > 0 || s.fy > 0;
@@ -82,13 +82,13 @@ Prediction::Prediction(const PredictSettings& s) : settings_(s) {
       } catch (const Error& e) {
         // The library's message names the model or the coefficients; say which file holds them.
         if (e.kind() != ErrorKind::InvalidInput) throw;
-        throw invalid_input(source_->description() + ": cam0/sensor.yaml: " + e.what());
+        throw invalid_input(source_->description() + ": " + s.camera + "/sensor.yaml: " + e.what());
       }
       // The geometric head allocates per pixel of the calibrated size: compare it with the
       // images before, so that a wrong resolution is a clear message, not gigabytes asked for.
       const HostImage first = source_->decode(0);
       if (first.width != processor_.camera->width || first.height != processor_.camera->height) {
-        throw invalid_input(source_->description() + ": cam0/sensor.yaml gives the resolution " +
+        throw invalid_input(source_->description() + ": " + s.camera + "/sensor.yaml gives the resolution " +
                             std::to_string(processor_.camera->width) + "x" + std::to_string(processor_.camera->height) +
                             ", which does not match the images (" + std::to_string(first.width) + "x" +
                             std::to_string(first.height) + ").");
@@ -96,7 +96,7 @@ Prediction::Prediction(const PredictSettings& s) : settings_(s) {
       processor_.camera_to_body = calibration->rotation_BS();
     } else {
       throw invalid_input("the geometric head needs the camera: " + source_->description() +
-                          " has no cam0/sensor.yaml; give --fx (and --fy --cx --cy)");
+                          " has no " + s.camera + "/sensor.yaml; give --fx (and --fy --cx --cy)");
     }
   }
   processor_.keep_flow = s.keep_flow;
@@ -168,7 +168,8 @@ std::vector<std::pair<std::string, std::string>> Prediction::csv_metadata() cons
 
 void Prediction::warm_up(const std::function<void(const DeviceInfo& device, double seconds)>& report) {
   auto source = open_frame_source(settings_.sequence,
-                                  settings_.rate_hz > 0 ? std::optional<double>(settings_.rate_hz) : std::nullopt);
+                                  settings_.rate_hz > 0 ? std::optional<double>(settings_.rate_hz) : std::nullopt,
+                                  settings_.camera);
   const Frame first{0, source->timestamp_ns(0), source->decode(0), {}};
   const Frame second{1, source->timestamp_ns(1), source->decode(1), {}};
   const std::atomic<bool> keep_going{false};

@@ -202,6 +202,30 @@ TEST(Euroc, MissingImagesAndFiles) {
   EXPECT_TRUE(contains(msg, "not a EuRoC")) << msg;
 }
 
+// EurocReadOptions::camera (--camera cam1): that camera's listing and calibration; a camera the
+// sequence lacks is named with the ones it has.
+TEST(Euroc, SecondCamera) {
+  te::TempDir dir("euroc_cam1");
+  te::Spec spec;
+  te::write(dir.path() / "seq", spec);
+  const fs::path mav0 = dir.path() / "seq" / "mav0";
+  EurocReadOptions options;
+  options.camera = "cam1";
+  const std::string missing = invalid_input_message([&] { read_euroc(dir.path() / "seq", options); });
+  EXPECT_TRUE(contains(missing, "has no camera cam1")) << missing;
+  EXPECT_TRUE(contains(missing, "its cameras: cam0.")) << missing;
+
+  fs::create_directories(mav0 / "cam1");
+  const std::int64_t t0 = te::kStartNs + 7;
+  std::ofstream(mav0 / "cam1" / "data.csv") << "#timestamp [ns],filename\n" << t0 << ",a.png\n" << t0 + 50'000'000 << ",b.png\n";
+  options.check_images = false;
+  const EurocSequence seq = read_euroc(dir.path() / "seq", options);
+  ASSERT_EQ(seq.frames.size(), 2u);
+  EXPECT_EQ(seq.frames[0].t_ns, t0);
+  EXPECT_EQ(seq.frames[1].path, mav0 / "cam1" / "data" / "b.png");
+  EXPECT_FALSE(seq.camera.has_value());  // cam1 has no sensor.yaml here: cam0's is not taken for it
+}
+
 TEST(Euroc, GroundTruthIsOptional) {
   te::TempDir dir("euroc_nogt");
   te::Spec spec;

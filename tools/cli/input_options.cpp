@@ -62,7 +62,15 @@ void add_intrinsics_options(CLI::App& app, IntrinsicsCliOptions& o) {
   app.add_option("--cy", o.cy, "principal point y (px)")->check(finite_pixel_coordinate());
 }
 
+void add_camera_option(CLI::App& app, std::string& camera) {
+  app.add_option("--camera", camera,
+                 "camera of a EuRoC sequence: cam0 or cam1 (mav0/<camera>/data.csv and sensor.yaml)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"cam0", "cam1"}));
+}
+
 void add_imu_options(CLI::App& app, ImuCliOptions& o) {
+  add_camera_option(app, o.camera);
   app.add_option("--imu", o.imu,
                  "gyro log on the frames' clock, for an image folder or a video (for a EuRoC folder it replaces "
                  "mav0/imu0/data.csv): a CSV of time, gx, gy, gz [rad/s] with or without accel x y z after them "
@@ -89,6 +97,7 @@ ImuSequenceOptions imu_sequence_options(const ImuCliOptions& o) {
   ImuSequenceOptions options;
   options.imu_csv = o.imu;
   if (o.rate_hz > 0) options.rate_hz = o.rate_hz;
+  options.camera = o.camera;
   if (!o.imu_time_unit.empty()) options.imu_time_unit = parse_time_unit(o.imu_time_unit);
   if (!o.T_cam_imu.empty()) options.camera_imu = parse_camera_imu(o.T_cam_imu, "--T-cam-imu");
   if (!o.camchain.empty()) options.camera_imu = read_kalibr_camchain(o.camchain);

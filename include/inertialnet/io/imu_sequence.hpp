@@ -29,6 +29,7 @@ struct ImuSequenceOptions {
   std::optional<CameraImuCalibration> camera_imu;  // IMU → camera for a folder or a video
   std::optional<double> rate_hz;                   // as predict's --rate, for a folder or a video
   std::optional<TimeUnit> imu_time_unit;           // the time unit of imu_csv's CSV (--imu-time-unit)
+  std::string camera = "cam0";                     // a EuRoC folder's camera (--camera); cam0 for others
 };
 
 // Frames (timestamps only; images are not decoded, a video is read once for its frame times),
