@@ -295,7 +295,7 @@ file(WRITE "${WORK}/gyro_s.csv" "t_s,gx,gy,gz\n1403715273.262142976,0.1,0.2,0.3\
 run(2 ${CLI} eval rates.csv ${folder} --imu gyro_s.csv --imu-time-unit ns)
 expect_match("gyro_s.csv line 1: the time column \"t_s\" is in s, but --imu-time-unit says ns")
 run(2 ${CLI} eval rates.csv ${folder} --imu gyro_s.csv --imu-time-unit sec)
-expect_match("--imu-time-unit: sec not in {s,ms,us,ns}")
+expect_match("--imu-time-unit: unknown time unit 'sec'; expected one of s, ms, us, ns")
 run(2 ${CLI} eval rates.csv seq --imu-time-unit s)
 expect_match("--imu-time-unit describes the file given with --imu, and none is given")
 file(WRITE "${WORK}/gyro_bare.csv" "0.005,0.1,0.2,0.3\n0.010,0.1,0.2,0.3\n")

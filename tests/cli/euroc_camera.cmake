@@ -67,6 +67,6 @@ expect_match("mono has no camera cam1 \\(no [^\n]*mono/mav0/cam1/data.csv\\); it
 run(2 ${CLI} eval cam1.csv mono --camera cam1)
 expect_match("has no camera cam1")
 run(2 ${CLI} predict seq --camera cam2)
-expect_match("--camera: cam2 not in {cam0,cam1}")
+expect_match("--camera: unknown camera 'cam2'; expected one of cam0, cam1")
 run(2 ${CLI} predict seq/mav0/cam0/data --camera cam1 --fx 100)
 expect_match("--camera cam1 picks a camera of a EuRoC sequence \\(mav0/cam1\\); seq/mav0/cam0/data is an image folder")

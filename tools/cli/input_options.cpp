@@ -1,5 +1,7 @@
 #include "input_options.hpp"
 
+#include "common.hpp"
+
 #include <cmath>
 #include <regex>
 #include <sstream>
@@ -66,7 +68,7 @@ void add_camera_option(CLI::App& app, std::string& camera) {
   app.add_option("--camera", camera,
                  "camera of a EuRoC sequence: cam0 or cam1 (mav0/<camera>/data.csv and sensor.yaml)")
       ->capture_default_str()
-      ->check(CLI::IsMember({"cam0", "cam1"}));
+      ->transform(choice("camera", {"cam0", "cam1"}));
 }
 
 void add_imu_options(CLI::App& app, ImuCliOptions& o) {
@@ -79,7 +81,7 @@ void add_imu_options(CLI::App& app, ImuCliOptions& o) {
       ->check(CLI::ExistingFile);
   app.add_option("--imu-time-unit", o.imu_time_unit,
                  "unit of the --imu CSV's time column when its header does not name it: s, ms, us or ns")
-      ->check(CLI::IsMember({"s", "ms", "us", "ns"}));
+      ->transform(choice("time unit", {"s", "ms", "us", "ns"}));
   auto* t = app.add_option("--T-cam-imu", o.T_cam_imu,
                            "with --imu: IMU-to-camera transform, 16 numbers (4x4 row-major, Kalibr's T_cam_imu) or a "
                            "YAML file with T_cam_imu (or T_BS as cam0/sensor.yaml writes it); default: identity");
