@@ -10,8 +10,8 @@
 // The IMU frame is the body frame. For a folder or a video, the rotation to the camera is the
 // calibration given (camera_imu.hpp) or, without one, the identity (a note says so); frame times
 // are the ones predict stamps (open_frame_source with the same rate). For a EuRoC folder the IMU
-// file replaces mav0/imu0/data.csv (a note says so) and is taken to be in imu0's frame: cam0's
-// T_BS keeps giving the rotation (a calibration given is refused, invalid_input), and the ground
+// file replaces mav0/imu0/data.csv (a note says so) and is taken to be in imu0's frame: the
+// camera's (`camera`: cam0 or cam1) T_BS keeps giving the rotation (a calibration given is refused, invalid_input), and the ground
 // truth's gyro bias, which belongs to imu0, is not used.
 #pragma once
 
