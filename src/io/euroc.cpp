@@ -79,10 +79,15 @@ fs::path find_mav0(const fs::path& root) {
   return {};
 }
 
+// The still-image formats that cameras and recording tools write and that the library's OpenCV
+// decodes (load_rgb_image): a folder of .bmp or .tif frames was refused as "no images" although
+// OpenCV reads them. Other files in the folder (timestamps, notes) are left out.
 bool is_image_extension(const fs::path& p) {
+  static const std::set<std::string> extensions = {".png", ".jpg",  ".jpeg", ".bmp", ".tif", ".tiff",
+                                                   ".pgm", ".ppm", ".pnm",  ".webp"};
   std::string ext = p.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  return ext == ".png" || ext == ".jpg" || ext == ".jpeg";
+  return extensions.count(ext) != 0;
 }
 
 // Natural order: digit runs compare by value, so frame2.png sorts before frame10.png.
@@ -259,6 +264,20 @@ EurocSequence read_euroc(const fs::path& root, const EurocReadOptions& options) 
   if (seq.name.empty()) seq.name = fs::absolute(parent).lexically_normal().parent_path().filename().string();
 
   const fs::path cam = mav0 / options.camera;
+  // A camera that the sequence does not have (cam1 of a monocular recording) is named with the
+  // ones it has, before its data.csv is looked for.
+  std::error_code error;
+  if (!fs::exists(cam / "data.csv", error)) {
+    std::set<std::string> cameras;
+    for (const auto& entry : fs::directory_iterator(mav0, error)) {
+      const std::string n = entry.path().filename().string();
+      if (n.rfind("cam", 0) == 0 && fs::exists(entry.path() / "data.csv")) cameras.insert(n);
+    }
+    std::string list;
+    for (const auto& c : cameras) list += (list.empty() ? "" : ", ") + c;
+    throw invalid_input(root.string() + " has no camera " + options.camera + " (no " + (cam / "data.csv").string() +
+                        "); its cameras: " + (list.empty() ? std::string("none") : list) + ".");
+  }
   seq.frames = read_camera_csv(cam / "data.csv", cam / "data", options.check_images, &seq.warnings);
   if (fs::exists(cam / "sensor.yaml")) seq.camera = read_camera_yaml(cam / "sensor.yaml");
 
@@ -293,7 +312,7 @@ ImageFolder list_image_folder(const fs::path& dir, std::optional<double> rate_hz
     }
     if (regular) names.push_back(entry.path().filename().string());
   }
-  if (names.empty()) throw invalid_input("Image folder " + dir.string() + " holds no .png or .jpg images.");
+  if (names.empty()) throw invalid_input("Image folder " + dir.string() + " holds no images (.png, .jpg, .jpeg, .bmp, .tif, .tiff, .pgm, .ppm, .pnm or .webp).");
   std::sort(names.begin(), names.end(), natural_less);
 
   ImageFolder folder;

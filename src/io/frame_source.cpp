@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "inertialnet/io/kitti_timestamps.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "io/image_mat.hpp"
 #include "io/video_file.hpp"
@@ -121,19 +122,26 @@ class VideoFrames : public FrameSource {
 
 }  // namespace
 
-std::unique_ptr<FrameSource> open_frame_source(const std::filesystem::path& path, std::optional<double> rate_hz) {
+std::unique_ptr<FrameSource> open_frame_source(const std::filesystem::path& path, std::optional<double> rate_hz,
+                                               const std::string& camera) {
   std::error_code error;
   if (!std::filesystem::exists(path, error)) throw invalid_input("sequence '" + path.string() + "' does not exist");
   std::unique_ptr<FrameSource> source;
   if (is_euroc_folder(path)) {
     EurocReadOptions options;
+    options.camera = camera;
     options.read_imu = false;  // predicting needs the frames only
     options.read_ground_truth = false;
     EurocSequence sequence = read_euroc(path, options);
-    const std::string description = "EuRoC sequence " + sequence.name + " (" + std::to_string(sequence.frames.size()) + " frames)";
+    const std::string description = "EuRoC sequence " + sequence.name + (camera == "cam0" ? "" : " " + camera) + " (" +
+                                    std::to_string(sequence.frames.size()) + " frames)";
     std::vector<std::string> notes;
-    if (rate_hz) notes.push_back("--rate is ignored: the EuRoC sequence's cam0/data.csv gives every frame's timestamp.");
+    if (rate_hz) notes.push_back("--rate is ignored: the EuRoC sequence's " + camera + "/data.csv gives every frame's timestamp.");
     source = std::make_unique<ListedFrames>(std::move(sequence.frames), sequence.camera, description, std::move(notes));
+  } else if (camera != "cam0") {
+    throw invalid_input("--camera " + camera + " picks a camera of a EuRoC sequence (mav0/" + camera + "); " +
+                        path.string() + " is " + (std::filesystem::is_directory(path, error) ? "an image folder" : "a video") +
+                        ", with one camera.");
   } else if (std::filesystem::is_directory(path, error)) {
     // Nanosecond stamps in the file names win over an assumed rate; a given rate wins over both,
     // and either choice that is not the names' own stamps is said.
@@ -141,11 +149,30 @@ std::unique_ptr<FrameSource> open_frame_source(const std::filesystem::path& path
     std::vector<std::string> notes;
     const std::string name = path.filename().string();
     if (rate_hz) {
-      if (folder.timestamps_known) {
+      if (!kitti_timestamps_beside(path).empty()) {
+        notes.push_back("--rate " + format_rate(*rate_hz) + " Hz overrides the frame times in " +
+                        kitti_timestamps_beside(path).string() + ".");
+      } else if (folder.timestamps_known) {
         notes.push_back("--rate " + format_rate(*rate_hz) + " Hz overrides the nanosecond timestamps in the file names of " +
                         name + ".");
       }
       folder = list_image_folder(path, rate_hz);
+    } else if (const std::filesystem::path stamps = kitti_timestamps_beside(path); !stamps.empty()) {
+      // KITTI raw: image_02/data/ beside image_02/timestamps.txt, one time per image (≈ 10 Hz,
+      // not the 20 Hz assumed otherwise). A count that differs is refused: the images could
+      // not be matched to their times.
+      std::vector<std::string> gaps;
+      const std::vector<std::int64_t> t = read_kitti_timestamps(stamps, &gaps);
+      if (t.size() != folder.frames.size()) {
+        throw invalid_input(stamps.string() + " lists " + std::to_string(t.size()) + " times but " + path.string() +
+                            " holds " + std::to_string(folder.frames.size()) +
+                            " images: each image needs its time (KITTI raw's layout), or give --rate to ignore the file.");
+      }
+      for (std::size_t i = 0; i < t.size(); ++i) folder.frames[i].t_ns = t[i];
+      folder.timestamps_known = true;
+      notes.push_back("Frame times of " + name + " from " + stamps.string() +
+                      " (KITTI raw), read as nanoseconds since 1970 in UTC.");
+      notes.insert(notes.end(), gaps.begin(), gaps.end());
     } else if (!folder.timestamps_known) {
       folder = list_image_folder(path, kDefaultRateHz);
       notes.push_back("The file names in " + name + " are not nanosecond timestamps: frames are taken to be " +

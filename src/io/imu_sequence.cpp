@@ -18,16 +18,25 @@ std::string name_of(const fs::path& path) {
 
 Mat3 rotation_of(const std::array<double, 16>& T) { return {T[0], T[1], T[2], T[4], T[5], T[6], T[8], T[9], T[10]}; }
 
+// The --imu file's samples into `seq`, its notes after the sequence's.
+void read_imu_file(const ImuSequenceOptions& options, EurocSequence& seq) {
+  GyroLog log = read_gyro_log(options.imu_csv, options.imu_time_unit, &seq.warnings);
+  seq.imu = std::move(log.samples);
+  seq.notes.insert(seq.notes.end(), log.notes.begin(), log.notes.end());
+}
+
 EurocSequence read_euroc_with_imu(const fs::path& path, const ImuSequenceOptions& options) {
   if (options.camera_imu) {
     throw invalid_input(options.camera_imu->source + ": " + path.string() + " is a EuRoC sequence, whose camera "
-                        "rotation comes from mav0/cam0/sensor.yaml's T_BS (predict's body-frame rates use it too); "
+                        "rotation comes from mav0/" + options.camera + "/sensor.yaml's T_BS (predict's body-frame rates use it too); "
                         "--T-cam-imu and --camchain are for image folders and videos. Edit T_BS to change it.");
   }
   EurocReadOptions read;
   read.check_images = false;
+  read.camera = options.camera;
   // As open_frame_source says it to predict: the listed stamps are the frame times.
-  const std::string rate_note = "--rate is ignored: the EuRoC sequence's cam0/data.csv gives every frame's timestamp.";
+  const std::string rate_note =
+      "--rate is ignored: the EuRoC sequence's " + options.camera + "/data.csv gives every frame's timestamp.";
   if (options.imu_csv.empty()) {
     EurocSequence seq = read_euroc(path, read);
     if (options.rate_hz) seq.notes.push_back(rate_note);
@@ -37,7 +46,7 @@ EurocSequence read_euroc_with_imu(const fs::path& path, const ImuSequenceOptions
   read.read_ground_truth = false;
   EurocSequence seq = read_euroc(path, read);
   if (options.rate_hz) seq.notes.push_back(rate_note);
-  seq.imu = read_imu_csv(options.imu_csv, &seq.warnings);
+  read_imu_file(options, seq);
   const fs::path imu0 = seq.mav0 / "imu0";
   if (fs::exists(imu0 / "sensor.yaml")) seq.imu_rotation_BS = rotation_of(read_sensor_T_BS(imu0 / "sensor.yaml"));
   seq.notes.push_back("IMU samples from " + options.imu_csv.string() + " instead of " + (imu0 / "data.csv").string() +
@@ -50,23 +59,27 @@ EurocSequence read_euroc_with_imu(const fs::path& path, const ImuSequenceOptions
 EurocSequence read_sequence_with_imu(const fs::path& path, const ImuSequenceOptions& options) {
   std::error_code error;
   if (!fs::exists(path, error)) throw invalid_input("sequence '" + path.string() + "' does not exist");
+  if (options.imu_time_unit && options.imu_csv.empty()) {
+    throw invalid_input("--imu-time-unit describes the file given with --imu, and none is given.");
+  }
   if (is_euroc_folder(path)) return read_euroc_with_imu(path, options);
 
   const bool folder = fs::is_directory(path, error);
   const std::string kind = folder ? "an image folder" : "a video";
   if (options.imu_csv.empty()) {
     throw invalid_input(path.string() + " is not a EuRoC sequence (no mav0/cam0/data.csv); as " + kind +
-                        " it holds no gyro: give the IMU with --imu FILE (an "
-                        "EuRoC-format CSV: timestamp [ns], w_RS_S_x, w_RS_S_y, w_RS_S_z [rad/s], a_RS_S_x, "
-                        "a_RS_S_y, a_RS_S_z [m/s^2]), and its rotation to the camera with --T-cam-imu or --camchain.");
+                        " it holds no gyro: give the IMU with --imu FILE (a "
+                        "CSV of time, gx, gy, gz [rad/s] with or without the accelerometer after them, as EuRoC's "
+                        "imu0/data.csv, times in ns unless its header or --imu-time-unit says otherwise; or "
+                        "Gyroflow's .gcsv), and its rotation to the camera with --T-cam-imu or --camchain.");
   }
   EurocSequence seq;
   seq.name = name_of(path);
-  const auto source = open_frame_source(path, options.rate_hz);
+  const auto source = open_frame_source(path, options.rate_hz, options.camera);
   seq.frames.resize(source->size());
   for (std::size_t i = 0; i < source->size(); ++i) seq.frames[i] = {source->timestamp_ns(i), std::string(), path};
   seq.notes = source->notes();
-  seq.imu = read_imu_csv(options.imu_csv, &seq.warnings);
+  read_imu_file(options, seq);
   if (options.camera_imu) {
     seq.imu_to_camera = options.camera_imu->rotation_cam_imu();
     seq.notes.push_back("IMU to camera rotation from " + options.camera_imu->source + ".");

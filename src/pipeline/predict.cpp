@@ -34,7 +34,8 @@ const char* kNoWeightsHelp =
 // recording costs its pairs, not the run), or the first frame's error when no two do. A fresh copy,
 // because a video decodes in order from its start and the pipeline starts at frame 0 again.
 std::pair<Frame, Frame> first_decodable_pair(const PredictSettings& s) {
-  auto source = open_frame_source(s.sequence, s.rate_hz > 0 ? std::optional<double>(s.rate_hz) : std::nullopt);
+  auto source =
+      open_frame_source(s.sequence, s.rate_hz > 0 ? std::optional<double>(s.rate_hz) : std::nullopt, s.camera);
   std::optional<Frame> previous;
   std::optional<Error> first_error;
   for (std::size_t i = 0; i < source->size(); ++i) {
@@ -83,7 +84,7 @@ Prediction::Prediction(const PredictSettings& s) : settings_(s) {
   processor_.geometric.readout_time_s = s.readout_time_s;
   require_flow_check_setting(s.flow_check_px);
   processor_.flow_check_px = s.flow_check_px;
-  source_ = open_frame_source(s.sequence, s.rate_hz > 0 ? std::optional<double>(s.rate_hz) : std::nullopt);
+  source_ = open_frame_source(s.sequence, s.rate_hz > 0 ? std::optional<double>(s.rate_hz) : std::nullopt, s.camera);
   notes_ = source_->notes();
   if (processor_.geometric_head) {
     const bool given = s.fx > 0 || s.fy > 0;
@@ -104,13 +105,13 @@ Prediction::Prediction(const PredictSettings& s) : settings_(s) {
       } catch (const Error& e) {
         // The library's message names the model or the coefficients; say which file holds them.
         if (e.kind() != ErrorKind::InvalidInput) throw;
-        throw invalid_input(source_->description() + ": cam0/sensor.yaml: " + e.what());
+        throw invalid_input(source_->description() + ": " + s.camera + "/sensor.yaml: " + e.what());
       }
       // The geometric head allocates per pixel of the calibrated size: compare it with the
       // images before, so that a wrong resolution is a clear message, not gigabytes asked for.
       const HostImage first = first_decodable_pair(s).first.image;
       if (first.width != processor_.camera->width || first.height != processor_.camera->height) {
-        throw invalid_input(source_->description() + ": cam0/sensor.yaml gives the resolution " +
+        throw invalid_input(source_->description() + ": " + s.camera + "/sensor.yaml gives the resolution " +
                             std::to_string(processor_.camera->width) + "x" + std::to_string(processor_.camera->height) +
                             ", which does not match the images (" + std::to_string(first.width) + "x" +
                             std::to_string(first.height) + ").");
@@ -118,7 +119,7 @@ Prediction::Prediction(const PredictSettings& s) : settings_(s) {
       processor_.camera_to_body = calibration->rotation_BS();
     } else {
       throw invalid_input("the geometric head needs the camera: " + source_->description() +
-                          " has no cam0/sensor.yaml; give --fx (and --fy --cx --cy)");
+                          " has no " + s.camera + "/sensor.yaml; give --fx (and --fy --cx --cy)");
     }
   }
   processor_.keep_flow = s.keep_flow;

@@ -77,7 +77,9 @@ void check_xgemm_parameters(const std::map<std::string, std::size_t>& p, const D
   for (const char* name : names) {
     if (!p.count(name)) missing += std::string(missing.empty() ? "" : ", ") + name;
   }
-  for (const auto& [name, value] : p) {
+  for (const auto& entry : p) {
+    // (No structured binding: C++17 lambdas cannot capture one, and clang refuses it.)
+    const std::string& name = entry.first;
     if (std::find_if(std::begin(names), std::end(names), [&](const char* n) { return name == n; }) ==
         std::end(names)) {
       throw invalid_input("the key 'clblast.parameters." + name + "' is not a parameter of CLBlast's Xgemm");

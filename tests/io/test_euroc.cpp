@@ -2,10 +2,13 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <string>
+#include <vector>
 
 #include "eval/synthetic_euroc.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/io/euroc.hpp"
+#include "inertialnet/io/frame_source.hpp"
 #include "support/testing.hpp"
 
 namespace fs = std::filesystem;
@@ -199,6 +202,30 @@ TEST(Euroc, MissingImagesAndFiles) {
   EXPECT_TRUE(contains(msg, "not a EuRoC")) << msg;
 }
 
+// EurocReadOptions::camera (--camera cam1): that camera's listing and calibration; a camera the
+// sequence lacks is named with the ones it has.
+TEST(Euroc, SecondCamera) {
+  te::TempDir dir("euroc_cam1");
+  te::Spec spec;
+  te::write(dir.path() / "seq", spec);
+  const fs::path mav0 = dir.path() / "seq" / "mav0";
+  EurocReadOptions options;
+  options.camera = "cam1";
+  const std::string missing = invalid_input_message([&] { read_euroc(dir.path() / "seq", options); });
+  EXPECT_TRUE(contains(missing, "has no camera cam1")) << missing;
+  EXPECT_TRUE(contains(missing, "its cameras: cam0.")) << missing;
+
+  fs::create_directories(mav0 / "cam1");
+  const std::int64_t t0 = te::kStartNs + 7;
+  std::ofstream(mav0 / "cam1" / "data.csv") << "#timestamp [ns],filename\n" << t0 << ",a.png\n" << t0 + 50'000'000 << ",b.png\n";
+  options.check_images = false;
+  const EurocSequence seq = read_euroc(dir.path() / "seq", options);
+  ASSERT_EQ(seq.frames.size(), 2u);
+  EXPECT_EQ(seq.frames[0].t_ns, t0);
+  EXPECT_EQ(seq.frames[1].path, mav0 / "cam1" / "data" / "b.png");
+  EXPECT_FALSE(seq.camera.has_value());  // cam1 has no sensor.yaml here: cam0's is not taken for it
+}
+
 TEST(Euroc, GroundTruthIsOptional) {
   te::TempDir dir("euroc_nogt");
   te::Spec spec;
@@ -295,6 +322,23 @@ TEST(ImageFolder, NaturalOrderAndRate) {
   EXPECT_TRUE(contains(invalid_input_message([&] { list_image_folder(dir.path() / "none"); }), "does not exist"));
 }
 
+// Every format that recorders write and OpenCV reads is a frame (a folder of .bmp or .tif frames
+// was refused as holding no images); other files are not.
+TEST(ImageFolder, EveryRecordedImageFormatIsListed) {
+  te::TempDir dir("imgdir_formats");
+  const std::vector<std::string> images = {"f01.bmp", "f02.tif", "f03.TIFF", "f04.jpeg", "f05.pgm",
+                                           "f06.ppm", "f07.webp", "f08.png", "f09.JPG", "f10.pnm"};
+  for (const auto& n : images) std::ofstream(dir.path() / n);
+  for (const char* n : {"timestamps.txt", "calib.yaml", "f11.gif.bak"}) std::ofstream(dir.path() / n);
+  const ImageFolder folder = list_image_folder(dir.path());
+  ASSERT_EQ(folder.frames.size(), images.size());
+  for (std::size_t i = 0; i < images.size(); ++i) EXPECT_EQ(folder.frames[i].filename, images[i]);
+
+  te::TempDir empty("imgdir_none");
+  std::ofstream(empty.path() / "notes.txt");
+  EXPECT_TRUE(contains(invalid_input_message([&] { list_image_folder(empty.path()); }), ".bmp, .tif"));
+}
+
 TEST(ImageFolder, NanosecondFileNamesAreTimestamps) {
   te::TempDir dir("imgdir_ns");
   std::ofstream(dir.path() / "1403715273312142976.png");
@@ -303,4 +347,45 @@ TEST(ImageFolder, NanosecondFileNamesAreTimestamps) {
   ASSERT_TRUE(f.timestamps_known);
   EXPECT_EQ(f.frames[0].t_ns, 1403715273262142976);
   EXPECT_EQ(f.frames[1].t_ns, 1403715273312142976);
+}
+
+// KITTI raw: image_02/data/ beside image_02/timestamps.txt takes its frame times from the file
+// (KITTI is ≈ 10 Hz; 20 Hz was assumed), with a note; a count that differs or a malformed line is
+// refused naming the file and line; --rate still wins, with a note.
+TEST(ImageFolder, KittiRawTimestampsBesideTheFolder) {
+  te::TempDir dir("kitti_raw");
+  const fs::path data = dir.path() / "image_02" / "data";
+  fs::create_directories(data);
+  for (int i = 0; i < 3; ++i) std::ofstream(data / ("000000000" + std::to_string(i) + ".png"));
+  const fs::path stamps = dir.path() / "image_02" / "timestamps.txt";
+  std::ofstream(stamps) << "2011-09-26 13:02:25.964389445\n2011-09-26 13:02:26.074404031\n"
+                           "2011-09-26 13:02:26.184420\n";
+  const auto source = open_frame_source(data);
+  ASSERT_EQ(source->size(), 3u);
+  // 2011-09-26 is day 15243 after 1970-01-01.
+  const std::int64_t t0 = (15243LL * 86400 + 13 * 3600 + 2 * 60 + 25) * 1'000'000'000LL + 964389445;
+  EXPECT_EQ(source->timestamp_ns(0), t0);
+  EXPECT_EQ(source->timestamp_ns(1) - t0, 110014586);
+  EXPECT_EQ(source->timestamp_ns(2) - t0, 220030555);
+  ASSERT_FALSE(source->notes().empty());
+  EXPECT_TRUE(contains(source->notes().front(), "timestamps.txt (KITTI raw)"));
+  // A trailing slash names the same folder.
+  EXPECT_EQ(open_frame_source(data.string() + "/")->timestamp_ns(0), t0);
+
+  const auto with_rate = open_frame_source(data, 10.0);
+  EXPECT_EQ(with_rate->timestamp_ns(1), 100'000'000);
+  EXPECT_TRUE(contains(with_rate->notes().front(), "overrides the frame times in"));
+
+  std::ofstream(data / "0000000003.png");
+  EXPECT_TRUE(contains(invalid_input_message([&] { open_frame_source(data); }), "lists 3 times but"));
+  fs::remove(data / "0000000003.png");
+
+  std::ofstream(stamps) << "2011-09-26 13:02:25.964389445\n2011-13-26 13:02:26.07\n2011-09-26 13:02:26.18\n";
+  const std::string month = invalid_input_message([&] { open_frame_source(data); });
+  EXPECT_TRUE(contains(month, "timestamps.txt line 2: 2011-13-26 13:02:26.07")) << month;
+  EXPECT_TRUE(contains(month, "month 13")) << month;
+  std::ofstream(stamps) << "2011-09-26 13:02:25.9\n2011-09-26 13:02:25.8\n2011-09-26 13:02:26\n";
+  EXPECT_TRUE(contains(invalid_input_message([&] { open_frame_source(data); }), "goes back in time"));
+  std::ofstream(stamps) << "1317042145.9\n1317042146.0\n1317042146.1\n";
+  EXPECT_TRUE(contains(invalid_input_message([&] { open_frame_source(data); }), "line 1: 1317042145.9 is not a KITTI time"));
 }

@@ -252,3 +252,40 @@ TEST_F(ImageIo, FloatImagesAreRefused) {
   const std::string m = invalid_input_message([&] { load_rgb_image(dir / "f.tiff"); });
   EXPECT_TRUE(contains(m, "f.tiff") && contains(m, "32-bit float")) << m;
 }
+
+// A folder of frames in each format that recorders write besides PNG and JPEG (.bmp, .tif,
+// .pgm/.ppm, .webp): listed, decoded and the same pixels as written (lossless formats; WebP
+// written lossless). Before, such a folder "held no .png or .jpg images".
+TEST_F(ImageIo, FolderOfEveryRecordedFormatDecodes) {
+  const cv::Mat colour = pattern_bgr8();
+  cv::Mat gray;
+  cv::extractChannel(colour, gray, 1);
+  struct Case {
+    const char* name;
+    const cv::Mat& image;
+    std::vector<int> params;
+  };
+  const std::vector<Case> cases = {{"f0.bmp", colour, {}},  {"f1.tif", colour, {}},
+                                   {"f2.TIFF", colour, {}}, {"f3.ppm", colour, {}},
+                                   {"f4.pgm", gray, {}},    {"f5.webp", colour, {cv::IMWRITE_WEBP_QUALITY, 101}}};
+  const fs::path folder = dir / "formats";
+  fs::create_directories(folder);
+  for (const auto& c : cases) {
+    ASSERT_TRUE(cv::imwrite((folder / c.name).string(), c.image, c.params)) << c.name << ": OpenCV cannot write it";
+  }
+  auto source = open_frame_source(folder);
+  ASSERT_EQ(source->size(), cases.size());
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    const HostImage img = source->decode(i);
+    ASSERT_EQ(img.width, 5) << cases[i].name;
+    ASSERT_EQ(img.height, 3) << cases[i].name;
+    const bool is_gray = cases[i].image.channels() == 1;
+    for (int y = 0; y < 3; ++y) {
+      for (int x = 0; x < 5; ++x) {
+        EXPECT_EQ(img.at(0, y, x), is_gray ? 100 + 10 * y + x : 200 + 10 * y + x) << cases[i].name;
+        EXPECT_EQ(img.at(1, y, x), 100 + 10 * y + x) << cases[i].name;
+        EXPECT_EQ(img.at(2, y, x), is_gray ? 100 + 10 * y + x : 10 * y + x) << cases[i].name;
+      }
+    }
+  }
+}

@@ -30,7 +30,7 @@ struct CalibrateTimeOptions {
 RatesTable predict_weight_free(const CalibrateTimeOptions& o, const EurocSequence& seq, const GlobalOptions& global) {
   const bool given = o.camera.fx > 0 || o.camera.fy > 0;
   if (!seq.camera && !given) {
-    throw invalid_input("calibrate-time: " + o.sequence + (seq.mav0.empty() ? " has no camera calibration" : " has no cam0/sensor.yaml") +
+    throw invalid_input("calibrate-time: " + o.sequence + (seq.mav0.empty() ? " has no camera calibration" : " has no " + o.input.camera + "/sensor.yaml") +
                         " to predict with; give --fx (and --fy --cx --cy), or a rates file.");
   }
   PredictSettings settings;
@@ -40,6 +40,7 @@ RatesTable predict_weight_free(const CalibrateTimeOptions& o, const EurocSequenc
   settings.cx = o.camera.cx;
   settings.cy = o.camera.cy;
   settings.rate_hz = o.input.rate_hz;
+  settings.camera = o.input.camera;
   settings.device = global.device;
   settings.no_cache = global.no_cache;
   Prediction prediction(settings);
@@ -101,7 +102,9 @@ Command register_calibrate_time(CLI::App& app, const GlobalOptions& global) {
     }
     std::printf("time_offset_s %.6f\nstd_error_s %.6f\nconfidence %s\n", e.offset_s, e.std_error_s, e.confidence().c_str());
     std::string input;
+    if (o->input.camera != "cam0") input += " --camera " + o->input.camera;
     if (!o->input.imu.empty()) input += " --imu " + o->input.imu;
+    if (!o->input.imu_time_unit.empty()) input += " --imu-time-unit " + o->input.imu_time_unit;
     if (!o->input.T_cam_imu.empty()) input += " --T-cam-imu '" + o->input.T_cam_imu + "'";
     if (!o->input.camchain.empty()) input += " --camchain " + o->input.camchain;
     std::cout << "apply it with: inertialnet eval RATES.csv " << o->sequence << input << " --time-offset " << e.offset_s

@@ -62,6 +62,7 @@ struct PredictOptions {
   std::string save_flow;
   std::string flow_format = "flo";
   double rate_hz = 0;
+  std::string camera_name = "cam0";  // --camera (o.camera holds --fx …)
   std::string time_offset, readout_time;
   double flow_check_px = 0.5;  // PredictSettings' default
   int lanes = 0;  // 0: default_lanes_per_device()
@@ -129,6 +130,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
       ->needs(save_flow_option);
   app.add_option("--rate", o->rate_hz, "frame rate for image folders and videos without timestamps (Hz)")
       ->check(finite_positive_up_to(1e6, "Hz"));
+  add_camera_option(app, o->camera_name);
   app.add_option("--time-offset", o->time_offset,
                  "camera-IMU time offset in seconds (t_imu = t_cam + offset), stated in the CSV for eval");
   app.add_option("--readout-time", o->readout_time,
@@ -169,6 +171,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
     settings.cx = o->camera.cx;
     settings.cy = o->camera.cy;
     settings.rate_hz = o->rate_hz;
+    settings.camera = o->camera_name;
     settings.flow_check_px = o->flow_check_px;
     if (!o->readout_time.empty()) settings.readout_time_s = parse_seconds(o->readout_time, "--readout-time");
     if (!o->time_offset.empty()) settings.time_offset_s = parse_seconds(o->time_offset, "--time-offset");

@@ -1,5 +1,7 @@
 #include "input_options.hpp"
 
+#include "common.hpp"
+
 #include <cmath>
 #include <regex>
 #include <sstream>
@@ -62,11 +64,24 @@ void add_intrinsics_options(CLI::App& app, IntrinsicsCliOptions& o) {
   app.add_option("--cy", o.cy, "principal point y (px)")->check(finite_pixel_coordinate());
 }
 
+void add_camera_option(CLI::App& app, std::string& camera) {
+  app.add_option("--camera", camera,
+                 "camera of a EuRoC sequence: cam0 or cam1 (mav0/<camera>/data.csv and sensor.yaml)")
+      ->capture_default_str()
+      ->transform(choice("camera", {"cam0", "cam1"}));
+}
+
 void add_imu_options(CLI::App& app, ImuCliOptions& o) {
+  add_camera_option(app, o.camera);
   app.add_option("--imu", o.imu,
-                 "IMU CSV in EuRoC's format (timestamp [ns], gyro x y z [rad/s], accel x y z [m/s^2]) on the frames' "
-                 "clock, for an image folder or a video; for a EuRoC folder it replaces mav0/imu0/data.csv")
+                 "gyro log on the frames' clock, for an image folder or a video (for a EuRoC folder it replaces "
+                 "mav0/imu0/data.csv): a CSV of time, gx, gy, gz [rad/s] with or without accel x y z after them "
+                 "(EuRoC's imu0/data.csv), times in ns unless the header (t_s, timestamp [ns], ...) or "
+                 "--imu-time-unit says otherwise; or Gyroflow's .gcsv")
       ->check(CLI::ExistingFile);
+  app.add_option("--imu-time-unit", o.imu_time_unit,
+                 "unit of the --imu CSV's time column when its header does not name it: s, ms, us or ns")
+      ->transform(choice("time unit", {"s", "ms", "us", "ns"}));
   auto* t = app.add_option("--T-cam-imu", o.T_cam_imu,
                            "with --imu: IMU-to-camera transform, 16 numbers (4x4 row-major, Kalibr's T_cam_imu) or a "
                            "YAML file with T_cam_imu (or T_BS as cam0/sensor.yaml writes it); default: identity");
@@ -84,6 +99,8 @@ ImuSequenceOptions imu_sequence_options(const ImuCliOptions& o) {
   ImuSequenceOptions options;
   options.imu_csv = o.imu;
   if (o.rate_hz > 0) options.rate_hz = o.rate_hz;
+  options.camera = o.camera;
+  if (!o.imu_time_unit.empty()) options.imu_time_unit = parse_time_unit(o.imu_time_unit);
   if (!o.T_cam_imu.empty()) options.camera_imu = parse_camera_imu(o.T_cam_imu, "--T-cam-imu");
   if (!o.camchain.empty()) options.camera_imu = read_kalibr_camchain(o.camchain);
   return options;

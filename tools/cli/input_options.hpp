@@ -28,9 +28,13 @@ struct IntrinsicsCliOptions {
 };
 void add_intrinsics_options(CLI::App& app, IntrinsicsCliOptions& o);
 
-// --imu FILE, --T-cam-imu M|FILE, --camchain FILE, --rate HZ.
+// --camera cam0|cam1: which camera of a EuRoC sequence (predict, eval, calibrate-time).
+void add_camera_option(CLI::App& app, std::string& camera);
+
+// --imu FILE, --imu-time-unit s|ms|us|ns, --T-cam-imu M|FILE, --camchain FILE, --rate HZ.
 struct ImuCliOptions {
-  std::string imu, T_cam_imu, camchain;
+  std::string imu, imu_time_unit, T_cam_imu, camchain;
+  std::string camera = "cam0";  // --camera, added with the IMU options
   double rate_hz = 0;
 };
 void add_imu_options(CLI::App& app, ImuCliOptions& o);

@@ -98,8 +98,9 @@ std::vector<ImuSample> read_imu_csv(const std::filesystem::path& csv,
 std::vector<GroundTruthSample> read_ground_truth_csv(const std::filesystem::path& csv,
                                                      std::vector<std::string>* warnings = nullptr);
 
-// A folder of *.png / *.jpg / *.jpeg images (case-insensitive), sorted by name with digit runs
-// compared as numbers (frame2 before frame10).
+// A folder of images (.png .jpg .jpeg .bmp .tif .tiff .pgm .ppm .pnm .webp, case-insensitive:
+// what recorders write and OpenCV decodes), sorted by name with digit runs compared as numbers
+// (frame2 before frame10); other files are left out.
 struct ImageFolder {
   std::vector<CameraFrame> frames;
   // How t_ns was obtained: with a rate, t_ns = round(i · 1e9 / rate); without one, from the file

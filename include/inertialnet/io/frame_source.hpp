@@ -37,15 +37,17 @@ class FrameSource {
   virtual std::vector<std::string> notes() const { return {}; }
 };
 
-// Opens `path`: a EuRoC folder (mav0/cam0/data.csv), a folder of images (sorted by name;
+// Opens `path`: a EuRoC folder (mav0/cam0/data.csv, or the camera asked for), a folder of images (sorted by name;
 // timestamps from `rate_hz` when given, else from the names when they are nanosecond stamps,
 // else 20 Hz), or a video file read with FFmpeg (timestamps from `rate_hz` when given, else the
 // presentation timestamps of its frames, read in one pass over the container when it is opened,
 // when they increase, else its nominal frame rate; never renumbered: docs/data_conventions.md).
 // notes() says which was used when it was not the sequence's own stamps, and that a video ends
 // before the frame count its header announces. Fewer than two frames, an empty or unreadable
-// source are invalid_input.
+// source are invalid_input. `camera` picks a EuRoC folder's camera (mav0/cam0 or mav0/cam1, as
+// --camera); any other than cam0 is refused for a folder of images or a video.
 std::unique_ptr<FrameSource> open_frame_source(const std::filesystem::path& path,
-                                               std::optional<double> rate_hz = std::nullopt);
+                                               std::optional<double> rate_hz = std::nullopt,
+                                               const std::string& camera = "cam0");
 
 }  // namespace inertialnet
