@@ -106,7 +106,9 @@ int show(Device& device, bool json) {
   // The packed GEMM runs its default for a stored value it does not support
   // (packed_gemm_setting); say so where the device's description lists the stored value.
   std::vector<std::string> not_applied;
-  for (const auto& [name, value] : tuning.packed) {
+  for (const auto& entry : tuning.packed) {
+    const auto& name = entry.first;  // not a structured binding: the lambda below captures it (C++17)
+    const auto& value = entry.second;
     const auto known = std::find_if(packed_gemm_parameters().begin(), packed_gemm_parameters().end(),
                                     [&](const PackedGemmParameter& p) { return name == p.name; });
     std::string why;
