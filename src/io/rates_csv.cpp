@@ -14,6 +14,7 @@
 
 #include "inertialnet/runtime/error.hpp"
 #include "io/csv_util.hpp"
+#include "runtime/atomic_file.hpp"
 
 namespace fs = std::filesystem;
 
@@ -394,14 +395,6 @@ fs::path regular_rates_target(const fs::path& path) {
   return target;
 }
 
-void sync_folder_of(const fs::path& file) {
-  fs::path folder = file.parent_path();
-  if (folder.empty()) folder = ".";
-  const int fd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (fd < 0) return;  // best effort: the rows are on the disk under one name or the other
-  ::fsync(fd);
-  ::close(fd);
-}
 
 }  // namespace
 
@@ -431,7 +424,7 @@ struct RatesCsvWriter::Stream {
     if (::close(closing) != 0) throw_write_error("close", journal, errno);
     if (in_place) return;
     if (::rename(journal.c_str(), target.c_str()) != 0) throw_write_error("rename " + journal.string() + " to", target, errno);
-    sync_folder_of(target);
+    sync_folder(target);
   }
   ~Stream() {
     if (fd >= 0) ::close(fd);  // not closed: the journal stays, with every row written so far

@@ -24,17 +24,6 @@ namespace {
   throw runtime_error(message);
 }
 
-// Makes the rename durable. Best effort: some file systems cannot sync a folder (EINVAL), and by
-// now the file's content is on the disk under one name or the other.
-void sync_folder(const std::filesystem::path& file) {
-  std::filesystem::path folder = file.parent_path();
-  if (folder.empty()) folder = ".";
-  const int fd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (fd < 0) return;
-  ::fsync(fd);
-  ::close(fd);
-}
-
 // The file that writing `path` should replace. A symbolic link is followed on purpose, so that the
 // file it names is written and the link stays; anything that exists and is not a regular file (a
 // device, a FIFO, a socket, a folder) is refused, because renaming over it would destroy it.
@@ -60,6 +49,17 @@ std::filesystem::path regular_target(const std::filesystem::path& path) {
 }
 
 }  // namespace
+
+// Makes the rename durable. Best effort: some file systems cannot sync a folder (EINVAL), and by
+// now the file's content is on the disk under one name or the other.
+void sync_folder(const std::filesystem::path& file) {
+  std::filesystem::path folder = file.parent_path();
+  if (folder.empty()) folder = ".";
+  const int fd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return;
+  ::fsync(fd);
+  ::close(fd);
+}
 
 AtomicFile::AtomicFile(std::filesystem::path path) : path_(regular_target(path)) {
   // Unique per process and per call, so that threads writing the same name never share a temporary.

@@ -38,6 +38,10 @@ class AtomicFile {
   bool committed_ = false;
 };
 
+// Flushes the folder holding `file` to the disk, so that a rename into it survives a power cut.
+// Best effort: some file systems cannot sync a folder, and the file is on the disk either way.
+void sync_folder(const std::filesystem::path& file);
+
 // The whole file at once.
 void write_file_atomically(const std::filesystem::path& path, const void* data, std::size_t size);
 
