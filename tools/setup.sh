@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs the Debian packages that building, testing and running InertialNet-CL need (OpenCL
-# headers and ICD loader, PoCL for the CPU, CLBlast, OpenCV, FFmpeg's libraries for videos,
+# headers and ICD loader, PoCL for the CPU, CLBlast, OpenCV, FFmpeg's libraries for videos;
+# sqlite3, zstd, lz4 and bz2 for ROS bags; GStreamer's base plugins and gst-launch for the
+# live-capture tests (videotestsrc; OpenCV's videoio reads live sources through GStreamer);
 # Eigen, GoogleTest, Google Benchmark, CLI11, nlohmann-json, CMake and a C++17 compiler; OpenBLAS
 # only as the benchmarks' reference, never linked into the library; python3 and zsh for the CLI's
 # terminal and completion tests; python3-venv and python3-dev for the Python package, whose own
@@ -16,6 +18,8 @@ packages=(
   libclblast-dev libopenblas-dev
   libopencv-dev libeigen3-dev libopengv-dev
   libavformat-dev libavcodec-dev libswscale-dev libavutil-dev
+  libsqlite3-dev libzstd-dev liblz4-dev libbz2-dev
+  gstreamer1.0-plugins-base gstreamer1.0-tools
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev
   python3 zsh python3-venv python3-dev
