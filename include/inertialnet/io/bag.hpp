@@ -32,15 +32,25 @@ struct BagMessage {
   std::vector<std::uint8_t> data;             // the serialised message
 };
 
+// Messages of some topics, one at a time, in the order the bag stores them (recorders write in
+// receive order; a ROS 2 sqlite3 bag is read ordered by its timestamp column).
+class BagCursor {
+ public:
+  virtual ~BagCursor() = default;
+  // Fills `message` with the next one and returns true, or returns false at the end. A damaged
+  // container (a truncated chunk, a bad compression frame, a record that overruns the file) is
+  // invalid_input naming the bag and the byte offset or row; a message is handed out only when
+  // it was read whole.
+  virtual bool next(BagMessage& message) = 0;
+};
+
 class BagReader {
  public:
   virtual ~BagReader() = default;
   virtual const std::vector<BagConnection>& connections() const = 0;
-  // Calls `visit` for every message on one of `topics`, in log-time order (ties in the order
-  // stored). A damaged container (a truncated chunk, a bad compression frame) is invalid_input
-  // naming the bag and where in it; a message is handed out only when it was read whole.
-  virtual void read(const std::vector<std::string>& topics,
-                    const std::function<void(const BagMessage&)>& visit) = 0;
+  // A cursor over the messages on `topics` (each must be one of connections(); the caller checks
+  // and names the bag's topics when it is not). Several cursors may be open at once.
+  virtual std::unique_ptr<BagCursor> read(const std::vector<std::string>& topics) = 0;
   // "ROS 1 bag <path>", "ROS 2 bag <path> (sqlite3)", "ROS 2 bag <path> (MCAP)".
   virtual std::string description() const = 0;
 };
