@@ -4,6 +4,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -117,12 +118,21 @@ RatesExportFormat export_format(const std::string& format) {
   return rates_export_format_from_string(format == "gcsv" ? "gyroflow" : format);
 }
 
+// A value as the CSV holds it (%.9g, format_rates_row), so that `predict --format F` writes what
+// `export --format F` makes of predict's CSV, to the byte.
+double as_written(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.9g", v);
+  return std::strtod(text, nullptr);
+}
+
 // --format other than csv: the rows are kept as a rates table (what the CSV would hold: a rate
 // without an answer is NaN, as an empty cell reads) and converted when the run ends.
 void append_row(RatesTable& table, const RatesLayout& layout, const RatesRow& row) {
   const double nan = std::nan("");
   table.t_ns.push_back(row.t_ns);
-  table.w.push_back(row.status == "ok" ? row.w : Vec3{nan, nan, nan});
+  table.w.push_back(row.status == "ok" ? Vec3{as_written(row.w[0]), as_written(row.w[1]), as_written(row.w[2])}
+                                       : Vec3{nan, nan, nan});
   table.statuses[0].push_back(row.status);
   for (std::size_t c = 0; c < row.statuses.size(); ++c) table.statuses[c + 1].push_back(row.statuses[c]);
   for (std::size_t c = 0; c < row.extra.size(); ++c) {
@@ -133,7 +143,7 @@ void append_row(RatesTable& table, const RatesLayout& layout, const RatesRow& ro
     for (std::size_t g = 0; g < layout.status_names.size(); ++g) {
       if (layout.status_names[g] == status) ok = row.statuses[g] == "ok";
     }
-    table.extra[c].push_back(ok ? row.extra[c] : nan);
+    table.extra[c].push_back(ok ? as_written(row.extra[c]) : nan);
   }
 }
 
