@@ -11,7 +11,6 @@
 #include <fstream>
 #include <iterator>
 #include <set>
-#include <sstream>
 #include <utility>
 
 #include <nlohmann/json.hpp>
@@ -642,7 +641,13 @@ RatesCsvWriter::RatesCsvWriter(const fs::path& path, const RatesLayout& layout,
   // The journal's sidecar after the journal is truncated and before its first row: a stale
   // sidecar never describes new rows (a header alone is no rates file).
   if (!out_->in_place) {
-    write_file_atomically(rates_sidecar_path(out_->journal), journal_sidecar.data(), journal_sidecar.size());
+    try {
+      write_file_atomically(rates_sidecar_path(out_->journal), journal_sidecar.data(), journal_sidecar.size());
+    } catch (const Error&) {
+      ::close(std::exchange(out_->fd, -1));
+      ::unlink(out_->journal.c_str());  // no destructor runs after a throwing constructor
+      throw;
+    }
   }
 }
 

@@ -133,10 +133,10 @@ Quaternion normalised(const Quaternion& q) {
 }  // namespace
 
 RatesExportFormat rates_export_format_from_string(const std::string& name) {
-  if (name == "gyroflow") return RatesExportFormat::Gyroflow;
+  if (name == "gcsv" || name == "gyroflow") return RatesExportFormat::Gyroflow;  // the file format's name, or the tool's
   if (name == "euroc-imu") return RatesExportFormat::EurocImu;
   if (name == "tum") return RatesExportFormat::Tum;
-  throw invalid_input("unknown export format '" + name + "'; expected one of gyroflow, euroc-imu, tum");
+  throw invalid_input("unknown export format '" + name + "'; expected one of gcsv, gyroflow, euroc-imu, tum");
 }
 
 const char* to_string(RatesExportFormat format) {

@@ -136,7 +136,7 @@ endif()
 
 # 5. Bad inputs: exit 2, a message naming what is wrong, nothing written.
 run(2 ${CLI} export rates.csv --format csv -o x.csv)
-expect_match("--format: unknown format 'csv'; expected one of gyroflow, euroc-imu, tum")
+expect_match("--format: unknown format 'csv'; expected one of gcsv, gyroflow, euroc-imu, tum")
 file(SHA256 "${WORK}/rates.csv" before)
 run(2 ${CLI} export rates.csv --format tum -o rates.csv)
 expect_match("inertialnet: error: -o \\(rates.csv\\) would overwrite the input rates.csv")

@@ -79,7 +79,7 @@ run(0 ${CLI} eval rates.csv gap)  # the earlier pair still belongs together
 
 # 5. Bad output choices, refused before any pair (exit 2).
 run(2 ${CLI} predict gap --format mp4 -o x.txt)
-expect_match("--format: unknown format 'mp4'; expected one of csv, gcsv, euroc-imu, tum")
+expect_match("--format: unknown format 'mp4'; expected one of csv, gcsv, gyroflow, euroc-imu, tum")
 # An image folder has no IMU: its rates are in the camera frame, which EuRoC's columns are not.
 run(2 ${CLI} predict gap/mav0/cam0/data --rate 20 --fx 300 --format euroc-imu -o cam.csv)
 expect_match("inertialnet: error: --format euroc-imu: the rates of .* are in the camera frame")

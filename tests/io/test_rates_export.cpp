@@ -58,10 +58,11 @@ const char* kThreeRows =
 
 TEST(RatesExport, FormatNames) {
   EXPECT_EQ(rates_export_format_from_string("gyroflow"), RatesExportFormat::Gyroflow);
+  EXPECT_EQ(rates_export_format_from_string("gcsv"), RatesExportFormat::Gyroflow);  // predict --format's word
   EXPECT_EQ(rates_export_format_from_string("euroc-imu"), RatesExportFormat::EurocImu);
   EXPECT_EQ(rates_export_format_from_string("tum"), RatesExportFormat::Tum);
   EXPECT_STREQ(to_string(RatesExportFormat::EurocImu), "euroc-imu");
-  expect_invalid_input([] { rates_export_format_from_string("csv"); }, "'csv'; expected one of gyroflow, euroc-imu, tum");
+  expect_invalid_input([] { rates_export_format_from_string("csv"); }, "'csv'; expected one of gcsv, gyroflow, euroc-imu, tum");
 }
 
 TEST(RatesExport, GcsvHeaderAndOkRowsInMicroseconds) {

@@ -113,11 +113,6 @@ void check_predict_outputs(const PredictOptions& o) {
   if (!o.output.empty()) prepare_output_file(o.output, "-o");
 }
 
-// The export format `--format` names; csv is the rates CSV itself (not an export).
-RatesExportFormat export_format(const std::string& format) {
-  return rates_export_format_from_string(format == "gcsv" ? "gyroflow" : format);
-}
-
 // A value as the CSV holds it (%.9g, format_rates_row), so that `predict --format F` writes what
 // `export --format F` makes of predict's CSV, to the byte.
 double as_written(double v) {
@@ -165,10 +160,10 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
   add_intrinsics_options(app, o->camera);
   app.add_option("-o,--output", o->output, "rates CSV to write, folders created as needed (default: standard output)");
   app.add_option("--format", o->format,
-                 "csv (rates CSV and its sidecar <file>.json), gcsv (Gyroflow gyro log), euroc-imu (imu0/data.csv "
+                 "csv (rates CSV and its sidecar <file>.json), gcsv or gyroflow (Gyroflow's gyro log), euroc-imu (imu0/data.csv "
                  "layout, gyro only) or tum (orientation trajectory integrated from the rates, for evo); as `export`")
       ->capture_default_str()
-      ->transform(choice("format", {"csv", "gcsv", "euroc-imu", "tum"}));
+      ->transform(choice("format", {"csv", "gcsv", "gyroflow", "euroc-imu", "tum"}));
   auto* save_flow_option = app.add_option(
       "--save-flow", o->save_flow, "write each pair's flow as <timestamp>.flo (or .png) into this folder (created as needed)");
   app.add_option("--flow-format", o->flow_format,
@@ -371,10 +366,10 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
       // Pairs without an answer: left out of gcsv and euroc-imu, held over in tum (notes say so).
       RatesExportSummary written;
       if (o->output.empty()) {
-        std::cout << rates_export_text(collected, export_format(o->format), {}, o->sequence, written);
+        std::cout << rates_export_text(collected, rates_export_format_from_string(o->format), {}, o->sequence, written);
         flush_standard_output();
       } else {
-        written = export_rates(collected, o->sequence, o->output, export_format(o->format));
+        written = export_rates(collected, o->sequence, o->output, rates_export_format_from_string(o->format));
       }
       for (const std::string& note : written.notes) info("note: " + note);
       if (!o->output.empty()) {

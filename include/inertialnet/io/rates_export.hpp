@@ -49,7 +49,7 @@ namespace inertialnet {
 
 enum class RatesExportFormat { Gyroflow, EurocImu, Tum };
 
-// "gyroflow", "euroc-imu", "tum"; invalid_input listing them for another word.
+// "gcsv" (or "gyroflow"), "euroc-imu", "tum"; invalid_input listing them for another word.
 RatesExportFormat rates_export_format_from_string(const std::string& name);
 const char* to_string(RatesExportFormat format);
 
