@@ -176,10 +176,12 @@ def predict(
     head: Optional[str] = None,
     model: Optional[str] = None,
     solver: str = "motion-field",
-    fx: float = 0.0,
-    fy: float = 0.0,
-    cx: float = 0.0,
-    cy: float = 0.0,
+    fx: Optional[float] = None,
+    fy: Optional[float] = None,
+    cx: Optional[float] = None,
+    cy: Optional[float] = None,
+    calibration: Optional[PathLike] = None,
+    calibration_camera: str = "",
     rate_hz: float = 0.0,
     camera: str = "cam0",
     time_offset: Optional[float] = None,
@@ -202,13 +204,16 @@ def predict(
     ``head="both"`` the geometric head's columns follow (``rates["wx_geometric"]``,
     ``rates.head("geometric")``). The arguments are the CLI's options: without weights, DIS flow
     and the geometric head; ``camera`` is ``--camera`` (a EuRoC sequence's cam0 or cam1);
+    ``calibration`` is ``--calibration`` (EuRoC sensor.yaml, Kalibr camchain, OpenCV YAML/XML;
+    ``calibration_camera`` picks a camchain's camera) and ``fx``, ``fy``, ``cx``, ``cy`` are
+    ``--fx`` … (None: not given; ``cx=0`` is a principal point at the corner);
     ``time_offset`` and ``readout_time`` are ``--time-offset`` and ``--readout-time`` (seconds;
     stated in the rates for :func:`evaluate`, the readout time also corrects the geometric head);
     ``flow_check`` is ``--flow-check`` (the DIS forward-backward check for the geometric head,
     pixels at 752 columns; 0: off). With ``keep_flow=True`` returns ``(rates, flows)``, flows a
     list of ``(H, W, 2)`` arrays (as computed, without the check's marks).
 
-    ``rate_hz``, ``fx`` and ``fy`` are 0 (not given) or what the CLI accepts for ``--rate``,
+    ``rate_hz``, ``fx`` and ``fy`` are 0 or None (not given) or what the CLI accepts for ``--rate``,
     ``--fx``, ``--fy`` (finite, positive, at most 1e6); ``max_pairs`` is 0 (all) or a count:
     anything else is a ``ValueError``. A missing sequence or weights file is a
     ``FileNotFoundError``.
@@ -223,9 +228,10 @@ def predict(
         weights = [weights]
     columns, t_ns, values, flows, statuses, metadata = _native._predict(
         os.fspath(sequence), [os.fspath(w) for w in weights], model or "", flow or "", head or "", solver,
-        float(fx), float(fy), float(cx), float(cy), float(rate_hz), _device_spec(device),
+        *(None if v is None else float(v) for v in (fx, fy, cx, cy)), float(rate_hz), _device_spec(device),
         keep_flow, max_pairs, int(lanes), int(decode_threads), float(flow_check), progress,
-        None if time_offset is None else float(time_offset), float(readout_time), camera)
+        None if time_offset is None else float(time_offset), float(readout_time), camera,
+        "" if calibration is None else os.fspath(calibration), calibration_camera)
     rates = _rates_of_predict(columns, t_ns, values, statuses, metadata)
     return (rates, flows) if keep_flow else rates
 
@@ -269,6 +275,8 @@ def evaluate(
     imu_time_unit: Optional[str] = None,
     T_cam_imu=None,
     camchain: Optional[PathLike] = None,
+    calibration: Optional[PathLike] = None,
+    calibration_camera: str = "",
     camera: str = "cam0",
     rate_hz: float = 0.0,
     plot: Optional[PathLike] = None,
@@ -286,8 +294,9 @@ def evaluate(
     (seconds, t_imu = t_cam + offset, or "auto" to estimate it within ±``time_offset_range``;
     None: the rates' own), ``readout_time`` (seconds; None: the rates' own), ``imu`` (a gyro log:
     EuRoC CSV, gyro-only CSV, Gyroflow .gcsv; ``imu_time_unit`` s|ms|us|ns), ``T_cam_imu`` (IMU to
-    camera: a 4x4 matrix, 16 numbers, or a YAML file), ``camchain`` (a Kalibr camchain, its
-    ``camera``), ``camera`` (a EuRoC sequence's cam0 or cam1), ``rate_hz`` (a folder's or video's
+    camera: a 4x4 matrix, 16 numbers, or a YAML file), ``camchain`` (a Kalibr camchain's cam0),
+    ``calibration`` (a calibration file whose camera-IMU extrinsic, if it has one, stands for
+    ``camchain``; ``calibration_camera`` picks a camchain's camera), ``camera`` (a EuRoC sequence's cam0 or cam1), ``rate_hz`` (a folder's or video's
     frame rate, as predict was given it), ``plot`` (a PNG).
 
     Returns the ``inertialnet.eval/1`` document as a dict: its ``estimators`` list holds one
@@ -306,7 +315,8 @@ def evaluate(
             return evaluate(path, sequence, target=target, head=head, gyro_bias=gyro_bias, camera_frame=camera_frame,
                             time_offset=time_offset, time_offset_range=time_offset_range,
                             readout_time=readout_time, imu=imu, imu_time_unit=imu_time_unit, T_cam_imu=T_cam_imu,
-                            camchain=camchain, camera=camera, rate_hz=rate_hz, plot=plot, series=series)
+                            camchain=camchain, calibration=calibration, calibration_camera=calibration_camera,
+                            camera=camera, rate_hz=rate_hz, plot=plot, series=series)
     if isinstance(gyro_bias, str):
         bias = gyro_bias
     else:
@@ -315,5 +325,6 @@ def evaluate(
         os.fspath(rates), os.fspath(sequence), target or "", head or "", bias, camera_frame,
         "" if plot is None else os.fspath(plot), series, time_offset, float(time_offset_range), readout_time,
         "" if imu is None else os.fspath(imu), imu_time_unit or "", _t_cam_imu_text(T_cam_imu),
-        "" if camchain is None else os.fspath(camchain), camera, float(rate_hz))
+        "" if camchain is None else os.fspath(camchain), camera, float(rate_hz),
+        "" if calibration is None else os.fspath(calibration), calibration_camera)
     return json.loads(text)

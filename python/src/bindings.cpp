@@ -33,6 +33,7 @@
 #include <vector>
 
 #include "inertialnet/inertialnet.hpp"
+#include "inertialnet/io/calibration_file.hpp"
 
 namespace py = pybind11;
 using namespace inertialnet;
@@ -830,7 +831,8 @@ std::string evaluate_json(const std::filesystem::path& rates, const std::filesys
                           bool camera_frame, const std::string& plot, bool series, const py::object& time_offset,
                           double time_offset_range, const py::object& readout_time, const std::string& imu,
                           const std::string& imu_time_unit, const std::string& T_cam_imu, const std::string& camchain,
-                          const std::string& camera, double rate_hz) {
+                          const std::string& camera, double rate_hz, const std::string& calibration,
+                          const std::string& calibration_camera) {
   existing(rates, "the rates file");
   existing(sequence, "the sequence");
   EvalOptions options;
@@ -877,7 +879,19 @@ std::string evaluate_json(const std::filesystem::path& rates, const std::filesys
     throw invalid_input("T_cam_imu and camchain both give the camera-IMU rotation: give one of them.");
   }
   if (!T_cam_imu.empty()) options.input.camera_imu = parse_camera_imu(T_cam_imu, "T_cam_imu");
-  if (!camchain.empty()) options.input.camera_imu = read_kalibr_camchain(existing(camchain, "the camchain"), camera);
+  if (!camchain.empty()) options.input.camera_imu = read_kalibr_camchain(existing(camchain, "the camchain"));
+  if (!calibration.empty()) {
+    // As eval --calibration: the file's camera-IMU extrinsic, when it has one, stands for a
+    // camchain (tools/cli/input_options.cpp); a file without one leaves the others in charge.
+    const CalibrationFile file = read_calibration_file(existing(calibration, "the calibration file"), calibration_camera);
+    if (file.camera_imu) {
+      if (options.input.camera_imu) {
+        throw invalid_input("calibration=" + calibration + " holds a camera-IMU extrinsic, and " +
+                            (camchain.empty() ? "T_cam_imu=" : "camchain=") + " gives one too; give one of them.");
+      }
+      options.input.camera_imu = file.camera_imu;
+    }
+  }
   options.input.camera = camera;
   options.input.rate_hz = rate_of(rate_hz);
   options.head_suffix = head.empty() ? "" : "_" + head;
@@ -1082,10 +1096,11 @@ PYBIND11_MODULE(_inertialnet, m) {
 
   m.def("_predict",
         [](const std::filesystem::path& sequence, const std::vector<std::string>& weights, const std::string& model,
-           const std::string& flow, const std::string& head, const std::string& solver, double fx, double fy, double cx,
-           double cy, double rate_hz, const std::string& device, bool keep_flow, const py::object& max_pairs, int lanes,
-           int decode_threads, double flow_check, const py::object& progress, const py::object& time_offset,
-           double readout_time, const std::string& camera) {
+           const std::string& flow, const std::string& head, const std::string& solver, const py::object& fx,
+           const py::object& fy, const py::object& cx, const py::object& cy, double rate_hz, const std::string& device,
+           bool keep_flow, const py::object& max_pairs, int lanes, int decode_threads, double flow_check,
+           const py::object& progress, const py::object& time_offset, double readout_time, const std::string& camera,
+           const std::string& calibration, const std::string& calibration_camera) {
           // The CLI's checks of --max-pairs, --rate, --fx, --fy: a value they refuse is a ValueError
           // here, not ignored (a negative rate or focal length was taken as "not given").
           const std::int64_t pairs = integer_of(max_pairs, "max_pairs");
@@ -1093,8 +1108,25 @@ PYBIND11_MODULE(_inertialnet, m) {
             throw invalid_input("max_pairs must be a count of pairs (0 for all), got " + std::to_string(pairs));
           }
           rate_of(rate_hz);
-          zero_or_positive(fx, "fx", "pixels", "the calibration's focal length");
-          zero_or_positive(fy, "fy", "pixels", "fx");
+          // None: not given. fx, fy: 0 is "not given" too (never a focal length); cx, cy: any
+          // coordinate within 1e6 pixels, 0 included (a principal point at the corner), as
+          // --cx and --cy take it.
+          const auto focal = [](const py::object& value, const char* name, const char* zero_means) {
+            return value.is_none() ? std::optional<double>()
+                                   : std::optional<double>(zero_or_positive(value.cast<double>(), name, "pixels", zero_means));
+          };
+          const auto coordinate = [](const py::object& value, const char* name) {
+            if (value.is_none()) return std::optional<double>();
+            const double x = value.cast<double>();
+            if (!(std::abs(x) <= 1e6)) {
+              throw invalid_input(std::string(name) + " must be a finite pixel coordinate within 1e+06 of the origin, got " +
+                                  got(x));
+            }
+            return std::optional<double>(x);
+          };
+          const auto given_fx = focal(fx, "fx", "the calibration's focal length");
+          const auto given_fy = focal(fy, "fy", "fx");
+          const auto given_cx = coordinate(cx, "cx"), given_cy = coordinate(cy, "cy");
           if (!progress.is_none() && !PyCallable_Check(progress.ptr())) {
             throw py::type_error("progress must be a callable taking (done, total), or None, not " +
                                  type_name(progress));
@@ -1111,10 +1143,12 @@ PYBIND11_MODULE(_inertialnet, m) {
           s.flow = flow;
           s.head = head;
           s.solver = solver;
-          s.fx = fx;
-          s.fy = fy;
-          s.cx = cx;
-          s.cy = cy;
+          s.fx = given_fx;
+          s.fy = given_fy;
+          s.cx = given_cx;
+          s.cy = given_cy;
+          s.calibration = calibration.empty() ? std::filesystem::path() : existing(calibration, "the calibration file");
+          s.calibration_camera = calibration_camera;
           s.rate_hz = rate_hz;
           s.device = device;
           s.keep_flow = keep_flow;

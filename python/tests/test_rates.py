@@ -122,3 +122,22 @@ def test_an_old_structured_array_still_evaluates(sequence):
     assert records.dtype.names == ("timestamp_ns", "wx", "wy", "wz", "status")
     report = inertialnet.evaluate(records, sequence, target="mean")
     assert report["estimators"][0]["frames_evaluated"] == 4
+
+
+def test_calibration_file_for_a_folder_as_predict_and_eval_take_it(cli, sequence, tmp_path):
+    """calibration= is --calibration: the frames as a plain image folder with the sequence's own
+    sensor.yaml give the EuRoC folder's rates, in the body frame (its T_BS), and evaluate() with
+    the IMU beside them the numbers of `eval --imu --calibration`."""
+    folder = sequence / "mav0" / "cam0" / "data"
+    yaml = sequence / "mav0" / "cam0" / "sensor.yaml"
+    imu = sequence / "mav0" / "imu0" / "data.csv"
+    rates = inertialnet.predict(folder, calibration=yaml)
+    assert rates.frame == "body"
+    np.testing.assert_array_equal(rates.w, inertialnet.predict(sequence).w)
+    cli("predict", folder, "--calibration", yaml, "-o", tmp_path / "rates.csv")
+    expected = json.loads(cli("eval", tmp_path / "rates.csv", folder, "--imu", imu, "--calibration", yaml, "--json",
+                              stdout_only=True))
+    report = inertialnet.evaluate(rates, folder, imu=imu, calibration=yaml)
+    np.testing.assert_allclose(rmse(report, "raw"), rmse(expected, "raw"), rtol=1e-9)
+    with pytest.raises(FileNotFoundError):
+        inertialnet.predict(folder, calibration=tmp_path / "missing.yaml")
