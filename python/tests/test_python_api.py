@@ -104,3 +104,19 @@ def test_devices_by_index_and_object_everywhere(sequence):
     assert repr(inertialnet.GeometricHead(device=0)).endswith(f"on {device.name}>")
     with pytest.raises(TypeError, match="device must be None, a device spec string, an index"):
         inertialnet.predict(sequence, device=0.5)
+
+
+def test_stubs_name_what_the_native_module_has():
+    """_inertialnet.pyi lists the native module's functions and classes, and each of them exists
+    (a renamed or removed binding fails here rather than in a user's type checker)."""
+    import ast
+    import pathlib
+
+    stubs = ast.parse((pathlib.Path(inertialnet.__file__).parent / "_inertialnet.pyi").read_text())
+    names = [node.name for node in stubs.body if isinstance(node, (ast.FunctionDef, ast.ClassDef))]
+    assert "_Sequence" in names and "_read_rates_csv" in names
+    assert [n for n in names if not hasattr(inertialnet._native, n)] == []
+    for cls in (node for node in stubs.body if isinstance(node, ast.ClassDef)):
+        for member in cls.body:
+            if isinstance(member, ast.FunctionDef):
+                assert hasattr(getattr(inertialnet._native, cls.name), member.name), (cls.name, member.name)
