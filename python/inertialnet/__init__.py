@@ -42,9 +42,9 @@ from ._inertialnet import (  # noqa: F401  (re-exported)
     write_flow_png,
     write_kitti_flow,
 )
-from . import _inertialnet as _native
 from ._rates import Rates, read_rates, _rates_of_predict
 from ._sequence import Sequence
+from . import _inertialnet as _native
 
 PathLike = Union[str, "os.PathLike[str]"]
 Weights = Union[PathLike, Iterable[PathLike]]
@@ -52,10 +52,11 @@ DeviceLike = Union[None, str, int, Device]
 SequenceLike = Union[PathLike, Sequence]
 
 __all__ = [
+    "Rates", "read_rates",  # _rates.py
     "Camera", "Device", "FlowNet", "FlowNet2", "FlowNet2C", "FlowNet2S", "FlowNet2SD", "FlowNet2CS",
-    "FlowNet2CSS", "GeometricHead", "InertialNetHead", "Rates", "Sequence", "devices", "dis_flow", "evaluate",
-    "flow_to_color", "predict", "read_flo", "read_flow", "read_image", "read_kitti_flow", "read_rates",
-    "select_devices", "synth", "write_flo", "write_flow_png", "write_kitti_flow", "write_rates_csv",
+    "FlowNet2CSS", "GeometricHead", "InertialNetHead", "Sequence", "devices", "dis_flow", "evaluate",
+    "flow_to_color", "predict", "read_flo", "read_flow", "read_image", "read_kitti_flow", "select_devices",
+    "synth", "write_flo", "write_flow_png", "write_kitti_flow", "write_rates_csv",
 ]
 
 

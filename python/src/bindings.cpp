@@ -163,7 +163,9 @@ std::filesystem::path existing(const std::filesystem::path& path, const char* wh
 // `gyro_bias=(x, y, z)`; "eval " or "predict " before an option goes. Commands quoted in
 // backticks (`inertialnet weights --synthetic …`) are CLI commands to run and stay as they are.
 std::string python_words(const std::string& message) {
-  static const std::vector<std::string> values = {"FILE", "auto", "flownet2", "dis", "inertialnet", "geometric",
+  // Values that follow an option in the messages: placeholders stay as they are, words are quoted.
+  static const std::vector<std::string> placeholders = {"FILE", "N", "s|ms|us|ns"};
+  static const std::vector<std::string> values = {"auto", "flownet2", "dis", "inertialnet", "geometric",
                                                   "both", "spline", "mean"};
   std::string out;
   bool quoted = false;
@@ -193,15 +195,18 @@ std::string python_words(const std::string& message) {
     if (i < message.size() && message[i] == ' ') {
       std::size_t value_end = i + 1;
       while (value_end < message.size() && (std::isalnum(static_cast<unsigned char>(message[value_end])) ||
-                                             message[value_end] == ',')) {
+                                             message[value_end] == ',' || message[value_end] == '|')) {
         ++value_end;
       }
       const std::string value = message.substr(i + 1, value_end - i - 1);
       if (value == "x,y,z") {
         out += "(x, y, z)";
         i = value_end;
+      } else if (std::find(placeholders.begin(), placeholders.end(), value) != placeholders.end()) {
+        out += value;
+        i = value_end;
       } else if (std::find(values.begin(), values.end(), value) != values.end()) {
-        out += value == "FILE" ? value : "\"" + value + "\"";
+        out += "\"" + value + "\"";
         i = value_end;
       }
     }
