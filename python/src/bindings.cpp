@@ -157,6 +157,18 @@ std::filesystem::path existing(const std::filesystem::path& path, const char* wh
   throw py::error_already_set();
 }
 
+// The sequence of Sequence and predict: a path that must exist, unless it names a source by a
+// scheme ("camera:0", "gst:…": a word of letters and a colon before any '/'), which is no file and
+// which the frame source judges itself.
+std::filesystem::path existing_sequence(const std::filesystem::path& path) {
+  const std::string text = path.string();
+  const auto colon = text.find(':');
+  const bool scheme = colon != std::string::npos && colon >= 2 &&
+                      std::all_of(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(colon),
+                                  [](char c) { return std::islower(static_cast<unsigned char>(c)) != 0; });
+  return scheme ? path : existing(path, "the sequence");
+}
+
 // The library's messages are the CLI's and name its options ("give the IMU with --imu FILE");
 // in Python they name the keyword arguments instead ("imu=FILE"): `--imu-time-unit` becomes
 // `imu_time_unit=`, `--rate` `rate_hz=`, `--gyro-bias auto` `gyro_bias="auto"`, `--gyro-bias x,y,z`
@@ -683,7 +695,7 @@ class PyInertialNetHead {
 class PySequence {
  public:
   PySequence(const std::filesystem::path& path, double rate_hz)
-      : path_(existing(path, "the sequence")), rate_(rate_of(rate_hz)), source_(open_frame_source(path_, rate_)) {}
+      : path_(existing_sequence(path)), rate_(rate_of(rate_hz)), source_(open_frame_source(path_, rate_)) {}
   std::size_t size() const { return source_->size(); }
   py::array_t<std::int64_t> timestamps() const {
     py::array_t<std::int64_t> out(static_cast<py::ssize_t>(source_->size()));
@@ -1137,7 +1149,7 @@ PYBIND11_MODULE(_inertialnet, m) {
                                  type_name(progress));
           }
           PredictSettings s;
-          s.sequence = existing(sequence, "the sequence");
+          s.sequence = existing_sequence(sequence);
           // Stated in the rates' metadata for evaluate(), as predict --time-offset/--readout-time
           // state them in the CSV; the Prediction checks their ranges.
           if (!time_offset.is_none()) s.time_offset_s = time_offset.cast<double>();
