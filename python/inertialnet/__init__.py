@@ -324,7 +324,9 @@ def evaluate(
         bias = None if gyro_bias is None else [float(b) for b in gyro_bias]
     text = _native._evaluate_json(
         os.fspath(rates), os.fspath(sequence), target or "", head or "", bias, camera_frame,
-        "" if plot is None else os.fspath(plot), series, time_offset, float(time_offset_range), readout_time,
+        "" if plot is None else os.fspath(plot), series,
+        time_offset if time_offset is None or isinstance(time_offset, str) else float(time_offset),
+        float(time_offset_range), None if readout_time is None else float(readout_time),
         "" if imu is None else os.fspath(imu), imu_time_unit or "", _t_cam_imu_text(T_cam_imu),
         "" if camchain is None else os.fspath(camchain), camera, float(rate_hz),
         "" if calibration is None else os.fspath(calibration), calibration_camera)

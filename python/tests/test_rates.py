@@ -113,8 +113,10 @@ def test_evaluate_takes_imu_and_extrinsics_for_a_folder_as_eval_does(cli, sequen
     assert "--" not in str(error.value) and "imu=" in str(error.value) and "T_cam_imu=" in str(error.value)
     with pytest.raises(FileNotFoundError):
         inertialnet.evaluate(rates, folder, imu=tmp_path / "missing.csv")
-    with pytest.raises(ValueError, match="time_offset"):
+    with pytest.raises(ValueError, match="time_offset must be a number of seconds or \"auto\""):
         inertialnet.evaluate(rates, sequence, time_offset="soon")
+    with pytest.raises(ValueError, match="readout_time must be a finite number of seconds, got nan"):
+        inertialnet.evaluate(rates, sequence, readout_time=float("nan"))
 
 
 def test_an_old_structured_array_still_evaluates(sequence):
