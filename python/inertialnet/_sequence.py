@@ -46,6 +46,20 @@ class Sequence(collections.abc.Sequence):
         for k in range(len(self)):
             yield self._native[k]
 
+    # collections.abc.Sequence compares elements with ==, which NumPy answers elementwise (and
+    # `frame in seq` with "truth value of an array is ambiguous"): frames compare as whole arrays.
+    def __contains__(self, value) -> bool:
+        return any(np.array_equal(frame, value) for frame in self)
+
+    def index(self, value, start: int = 0, stop: Optional[int] = None) -> int:
+        for k in range(*slice(start, stop).indices(len(self))):
+            if np.array_equal(self._native[k], value):
+                return k
+        raise ValueError("the frame is not in the sequence")
+
+    def count(self, value) -> int:
+        return sum(1 for frame in self if np.array_equal(frame, value))
+
     def __fspath__(self) -> str:
         return self._native.path
 

@@ -25,6 +25,11 @@ def test_sequence_is_a_python_sequence(sequence):
         seq[5]
     with pytest.raises(TypeError, match="integers or slices, not str"):
         seq["0"]
+    # Membership and search compare whole frames.
+    assert seq[3] in seq and seq.index(seq[3]) == 3 and seq.count(seq[2]) == 1
+    assert np.zeros((96, 128, 3), np.uint8) not in seq
+    with pytest.raises(ValueError, match="not in the sequence"):
+        seq.index(seq[3], 0, 2)
     # A Sequence is path-like: predict takes it.
     assert len(inertialnet.predict(seq, max_pairs=1)) == 1
 
