@@ -139,9 +139,9 @@ class InertialNetHead:
 
     def rates(self, flow: np.ndarray, camera: Optional[Camera] = None, dt: Optional[float] = None) -> np.ndarray:
         """ω in rad/s: ``(3,)`` for one flow ``(H, W, 2)``, ``(N, 3)`` for a batch. The flow must have
-        the size the head was built for (``config``) and a finite, known vector at every pixel: NaN,
-        infinity or an unknown-flow mark (above 1e9, as ``dis_flow(flow_check=…)`` and KITTI files
-        write them) is a ``ValueError`` naming the first such index. ``camera`` and ``dt`` are
+        the size the head was built for (``config``) and a finite, known vector at every pixel: NaN
+        (what ``dis_flow(flow_check=…)`` and the flow readers give for unknown flow), infinity or a
+        value above 1e9 is a ``ValueError`` naming the first such index. ``camera`` and ``dt`` are
         accepted for symmetry with :class:`GeometricHead` and ignored: the learned head knows its
         camera and rate."""
         del camera, dt

@@ -1,13 +1,14 @@
 // The Python module `inertialnet._inertialnet`: the library's API for NumPy users. The pure
-// Python package (python/inertialnet/__init__.py) re-exports it and adds the model classes and
-// the structured array of predict().
+// Python package (python/inertialnet/__init__.py) re-exports it and adds the model classes,
+// Sequence (_sequence.py) and the Rates of predict() (_rates.py).
 //
-// Conventions: images are NumPy uint8 (or uint16) arrays (H, W) gray, (H, W, C) with C = 1, 3 or 4
-// (alpha dropped), or batches (N, H, W, C); flow is float32 (H, W, 2) (u, v in pixels) or
-// (N, H, W, 2); rates are float64 (3,) in rad/s. Device work runs without the GIL, and every long
-// call on a worker thread that Ctrl-C stops (run_interruptibly). Library errors keep their
-// messages: invalid input becomes ValueError, runtime failures RuntimeError, exhausted host memory
-// MemoryError.
+// Conventions: images are NumPy uint8 (or uint16) arrays, or floats in [0, 1], (H, W) gray,
+// (H, W, C) with C = 1, 3 or 4 (alpha dropped), or batches (N, H, W, C); flow is float32 (H, W, 2)
+// (u, v in pixels; NaN where unknown) or (N, H, W, 2); rates are float64 (3,) or (N, 3) in rad/s.
+// Device work runs without the GIL, and every long call on a worker thread that Ctrl-C stops
+// (run_interruptibly). Library errors keep their messages, with keyword arguments where they name
+// CLI options (python_words): invalid input becomes ValueError, runtime failures RuntimeError,
+// exhausted host memory MemoryError; a missing path is FileNotFoundError (existing).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -658,8 +659,8 @@ class PyInertialNetHead {
                                  std::to_string(i % w);
           throw invalid_input("flow[" + at + "] = (" + got(u) + ", " + got(v) +
                               ") is not a finite flow vector: the learned head needs a known flow at every pixel "
-                              "(NaN, infinity and the unknown-flow marks above 1e9 of dis_flow(flow_check=…) "
-                              "and KITTI files are refused).");
+                              "(NaN, which dis_flow(flow_check=…) and the flow readers give for unknown flow, infinity "
+                              "and values above 1e9 are refused).");
         }
         planar[2 * k * plane + i] = u;
         planar[(2 * k + 1) * plane + i] = v;
@@ -790,7 +791,7 @@ class ProgressReport {
 
 // The rows of predict(): the column names, the timestamps, the values (rows × columns; NaN where
 // a pair has no answer), with keep_flow each pair's flow, and the status words (rows × estimators).
-// The Python side makes the structured array.
+// The Python side makes the Rates (_rates.py).
 py::tuple predict(const PredictSettings& settings, std::size_t max_pairs, int lanes, int decode_threads,
                   const py::object& progress) {
   std::vector<std::int64_t> t_ns;
@@ -1074,7 +1075,7 @@ PYBIND11_MODULE(_inertialnet, m) {
   m.def("dis_flow", &dis_flow, py::arg("img1"), py::arg("img2"), py::arg("order") = "rgb", py::arg("flow_check") = 0.0,
         "OpenCV DIS optical flow (no weights) from img1 to img2: float32 (H, W, 2), or (N, H, W, 2) for batches.\n"
         "flow_check > 0 also computes the flow back and marks each vector whose round trip misses by more than\n"
-        "that many pixels (at 752 columns, scaled with the width) as unknown (1e10), as predict does for the\n"
+        "that many pixels (at 752 columns, scaled with the width) as unknown (NaN), as predict does for the\n"
         "geometric head (its default 0.5); GeometricHead.rates skips unknown vectors.");
 
   py::class_<PyGeometricHead>(m, "GeometricHead", "Angular velocity from flow by geometry alone (no weights).")
