@@ -1,8 +1,8 @@
 """The rates of :func:`inertialnet.predict`: one row per frame pair, with what the rates CSV states.
 
-A :class:`Rates` is what ``inertialnet predict`` writes to its CSV (schema ``inertialnet.rates/2``,
+A :class:`Rates` is what ``inertialnet predict`` writes to its CSV (schema ``inertialnet.rates/3``,
 docs/data_conventions.md), in memory: the timestamps, each estimator's rates and status words, and
-the ``# key: value`` metadata (the frame of the rates, the estimator, the camera-IMU time offset and
+the metadata of its sidecar (the frame of the rates, the estimator, the camera-IMU time offset and
 the readout time that predict was given). :func:`inertialnet.evaluate` reads that metadata exactly
 as ``inertialnet eval`` reads the CSV's; a bare array of rates lost it, and the target and the frame
 were then guessed (3.60 deg/s instead of 0.093 on the README's example).
@@ -31,7 +31,7 @@ class Rates:
     ``(N, 3)`` rad/s, NaN where the pair has no answer), ``rates.status`` (str ``(N,)``: ``"ok"``
     or why not, e.g. ``"no_texture"``), ``rates.estimator`` (``"inter_frame"`` or ``"network"``),
     ``rates.frame`` (``"body"`` or ``"camera"``), ``rates.time_offset_s``,
-    ``rates.readout_time_s`` and ``rates.metadata`` (every ``# key: value`` line of the CSV).
+    ``rates.readout_time_s`` and ``rates.metadata`` (every key of the CSV's sidecar, or of a schema-2 file's ``# key: value`` lines).
 
     ``np.asarray(rates)`` is ``rates.w``; ``len(rates)`` the number of pairs; ``rates["wx"]``,
     ``rates["status_geometric"]``, … a column of the CSV (``rates.columns`` lists them);
