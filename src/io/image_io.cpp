@@ -15,6 +15,7 @@
 
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/runtime/log.hpp"
+#include "io/crc32.hpp"
 #include "io/input_file.hpp"
 #include "io/image_mat.hpp"
 #include "io/third_party_log.hpp"
@@ -25,6 +26,7 @@ namespace inertialnet {
 
 namespace {
 
+using io_detail::crc32_of;
 using io_detail::quoted;
 
 using Bytes = std::vector<unsigned char>;
@@ -86,22 +88,6 @@ std::string jpeg_truncation(const Bytes& bytes) {
     }
   }
   return "it ends after " + std::to_string(bytes.size()) + " bytes without the end-of-image marker";
-}
-
-// CRC-32 as PNG (and zlib) compute it.
-std::uint32_t crc32_of(const unsigned char* data, std::size_t size) {
-  static const auto table = [] {
-    std::array<std::uint32_t, 256> t{};
-    for (std::uint32_t n = 0; n < 256; ++n) {
-      std::uint32_t c = n;
-      for (int k = 0; k < 8; ++k) c = (c & 1) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
-      t[n] = c;
-    }
-    return t;
-  }();
-  std::uint32_t c = 0xFFFFFFFFu;
-  for (std::size_t i = 0; i < size; ++i) c = table[(c ^ data[i]) & 0xFF] ^ (c >> 8);
-  return c ^ 0xFFFFFFFFu;
 }
 
 // PNG chunks carry a CRC-32 of their type and data. libpng checks it too, but prints its
