@@ -138,7 +138,7 @@ std::pair<std::uint64_t, std::uint64_t> header_size(const Bytes& bytes) {
 // OpenCV refuses to decode an image beyond its size limits (a "decompression bomb": a small file
 // whose header announces billions of pixels) with an assertion text; this says it in our words.
 // The limits are OpenCV's defaults unless its environment variables set them.
-std::string size_limit_message(const fs::path& path, const Bytes& bytes) {
+std::string size_limit_message(const std::string& what, const Bytes& bytes) {
   auto limit = [](const char* variable, const char* fallback) {
     const char* set = std::getenv(variable);
     return set && *set ? std::string(set) + " (" + variable + ")" : std::string(fallback);
@@ -147,7 +147,7 @@ std::string size_limit_message(const fs::path& path, const Bytes& bytes) {
   const std::string size = width > 0 && height > 0 ? " is " + std::to_string(width) + " × " + std::to_string(height) +
                                                          " pixels (" + std::to_string(width * height) + " in all),"
                                                    : " is";
-  return "The image " + quoted(path) + size + " larger than OpenCV decodes: at most " +
+  return "The image " + what + size + " larger than OpenCV decodes: at most " +
          limit("OPENCV_IO_MAX_IMAGE_PIXELS", "1073741824 (2^30)") + " pixels in all and " +
          limit("OPENCV_IO_MAX_IMAGE_WIDTH", "1048576 (2^20)") + " wide, " +
          limit("OPENCV_IO_MAX_IMAGE_HEIGHT", "1048576 (2^20)") +
@@ -200,13 +200,14 @@ void to_planar_rgb(const cv::Mat& image, float divisor, HostImage& out) {
 
 }  // namespace
 
-HostImage load_rgb_image(const fs::path& path) {
-  const Bytes bytes = read_whole_file(path);
+HostImage load_rgb_image(const fs::path& path) { return decode_image_bytes(read_whole_file(path), quoted(path)); }
+
+HostImage decode_image_bytes(const std::vector<unsigned char>& bytes, const std::string& what) {
   const std::string missing = truncation(bytes);
-  if (!missing.empty()) throw invalid_input("The image " + quoted(path) + " is truncated: " + missing + ".");
+  if (!missing.empty()) throw invalid_input("The image " + what + " is truncated: " + missing + ".");
   if (is_png(bytes)) {
     const std::string damage = png_corruption(bytes);
-    if (!damage.empty()) throw invalid_input("The image " + quoted(path) + " is corrupt: " + damage + ".");
+    if (!damage.empty()) throw invalid_input("The image " + what + " is corrupt: " + damage + ".");
   }
 
   io_detail::route_third_party_logs();
@@ -217,16 +218,16 @@ HostImage load_rgb_image(const fs::path& path) {
                          cv::IMREAD_UNCHANGED);
   } catch (const cv::Exception& e) {
     // OpenCV's text is an assertion with its source path: for -v only, our words for the user.
-    log_message(LogLevel::Debug, "OpenCV on " + quoted(path) + ": " + e.what());
-    if (e.err.find("CV_IO_MAX_IMAGE") != std::string::npos) throw invalid_input(size_limit_message(path, bytes));
-    throw invalid_input("The image " + quoted(path) +
+    log_message(LogLevel::Debug, "OpenCV on " + what + ": " + e.what());
+    if (e.err.find("CV_IO_MAX_IMAGE") != std::string::npos) throw invalid_input(size_limit_message(what, bytes));
+    throw invalid_input("The image " + what +
                         " cannot be decoded: OpenCV's decoder refuses it (its own words are in the debug log, -v).");
   }
   if (image.empty()) {
-    throw invalid_input("The image " + quoted(path) +
+    throw invalid_input("The image " + what +
                         " cannot be decoded: it is not in a format OpenCV reads, or it is corrupt.");
   }
-  return host_image_from_mat(image, quoted(path));
+  return host_image_from_mat(image, what);
 }
 
 HostImage host_image_from_mat(const cv::Mat& image, const std::string& what) {

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <optional>
 
+#include "inertialnet/io/bag.hpp"
 #include "inertialnet/io/camera.hpp"
 #include "inertialnet/models/flow_consistency.hpp"
 #include "inertialnet/runtime/device_selection.hpp"
@@ -35,7 +36,7 @@ const char* kNoWeightsHelp =
 // because a video decodes in order from its start and the pipeline starts at frame 0 again.
 std::pair<Frame, Frame> first_decodable_pair(const PredictSettings& s) {
   auto source =
-      open_frame_source(s.sequence, s.rate_hz > 0 ? std::optional<double>(s.rate_hz) : std::nullopt, s.camera);
+      open_frame_source(s.sequence, s.rate_hz > 0 ? std::optional<double>(s.rate_hz) : std::nullopt, s.camera, s.bag);
   std::optional<Frame> previous;
   std::optional<Error> first_error;
   for (std::size_t i = 0; i < source->size(); ++i) {
@@ -84,8 +85,10 @@ Prediction::Prediction(const PredictSettings& s) : settings_(s) {
   processor_.geometric.readout_time_s = s.readout_time_s;
   require_flow_check_setting(s.flow_check_px);
   processor_.flow_check_px = s.flow_check_px;
-  source_ = open_frame_source(s.sequence, s.rate_hz > 0 ? std::optional<double>(s.rate_hz) : std::nullopt, s.camera);
+  source_ = open_frame_source(s.sequence, s.rate_hz > 0 ? std::optional<double>(s.rate_hz) : std::nullopt, s.camera, s.bag);
   notes_ = source_->notes();
+  // Where the source's calibration comes from, for the messages below.
+  const std::string calibration_file = is_bag(s.sequence) ? "its CameraInfo" : s.camera + "/sensor.yaml";
   if (processor_.geometric_head) {
     const bool given = s.fx > 0 || s.fy > 0;
     if (given) {
@@ -105,21 +108,25 @@ Prediction::Prediction(const PredictSettings& s) : settings_(s) {
       } catch (const Error& e) {
         // The library's message names the model or the coefficients; say which file holds them.
         if (e.kind() != ErrorKind::InvalidInput) throw;
-        throw invalid_input(source_->description() + ": " + s.camera + "/sensor.yaml: " + e.what());
+        throw invalid_input(source_->description() + ": " + calibration_file + ": " + e.what());
       }
       // The geometric head allocates per pixel of the calibrated size: compare it with the
       // images before, so that a wrong resolution is a clear message, not gigabytes asked for.
       const HostImage first = first_decodable_pair(s).first.image;
       if (first.width != processor_.camera->width || first.height != processor_.camera->height) {
-        throw invalid_input(source_->description() + ": " + s.camera + "/sensor.yaml gives the resolution " +
+        throw invalid_input(source_->description() + ": " + calibration_file + " gives the resolution " +
                             std::to_string(processor_.camera->width) + "x" + std::to_string(processor_.camera->height) +
                             ", which does not match the images (" + std::to_string(first.width) + "x" +
                             std::to_string(first.height) + ").");
       }
-      processor_.camera_to_body = calibration->rotation_BS();
+      // A calibration without extrinsics (a bag's CameraInfo: T_BS all zero) leaves the rates in
+      // the camera frame, as for an image folder with --fx.
+      if (calibration->T_BS != std::array<double, 16>{}) processor_.camera_to_body = calibration->rotation_BS();
     } else {
       throw invalid_input("the geometric head needs the camera: " + source_->description() +
-                          " has no " + s.camera + "/sensor.yaml; give --fx (and --fy --cx --cy)");
+                          " has no " + (is_bag(s.sequence) ? "CameraInfo topic beside its images (--camera-info-topic)"
+                                                                      : s.camera + "/sensor.yaml") +
+                          "; give --fx (and --fy --cx --cy)");
     }
   }
   processor_.keep_flow = s.keep_flow;

@@ -41,6 +41,7 @@ RatesTable predict_weight_free(const CalibrateTimeOptions& o, const EurocSequenc
   settings.cy = o.camera.cy;
   settings.rate_hz = o.input.rate_hz;
   settings.camera = o.input.camera;
+  settings.bag = o.input.bag;
   settings.device = global.device;
   settings.no_cache = global.no_cache;
   Prediction prediction(settings);
@@ -66,7 +67,7 @@ RatesTable predict_weight_free(const CalibrateTimeOptions& o, const EurocSequenc
 
 Command register_calibrate_time(CLI::App& app, const GlobalOptions& global) {
   auto o = std::make_shared<CalibrateTimeOptions>();
-  app.add_option("sequence", o->sequence, "EuRoC-layout sequence with mav0/imu0, or an image folder or video with --imu")
+  app.add_option("sequence", o->sequence, "EuRoC-layout sequence with mav0/imu0, an image folder or video with --imu, or a ROS bag")
       ->required()
       ->check(CLI::ExistingPath);
   app.add_option("rates", o->rates, "rates CSV written by predict (default: predict weight-free now)")
