@@ -540,8 +540,8 @@ class PyInertialNetHead {
 
 class PySequence {
  public:
-  PySequence(const std::filesystem::path& path, double rate_hz)
-      : source_(open_frame_source(path, rate_of(rate_hz))) {}
+  PySequence(const std::filesystem::path& path, double rate_hz, const std::string& image_topic)
+      : source_(open_frame_source(path, rate_of(rate_hz), "cam0", BagTopics{image_topic, "", ""})) {}
   std::size_t size() const { return source_->size(); }
   py::array_t<std::int64_t> timestamps() const {
     py::array_t<std::int64_t> out(static_cast<py::ssize_t>(source_->size()));
@@ -572,7 +572,8 @@ class PySequence {
   }
   py::object camera_to_body() const {
     const auto c = source_->calibration();
-    if (!c) return py::none();
+    // A bag's CameraInfo has no extrinsics (T_BS all zero): no rotation to the body.
+    if (!c || c->T_BS == std::array<double, 16>{}) return py::none();
     const Mat3 r = c->rotation_BS();
     py::array_t<double> out({3, 3});
     std::copy(r.begin(), r.end(), out.mutable_data());
@@ -799,7 +800,8 @@ PYBIND11_MODULE(_inertialnet, m) {
       .def_property_readonly("config", &PyInertialNetHead::config);
 
   py::class_<PySequence>(m, "Sequence", "A EuRoC folder, an image folder or a video, frame by frame.")
-      .def(py::init<const std::filesystem::path&, double>(), py::arg("path"), py::arg("rate_hz") = 0.0)
+      .def(py::init<const std::filesystem::path&, double, const std::string&>(), py::arg("path"), py::arg("rate_hz") = 0.0,
+           py::arg("image_topic") = "")
       .def("__len__", &PySequence::size)
       .def("__getitem__", &PySequence::frame, py::arg("index"), "Frame `index` as uint8 RGB (H, W, 3).")
       .def_property_readonly("timestamps_ns", &PySequence::timestamps)

@@ -64,7 +64,13 @@ void check_increasing(const BagReader& reader, const std::string& topic, const s
 }
 
 // The topics' namespace: "/cam0/image_raw" → "/cam0/"; a CameraInfo beside an image topic shares it.
-std::string namespace_of(const std::string& topic) {
+// image_transport publishes a CompressedImage as "<image topic>/compressed": its camera's
+// namespace is the one of the image topic it compresses ("/cam0/image_raw/compressed" → "/cam0/").
+std::string namespace_of(std::string topic) {
+  const std::string transport = "/compressed";
+  if (topic.size() > transport.size() && topic.compare(topic.size() - transport.size(), transport.size(), transport) == 0) {
+    topic.resize(topic.size() - transport.size());
+  }
   const std::size_t slash = topic.rfind('/');
   return slash == std::string::npos ? std::string() : topic.substr(0, slash + 1);
 }
@@ -81,6 +87,13 @@ class BagFrames : public FrameSource {
       while (cursor->next(message)) stamps_.push_back(ros_header_stamp_ns(message, message_where(*reader_, topic_, stamps_.size())));
     }
     check_increasing(*reader_, topic_, stamps_);
+    // Before the CameraInfo is looked for: an empty bag is said to be empty, not to lack one.
+    if (stamps_.size() < 2) {
+      bool empty = true;
+      for (const BagConnection& c : reader_->connections()) empty = empty && c.message_count == 0;
+      throw invalid_input(description() + " has fewer than two frames: there is no frame pair to predict" +
+                          (empty ? " (the bag holds no message at all)." : "."));
+    }
     read_calibration(topics.camera_info);
   }
 
