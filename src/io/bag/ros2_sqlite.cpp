@@ -218,11 +218,11 @@ fs::path ros2_storage_file(const fs::path& folder) {
     throw invalid_input(where + " has storage_identifier \"" + storage + "\"; inertialnet reads \"sqlite3\" and \"mcap\".");
   }
   // rosbag2's own compression (`ros2 bag record --compression-mode file|message`) wraps the whole
-  // file or each message in zstd on top of the storage; `ros2 bag decompress` undoes it.
+  // file or each message in zstd on top of the storage; `ros2 bag convert` writes it uncompressed.
   const std::string compression = yaml::string(info["compression_mode"]);
   if (!compression.empty() && compression != "NONE" && compression != "none") {
     throw invalid_input(where + " is compressed by rosbag2 (compression_mode " + compression +
-                        "), which inertialnet does not read; decompress it first (rosbag2's `ros2 bag decompress`).");
+                        "), which inertialnet does not read; convert it to an uncompressed bag first (`ros2 bag convert`).");
   }
   const cv::FileNode paths = info["relative_file_paths"];
   std::vector<std::string> files;
