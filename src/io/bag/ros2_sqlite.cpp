@@ -19,6 +19,7 @@
 
 #include "inertialnet/runtime/error.hpp"
 #include "io/bag/containers.hpp"
+#include "io/bag/rosbag2_message_compression.hpp"
 #include "io/input_file.hpp"
 #include "io/yaml_util.hpp"
 
@@ -100,7 +101,9 @@ class SqliteCursor : public BagCursor {
  public:
   SqliteCursor(Database db, const fs::path& file, const std::string& sql,
                std::vector<std::pair<std::int64_t, const BagConnection*>> wanted)
-      : statement_(std::move(db), file, sql, "reading its messages"), wanted_(std::move(wanted)) {}
+      : statement_(std::move(db), file, sql, "reading its messages"),
+        wanted_(std::move(wanted)),
+        description_("ROS 2 bag " + io_detail::quoted(file)) {}
 
   bool next(BagMessage& message) override {
     if (!statement_.step()) return false;
@@ -116,12 +119,14 @@ class SqliteCursor : public BagCursor {
     // code on the connection); an empty message is a null pointer with size 0.
     if (data == nullptr && size > 0) statement_.fail();
     message.data.assign(data, data + size);
+    refuse_compressed_message(message, description_);
     return true;
   }
 
  private:
   Statement statement_;
   std::vector<std::pair<std::int64_t, const BagConnection*>> wanted_;
+  std::string description_;
 };
 
 class SqliteReader : public BagReader {
