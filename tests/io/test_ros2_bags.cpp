@@ -189,6 +189,9 @@ TEST_P(Ros2Bag, ReadsTopicsAndMessagesAsWritten) {
   }
   EXPECT_EQ(image_times, expected_image_times);
   EXPECT_EQ(imu_times, expected_imu_times);
+  // At the end a cursor stays at the end (it does not start over).
+  EXPECT_FALSE(images->next(message));
+  EXPECT_FALSE(imu->next(message));
   EXPECT_TRUE(read_all(*reader, {}).empty());
 }
 

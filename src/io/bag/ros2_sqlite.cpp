@@ -106,7 +106,12 @@ class SqliteCursor : public BagCursor {
         description_("ROS 2 bag " + io_detail::quoted(file)) {}
 
   bool next(BagMessage& message) override {
-    if (!statement_.step()) return false;
+    // Stepping a statement past its end would run the query again from the start (SQLite resets
+    // it automatically), so the end is remembered.
+    if (done_ || !statement_.step()) {
+      done_ = true;
+      return false;
+    }
     const std::int64_t topic_id = sqlite3_column_int64(statement_.get(), 0);
     message.connection = nullptr;
     for (const auto& entry : wanted_) {
@@ -127,6 +132,7 @@ class SqliteCursor : public BagCursor {
   Statement statement_;
   std::vector<std::pair<std::int64_t, const BagConnection*>> wanted_;
   std::string description_;
+  bool done_ = false;
 };
 
 class SqliteReader : public BagReader {
@@ -182,7 +188,10 @@ class SqliteReader : public BagReader {
       ids += (ids.empty() ? "" : ", ") + std::to_string(ids_[i]);
     }
     // Ordered as rosbag2's own reader orders them (by timestamp); equal timestamps keep the order
-    // they were written in (id). The ids are integers from the table, not user text.
+    // they were written in (id). rosbag2's timestamp_idx serves this order as it stands (an index
+    // entry is its timestamp, then the rowid, which id is), so SQLite sorts nothing, blobs least
+    // (EXPLAIN QUERY PLAN: "SCAN messages USING INDEX timestamp_idx"). The ids are integers from
+    // the topics table, not user text.
     const std::string sql = "SELECT topic_id, timestamp, data FROM messages WHERE topic_id IN (" + ids +
                             ") ORDER BY timestamp, id";
     return std::make_unique<SqliteCursor>(db_, file_, sql, std::move(wanted));
