@@ -120,8 +120,9 @@ class SqliteCursor : public BagCursor {
     message.log_time_ns = sqlite3_column_int64(statement_.get(), 1);
     const auto* data = static_cast<const std::uint8_t*>(sqlite3_column_blob(statement_.get(), 2));
     const int size = sqlite3_column_bytes(statement_.get(), 2);
-    // Fetching a blob may fail on a damaged page (a null pointer with a non-zero size, or an error
-    // code on the connection); an empty message is a null pointer with size 0.
+    // step() has read the row (a damaged page fails there); the blob can still fail to be handed
+    // over for want of memory (a null pointer with a non-zero size). An empty message is a null
+    // pointer with size 0.
     if (data == nullptr && size > 0) statement_.fail();
     message.data.assign(data, data + size);
     refuse_compressed_message(message, description_);
