@@ -15,6 +15,7 @@ seconds="${1:-30}"
 shift || true
 build="${FUZZ_BUILD_DIR:-build-asan}"
 all_targets=(safetensors camera_csv imu_csv gyro_log sensor_yaml rates_csv image device_spec flo)
+all_targets+=(mcap ros2_sqlite)  # ROS 2 bag containers
 targets=("$@")
 [ ${#targets[@]} -eq 0 ] && targets=("${all_targets[@]}")
 

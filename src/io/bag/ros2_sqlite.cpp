@@ -194,17 +194,13 @@ class SqliteReader : public BagReader {
 
 }  // namespace
 
+// SQLite's header alone: any SQLite file given as a sequence is meant as a bag (nothing else we
+// read is one), and open_ros2_sqlite() then says what is wrong with it (rosbag2's tables missing,
+// a damaged database) instead of the video reader saying that FFmpeg cannot open it.
 bool looks_like_ros2_sqlite(const fs::path& file) {
-  {
-    std::ifstream in(file, std::ios::binary);
-    char magic[sizeof kSqliteMagic] = {};
-    if (!in.read(magic, sizeof magic) || std::memcmp(magic, kSqliteMagic, sizeof magic) != 0) return false;
-  }
-  try {
-    return has_rosbag2_tables(open_database(file), file);
-  } catch (const Error&) {
-    return false;  // an SQLite header on a damaged file: not recognisably a bag
-  }
+  std::ifstream in(file, std::ios::binary);
+  char magic[sizeof kSqliteMagic] = {};
+  return in.read(magic, sizeof magic) && std::memcmp(magic, kSqliteMagic, sizeof magic) == 0;
 }
 
 fs::path ros2_storage_file(const fs::path& folder) {
@@ -222,11 +218,11 @@ fs::path ros2_storage_file(const fs::path& folder) {
     throw invalid_input(where + " has storage_identifier \"" + storage + "\"; inertialnet reads \"sqlite3\" and \"mcap\".");
   }
   // rosbag2's own compression (`ros2 bag record --compression-mode file|message`) wraps the whole
-  // file or each message in zstd on top of the storage; `ros2 bag decompress` undoes it.
+  // file or each message in zstd on top of the storage; `ros2 bag convert` writes it uncompressed.
   const std::string compression = yaml::string(info["compression_mode"]);
   if (!compression.empty() && compression != "NONE" && compression != "none") {
     throw invalid_input(where + " is compressed by rosbag2 (compression_mode " + compression +
-                        "), which inertialnet does not read; decompress it first (rosbag2's `ros2 bag decompress`).");
+                        "), which inertialnet does not read; convert it to an uncompressed bag first (`ros2 bag convert`).");
   }
   const cv::FileNode paths = info["relative_file_paths"];
   std::vector<std::string> files;
