@@ -40,7 +40,7 @@ def sequence(tmp_path_factory):
 
 
 def read_rates_csv(path):
-    """The header and the rows of a rates CSV (schema inertialnet.rates/2): timestamps as int, the
+    """The header and the rows of a rates CSV (schema inertialnet.rates/3, or 2): timestamps as int, the
     status columns as their words, rates as float (NaN where a pair has no answer: empty cells)."""
     with open(path) as f:
         rows = [r for r in csv.reader(f) if r and not r[0].startswith("#")]  # `# key: value` lines aside

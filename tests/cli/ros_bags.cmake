@@ -153,3 +153,26 @@ run(0 ${write_bag} bayer.bag --encoding bayer_rggb8 --camera-info)
 run(2 ${CLI} predict bayer.bag)
 expect_match("'bayer_rggb8' \\(a raw Bayer pattern")
 expect_match("mono8, mono16, rgb8, bgr8, rgba8")
+
+# train on a bag learns what it learns from the same sequence as a EuRoC folder: the same losses and
+# RMSEs every epoch (the folder's copy without ground truth, since a bag has none: both then
+# correct no bias). The log's last column, seconds, is left out.
+file(COPY "${WORK}/seq/" DESTINATION "${WORK}/no_ground_truth")
+file(REMOVE_RECURSE "${WORK}/no_ground_truth/mav0/state_groundtruth_estimate0")
+set(train_options --epochs 2 --head-size 64x48 --no-flow-cache)
+run(0 ${CLI} train --train mono8.bag --val mono8.bag --T-cam-imu seq/mav0/cam0/sensor.yaml ${train_options}
+    -o bag_head.safetensors --log bag_train.csv)
+run(0 ${CLI} train --train no_ground_truth --val no_ground_truth ${train_options} -o euroc_head.safetensors --log euroc_train.csv)
+foreach(which bag euroc)
+  file(STRINGS "${WORK}/${which}_train.csv" lines)
+  set(${which}_log "")
+  foreach(line ${lines})
+    string(REGEX REPLACE ",[^,]*$" "" line "${line}")
+    list(APPEND ${which}_log "${line}")
+  endforeach()
+endforeach()
+if(NOT bag_log STREQUAL euroc_log)
+  message(FATAL_ERROR "train on the bag logged\n${bag_log}\nand on the EuRoC folder\n${euroc_log}")
+endif()
+run(2 ${CLI} train --train seq --val seq --image-topic /cam0/image_raw ${train_options} -o refused.safetensors)
+expect_match("are for ROS bags; seq is a EuRoC sequence")

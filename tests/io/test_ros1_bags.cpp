@@ -13,7 +13,10 @@
 #include <string>
 #include <vector>
 
+#include <opencv2/imgcodecs.hpp>
+
 #include "inertialnet/io/bag.hpp"
+#include "inertialnet/io/bag_source.hpp"
 #include "inertialnet/io/ros_messages.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "io/bag/containers.hpp"
@@ -206,6 +209,23 @@ BagBytes bag_bytes(const std::string& how, bool indexed = true) {
   out.chunk_data_offset = out.bytes.size() + 4 + chunk_fields + 4;
   out.bytes.insert(out.bytes.end(), chunks.begin(), chunks.end());
   out.bytes.insert(out.bytes.end(), index.begin(), index.end());
+  return out;
+}
+
+// A bag of one uncompressed chunk holding `records` and no index section (as a recorder that was
+// killed leaves it): the reader finds the connections in the chunk.
+Bytes unindexed_bag(const std::vector<Bytes>& records) {
+  Bytes chunk;
+  for (const Bytes& r : records) chunk.insert(chunk.end(), r.begin(), r.end());
+  Bytes out = text("#ROSBAG V2.0\n");
+  const std::vector<Bytes> header_fields = {field("op", {0x03}), field("index_pos", Bytes(8, 0)), field("conn_count", u32_bytes(0)),
+                                            field("chunk_count", u32_bytes(0))};
+  std::size_t fields_size = 0;
+  for (const Bytes& f : header_fields) fields_size += f.size();
+  const Bytes header = record(header_fields, Bytes(4096 - 8 - fields_size, ' '));
+  const Bytes chunks = record({field("op", {0x05}), field("compression", text("none")), field("size", u32_bytes(static_cast<std::uint32_t>(chunk.size())))}, chunk);
+  out.insert(out.end(), header.begin(), header.end());
+  out.insert(out.end(), chunks.begin(), chunks.end());
   return out;
 }
 
@@ -488,4 +508,78 @@ TEST(Ros1Bag, OtherVersionsAndOtherFilesAreRefusedByName) {
     read_all(*reader, {"/a"});
   });
   EXPECT_TRUE(contains(refused, "'zstd'")) << refused;
+}
+
+// --- a bag as a sequence -------------------------------------------------------------------------
+
+TEST(BagFrameSource, HeaderStampsMustIncreaseAndTopicsAreNamed) {
+  const Bytes pixels = {1, 2, 3, 4};
+  auto image = [&](std::int64_t stamp) {
+    Writer m(MessageEncoding::Ros1);
+    m.header(stamp);
+    m.u32(2);
+    m.u32(2);
+    m.string("mono8");
+    m.u8(0);
+    m.u32(2);
+    m.byte_sequence(pixels);
+    return m.bytes;
+  };
+  const std::int64_t s = 1000000000;
+  // Log times in order, header stamps not: the stamps are what is checked.
+  const fs::path backwards = write_file("backwards.bag", unindexed_bag({connection_record(0, "/cam/image", "sensor_msgs/Image"),
+                                                                        message_record(0, 1, image(3 * s)), message_record(0, 2, image(5 * s)),
+                                                                        message_record(0, 3, image(4 * s))}));
+  const std::string message = invalid_input_message([&] { open_bag_frame_source(backwards, {}); });
+  EXPECT_TRUE(contains(message, "message 2 of /cam/image")) << message;
+  EXPECT_TRUE(contains(message, "goes back")) << message;
+
+  const fs::path good = write_file("good.bag", unindexed_bag({connection_record(0, "/cam/image", "sensor_msgs/Image"),
+                                                              connection_record(1, "/imu", "sensor_msgs/Imu"),
+                                                              message_record(0, 9, image(3 * s)), message_record(0, 8, image(5 * s))}));
+  const auto source = open_bag_frame_source(good, {});
+  ASSERT_EQ(source->size(), 2u);
+  EXPECT_EQ(source->timestamp_ns(1), 5 * s);  // the header stamp, not the log time (8 s)
+  EXPECT_TRUE(source->sequential());
+  EXPECT_EQ(source->decode(0).at(0, 1, 1), 4.0f);
+  EXPECT_EQ(source->decode(0).at(0, 1, 1), 4.0f);  // the frame decoded last, asked again
+  EXPECT_EQ(source->decode(1).width, 2);
+  EXPECT_FALSE(source->calibration());
+  const std::string missing = invalid_input_message([&] { open_bag_frame_source(good, {"/cam1/image", "", ""}); });
+  EXPECT_TRUE(contains(missing, "/cam/image (sensor_msgs/Image, 2 messages), /imu (sensor_msgs/Imu, 0 messages)")) << missing;
+  std::vector<std::string> notes;
+  EXPECT_TRUE(contains(invalid_input_message([&] { read_bag_imu(good, {}, notes); }), "holds 0 messages"));
+}
+
+TEST(RosMessages, CompressedImagesDecodeAsOpenCvEncodedThem) {
+  cv::Mat bgr(6, 8, CV_8UC3);
+  cv::randu(bgr, 0, 255);
+  for (const std::string format : {"png", "jpeg"}) {
+    std::vector<unsigned char> encoded;
+    ASSERT_TRUE(cv::imencode(format == "png" ? ".png" : ".jpg", bgr, encoded));
+    const cv::Mat expected = cv::imdecode(encoded, cv::IMREAD_UNCHANGED);  // a JPEG is lossy: its own decoding
+    for (const MessageEncoding encoding : {MessageEncoding::Ros1, MessageEncoding::Cdr}) {
+      const BagConnection c = connection("sensor_msgs/msg/CompressedImage", encoding);
+      Writer w(encoding);
+      w.header(42);
+      w.string("bgr8; " + format + " compressed bgr8");
+      w.byte_sequence(Bytes(encoded.begin(), encoded.end()));
+      const HostImage image = decode_ros_image(message_of(c, w.bytes), "m");
+      ASSERT_EQ(image.width, 8);
+      ASSERT_EQ(image.height, 6);
+      for (int y = 0; y < 6; ++y) {
+        for (int x = 0; x < 8; ++x) {
+          const cv::Vec3b p = expected.at<cv::Vec3b>(y, x);
+          EXPECT_EQ(image.at(0, y, x), p[2]) << format;
+          EXPECT_EQ(image.at(2, y, x), p[0]) << format;
+        }
+      }
+      // Cut short: named as a truncated image, not decoded with a grey bottom.
+      Writer cut(encoding);
+      cut.header(42);
+      cut.string(format);
+      cut.byte_sequence(Bytes(encoded.begin(), encoded.end() - 10));
+      EXPECT_TRUE(contains(invalid_input_message([&] { decode_ros_image(message_of(c, cut.bytes), "message 3"); }), "message 3 is truncated"));
+    }
+  }
 }

@@ -156,7 +156,7 @@ class Ros1Bag : public BagReader {
     std::vector<std::uint8_t> packed = read_bytes(chunk.data_offset, chunk.data_size);
     return decompress(chunk, std::move(packed));
   }
-  std::string where(std::uint64_t offset) const { return "ROS 1 bag '" + file_.string() + "' at byte " + std::to_string(offset); }
+  std::string where(std::uint64_t offset) const { return description() + " at byte " + std::to_string(offset); }
   std::string where_in_chunk(std::uint64_t chunk_offset, std::uint64_t offset) const {
     return where(chunk_offset) + " (its chunk, at byte " + std::to_string(offset) + " of the uncompressed data)";
   }
@@ -300,7 +300,7 @@ class Ros1Bag : public BagReader {
       }
       at += data_size;
     }
-    if (!header_seen) throw invalid_input("ROS 1 bag '" + file_.string() + "' has no bag header record (damaged)");
+    if (!header_seen) throw invalid_input(description() + " has no bag header record (damaged)");
     if (connections_.empty() || !counted) {
       // Unindexed: the connections and counts come from the chunks themselves.
       counts.clear();
