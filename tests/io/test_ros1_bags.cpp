@@ -372,6 +372,9 @@ TEST(RosMessages, BayerAndShortImagesAreRefusedByName) {
   const std::string short_data = invalid_input_message(
       [&] { decode_ros_image(message_of(c, image_message(MessageEncoding::Ros1, false, "rgb8", 4, 4, 12, Bytes(40))), "m"); });
   EXPECT_TRUE(contains(short_data, "needs 48 bytes")) << short_data;
+  const std::string odd_step = invalid_input_message(
+      [&] { decode_ros_image(message_of(c, image_message(MessageEncoding::Ros1, false, "mono16", 2, 2, 5, Bytes(10))), "m"); });
+  EXPECT_TRUE(contains(odd_step, "odd row step of 5 bytes")) << odd_step;
 }
 
 TEST(RosMessages, ImuAndCameraInfo) {
