@@ -494,6 +494,19 @@ TEST(Ros1Bag, DamagedCompressedChunksAreInvalidInputNamingTheOffset) {
   }
 }
 
+TEST(Ros1Bag, AnLz4ChunkDeclaringMoreThanItCanHoldIsRefusedBeforeItIsAllocated) {
+  Bytes bag = bag_bytes("none").bytes;
+  const Bytes huge = record({field("op", {0x05}), field("compression", text("lz4")), field("size", u32_bytes(1000000000u))},
+                            compress("lz4", text("tiny")));
+  bag.insert(bag.end(), huge.begin(), huge.end());
+  const fs::path p = write_file("huge.bag", bag);
+  const std::string message = invalid_input_message([&] {
+    const auto reader = bag::open_ros1_bag(p);
+    read_all(*reader, {"/a"});
+  });
+  EXPECT_TRUE(contains(message, "declares 1000000000 uncompressed bytes, more than LZ4 can hold")) << message;
+}
+
 TEST(Ros1Bag, OtherVersionsAndOtherFilesAreRefusedByName) {
   const fs::path old = write_file("old.bag", text("#ROSBAG V1.2\nrest"));
   EXPECT_TRUE(is_bag(old));
