@@ -372,6 +372,9 @@ TEST(RosMessages, BayerAndShortImagesAreRefusedByName) {
   const std::string short_data = invalid_input_message(
       [&] { decode_ros_image(message_of(c, image_message(MessageEncoding::Ros1, false, "rgb8", 4, 4, 12, Bytes(40))), "m"); });
   EXPECT_TRUE(contains(short_data, "needs 48 bytes")) << short_data;
+  const std::string odd_step = invalid_input_message(
+      [&] { decode_ros_image(message_of(c, image_message(MessageEncoding::Ros1, false, "mono16", 2, 2, 5, Bytes(10))), "m"); });
+  EXPECT_TRUE(contains(odd_step, "odd row step of 5 bytes")) << odd_step;
 }
 
 TEST(RosMessages, ImuAndCameraInfo) {
@@ -489,6 +492,19 @@ TEST(Ros1Bag, DamagedCompressedChunksAreInvalidInputNamingTheOffset) {
   } catch (const Error& e) {
     EXPECT_EQ(e.kind(), ErrorKind::InvalidInput) << e.what();
   }
+}
+
+TEST(Ros1Bag, AnLz4ChunkDeclaringMoreThanItCanHoldIsRefusedBeforeItIsAllocated) {
+  Bytes bag = bag_bytes("none").bytes;
+  const Bytes huge = record({field("op", {0x05}), field("compression", text("lz4")), field("size", u32_bytes(1000000000u))},
+                            compress("lz4", text("tiny")));
+  bag.insert(bag.end(), huge.begin(), huge.end());
+  const fs::path p = write_file("huge.bag", bag);
+  const std::string message = invalid_input_message([&] {
+    const auto reader = bag::open_ros1_bag(p);
+    read_all(*reader, {"/a"});
+  });
+  EXPECT_TRUE(contains(message, "declares 1000000000 uncompressed bytes, more than LZ4 can hold")) << message;
 }
 
 TEST(Ros1Bag, OtherVersionsAndOtherFilesAreRefusedByName) {

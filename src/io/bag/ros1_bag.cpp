@@ -215,8 +215,8 @@ class Ros1Bag : public BagReader {
       }
       return packed;
     }
-    std::vector<std::uint8_t> out(chunk.size);
     if (chunk.compression == "bz2") {
+      std::vector<std::uint8_t> out(chunk.size);
       unsigned int produced = chunk.size;
       const int status = BZ2_bzBuffToBuffDecompress(reinterpret_cast<char*>(out.data()), &produced,
                                                     reinterpret_cast<char*>(packed.data()), static_cast<unsigned int>(packed.size()), 0, 0);
@@ -227,7 +227,14 @@ class Ros1Bag : public BagReader {
       return out;
     }
     if (chunk.compression == "lz4") {
+      // LZ4 expands at most 255-fold (a match token stands for at most 255 bytes per byte read):
+      // a larger declared size is damage, refused before it is allocated.
+      if (chunk.size > 255 * static_cast<std::uint64_t>(packed.size()) + 64) {
+        throw invalid_input(at + ": its lz4 chunk of " + std::to_string(packed.size()) + " bytes declares " +
+                            std::to_string(chunk.size) + " uncompressed bytes, more than LZ4 can hold in it (damaged)");
+      }
       // roslz4 writes one LZ4 frame per chunk (the LZ4 frame format, not raw blocks).
+      std::vector<std::uint8_t> out(chunk.size);
       LZ4F_dctx* context = nullptr;
       if (LZ4F_isError(LZ4F_createDecompressionContext(&context, LZ4F_VERSION))) throw runtime_error("cannot create an LZ4 decompression context");
       std::size_t in_at = 0, out_at = 0, hint = 1;

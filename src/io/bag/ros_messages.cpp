@@ -63,6 +63,10 @@ HostImage decode_raw(bag::MessageFields& f, const std::string& where) {
     throw invalid_input(where + ": an image of " + std::to_string(width) + " × " + std::to_string(height) + " pixels");
   }
   const std::size_t row = static_cast<std::size_t>(width) * CV_ELEM_SIZE(layout.cv_type);
+  // OpenCV asserts on a row step that is not a whole number of samples: refused here, named.
+  if (step % CV_ELEM_SIZE1(layout.cv_type) != 0) {
+    throw invalid_input(where + ": a " + encoding + " image with an odd row step of " + std::to_string(step) + " bytes");
+  }
   if (step < row || static_cast<std::uint64_t>(step) * height > size) {
     throw invalid_input(where + ": a " + std::to_string(width) + " × " + std::to_string(height) + " " + encoding + " image with step " +
                         std::to_string(step) + " needs " + std::to_string(static_cast<std::uint64_t>(std::max<std::size_t>(step, row)) * height) +
