@@ -65,8 +65,8 @@ class _InertialNetHead:
 # Wrapped by inertialnet.Sequence (a collections.abc.Sequence, python/inertialnet/_sequence.py).
 class _Sequence:
     # rate_hz: 0 (the source's frame times) or a finite positive rate up to 1e6 Hz, else ValueError.
-    # A missing path: FileNotFoundError.
-    def __init__(self, path: _Path, rate_hz: float = 0.0) -> None: ...
+    # A missing path: FileNotFoundError. image_topic: a ROS bag's image topic ("": its only one).
+    def __init__(self, path: _Path, rate_hz: float = 0.0, image_topic: str = "") -> None: ...
     def __len__(self) -> int: ...
     # Python indexing: seq[-1] is the last frame; IndexError beyond either end. Random access on
     # videos too (a step back re-opens the video).

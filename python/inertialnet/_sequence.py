@@ -14,7 +14,8 @@ PathLike = Union[str, "os.PathLike[str]"]
 
 
 class Sequence(collections.abc.Sequence):
-    """A EuRoC folder, an image folder or a video, frame by frame, as ``inertialnet predict``
+    """A EuRoC folder, an image folder, a video or a ROS bag (``image_topic``: its image topic, ""
+    for its only one), frame by frame, as ``inertialnet predict``
     reads it: a ``collections.abc.Sequence`` of uint8 RGB frames ``(H, W, 3)``.
 
     ``seq[k]`` decodes frame k (``seq[-1]`` the last; ``IndexError`` beyond either end);
@@ -29,8 +30,8 @@ class Sequence(collections.abc.Sequence):
     ``rate_hz``). Missing paths raise ``FileNotFoundError``.
     """
 
-    def __init__(self, path: PathLike, rate_hz: float = 0.0):
-        self._native = _native._Sequence(os.fspath(path), float(rate_hz))
+    def __init__(self, path: PathLike, rate_hz: float = 0.0, image_topic: str = ""):
+        self._native = _native._Sequence(os.fspath(path), float(rate_hz), str(image_topic))
 
     def __len__(self) -> int:
         return len(self._native)

@@ -695,8 +695,9 @@ class PyInertialNetHead {
 
 class PySequence {
  public:
-  PySequence(const std::filesystem::path& path, double rate_hz)
-      : path_(existing_sequence(path)), rate_(rate_of(rate_hz)), source_(open_frame_source(path_, rate_)) {}
+  PySequence(const std::filesystem::path& path, double rate_hz, const std::string& image_topic)
+      : path_(existing_sequence(path)), rate_(rate_of(rate_hz)), image_topic_(image_topic),
+        source_(open_frame_source(path_, rate_, "cam0", BagTopics{image_topic, "", ""})) {}
   std::size_t size() const { return source_->size(); }
   py::array_t<std::int64_t> timestamps() const {
     py::array_t<std::int64_t> out(static_cast<py::ssize_t>(source_->size()));
@@ -727,7 +728,8 @@ class PySequence {
   }
   py::object camera_to_body() const {
     const auto c = source_->calibration();
-    if (!c) return py::none();
+    // A bag's CameraInfo has no extrinsics (T_BS all zero): no rotation to the body.
+    if (!c || c->T_BS == std::array<double, 16>{}) return py::none();
     const Mat3 r = c->rotation_BS();
     py::array_t<double> out({3, 3});
     std::copy(r.begin(), r.end(), out.mutable_data());
@@ -747,7 +749,7 @@ class PySequence {
     if (!source_->sequential()) return source_->decode(index);
     if (last_ && index == *last_) return source_->decode(index);  // the frame decoded last, again
     if (last_ && index < *last_) {
-      source_ = open_frame_source(path_, rate_);
+      source_ = open_frame_source(path_, rate_, "cam0", BagTopics{image_topic_, "", ""});
       last_.reset();
     }
     for (std::size_t k = last_ ? *last_ + 1 : 0; k < index; ++k) source_->decode(k);
@@ -757,6 +759,7 @@ class PySequence {
 
   std::filesystem::path path_;
   std::optional<double> rate_;
+  std::string image_topic_;  // a ROS bag's image topic ("": its only one)
   std::unique_ptr<FrameSource> source_;
   std::optional<std::size_t> last_;  // a sequential source's frame decoded last
 };
@@ -1097,8 +1100,9 @@ PYBIND11_MODULE(_inertialnet, m) {
       .def_property_readonly("config", &PyInertialNetHead::config);
 
   // The Python class inertialnet.Sequence (a collections.abc.Sequence) wraps this one.
-  py::class_<PySequence>(m, "_Sequence", "A EuRoC folder, an image folder or a video, frame by frame.")
-      .def(py::init<const std::filesystem::path&, double>(), py::arg("path"), py::arg("rate_hz") = 0.0)
+  py::class_<PySequence>(m, "_Sequence", "A EuRoC folder, an image folder, a video or a ROS bag, frame by frame.")
+      .def(py::init<const std::filesystem::path&, double, const std::string&>(), py::arg("path"), py::arg("rate_hz") = 0.0,
+           py::arg("image_topic") = "")
       .def_property_readonly("path", &PySequence::path)
       .def_property_readonly("rate_hz", &PySequence::rate_hz)
       .def_property_readonly("sequential", &PySequence::sequential)

@@ -67,6 +67,7 @@ struct PredictOptions {
   std::string flow_format = "flo";
   double rate_hz = 0;
   std::string camera_name = "cam0";  // --camera (o.camera holds --fx …)
+  BagTopics bag;                     // --image-topic, --camera-info-topic
   std::string time_offset, readout_time;
   double flow_check_px = 0.5;  // PredictSettings' default
   int lanes = 0;  // 0: default_lanes_per_device()
@@ -146,7 +147,7 @@ void append_row(RatesTable& table, const RatesLayout& layout, const RatesRow& ro
 
 Command register_predict(CLI::App& app, const GlobalOptions& global) {
   auto o = std::make_shared<PredictOptions>();
-  app.add_option("sequence", o->sequence, "EuRoC folder, image folder or video")->required();
+  app.add_option("sequence", o->sequence, "EuRoC folder, image folder, video or ROS bag")->required();
   app.add_option("-w,--weights", o->weights,
                  "weights (safetensors) holding FlowNet2 and/or the InertialNet head; repeat for several files");
   app.add_option("--model", o->model, "flow network (default FlowNet2)")->transform(choice("model", flow_model_names()));
@@ -174,6 +175,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
   app.add_option("--rate", o->rate_hz, "frame rate for image folders and videos without timestamps (Hz)")
       ->check(finite_positive_up_to(1e6, "Hz"));
   add_camera_option(app, o->camera_name);
+  add_bag_topic_options(app, o->bag, false);
   app.add_option("--time-offset", o->time_offset,
                  "camera-IMU time offset in seconds (t_imu = t_cam + offset), stated in the CSV for eval");
   app.add_option("--readout-time", o->readout_time,
@@ -217,6 +219,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
     settings.calibration_camera = o->camera.calibration.camera;
     settings.rate_hz = o->rate_hz;
     settings.camera = o->camera_name;
+    settings.bag = o->bag;
     settings.flow_check_px = o->flow_check_px;
     if (!o->readout_time.empty()) settings.readout_time_s = parse_seconds(o->readout_time, "--readout-time");
     if (!o->time_offset.empty()) settings.time_offset_s = parse_seconds(o->time_offset, "--time-offset");
