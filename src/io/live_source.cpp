@@ -6,10 +6,15 @@
 #include <deque>
 #include <filesystem>
 
+#include <unistd.h>
+
+#include <cstdio>
+
 #include <opencv2/videoio.hpp>
 #include <opencv2/videoio/registry.hpp>
 
 #include "inertialnet/runtime/error.hpp"
+#include "inertialnet/runtime/log.hpp"
 #include "io/image_mat.hpp"
 #include "io/third_party_log.hpp"
 
@@ -131,6 +136,31 @@ class LiveCapture : public FrameSource {
   std::deque<std::int64_t> times_;  // of the last frames grabbed, the newest last
 };
 
+// Opens a GStreamer pipeline with what the libraries print meanwhile taken off the terminal: a
+// pipeline GStreamer cannot parse makes GLib print criticals on stderr by itself (OpenCV 4.6 goes
+// on with the failed bin, "invalid cast from 'GstAppSink' to 'GstBin'"), which says nothing to a
+// user; it goes to our log at Debug (-v). Called before any other thread of ours runs.
+void open_gstreamer(cv::VideoCapture& capture, const std::string& pipeline) {
+  char name[] = "/tmp/inertialnet-gst-XXXXXX";
+  const int scratch = ::mkstemp(name);
+  if (scratch < 0) {
+    capture.open(pipeline, cv::CAP_GSTREAMER);
+    return;
+  }
+  ::unlink(name);
+  std::fflush(stderr);
+  const int saved = ::dup(STDERR_FILENO);
+  ::dup2(scratch, STDERR_FILENO);
+  capture.open(pipeline, cv::CAP_GSTREAMER);
+  std::fflush(stderr);
+  ::dup2(saved, STDERR_FILENO);
+  ::close(saved);
+  std::string text(static_cast<std::size_t>(std::max<off_t>(::lseek(scratch, 0, SEEK_END), 0)), '\0');
+  if (!text.empty()) text.resize(static_cast<std::size_t>(std::max<ssize_t>(::pread(scratch, text.data(), text.size(), 0), 0)));
+  ::close(scratch);
+  if (!text.empty()) log_message(LogLevel::Debug, "GStreamer, opening '" + pipeline + "': " + text);
+}
+
 std::size_t parse_index(const std::string& text, const std::string& sequence) {
   if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos || text.size() > 4) {
     throw invalid_input("'" + sequence + "': expected camera:N with N a camera index (0, 1, …), got '" + text + "'");
@@ -176,10 +206,10 @@ std::unique_ptr<FrameSource> open_live_source(const std::string& sequence, std::
     if (pipeline.find("appsink") == std::string::npos) {
       throw invalid_input("the GStreamer pipeline '" + pipeline + "' should end in appsink, where the frames are taken");
     }
-    capture.open(pipeline, cv::CAP_GSTREAMER);
+    open_gstreamer(capture, pipeline);
     if (!capture.isOpened()) {
       throw invalid_input("GStreamer cannot run the pipeline '" + pipeline +
-                          "'; try it with `gst-launch-1.0` (fakesink in place of appsink) to see why");
+                          "'; `gst-launch-1.0` with fakesink in place of appsink says why");
     }
   } else if (starts_with(sequence, "capture:")) {
     const std::string target = sequence.substr(8);

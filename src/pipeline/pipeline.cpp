@@ -193,14 +193,19 @@ PipelineStats run_pipeline(FrameSource& source, const std::vector<Device*>& devi
     while (s.next_emit <= s.last_pair) {
       s.changed.wait_for(lock, std::chrono::milliseconds(50),
                          [&] { return s.stop || s.next_emit > s.last_pair || s.finished.count(s.next_emit); });
-      if (options.cancel && options.cancel->load()) {
+      if (options.cancel && options.cancel->load() && !s.stats.cancelled) {
+        // Nothing new starts; the pairs already finished are handed over in order, then the run
+        // ends (a live source's Ctrl-C ends it with every computed pair written).
         s.stats.cancelled = true;
         s.stop = true;
-        break;
+        s.changed.notify_all();
       }
-      if (s.stop) break;
+      if (s.stop && !s.stats.cancelled) break;
       auto found = s.finished.find(s.next_emit);
-      if (found == s.finished.end()) continue;
+      if (found == s.finished.end()) {
+        if (s.stop) break;
+        continue;
+      }
       PairResult result = std::move(found->second);
       s.finished.erase(found);
       ++s.next_emit;

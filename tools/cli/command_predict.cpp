@@ -242,9 +242,10 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
     const bool live = prediction.source().open_ended();
     const auto& infos = prediction.device_infos();
     if (!have_weights) info("no weights given: weight-free DIS optical flow + geometric head");
-    const std::string count = live ? (pairs > 0 ? "up to " + std::to_string(pairs) : std::string("live until Ctrl-C or its end:"))
-                                   : std::to_string(pairs);
-    std::string summary = prediction.source().description() + ", " + count + " pairs, " +
+    const std::string count = !live      ? std::to_string(pairs) + " pairs"
+                              : pairs > 0 ? "up to " + std::to_string(pairs) + " pairs"
+                                          : std::string("pairs until Ctrl-C or its end");
+    std::string summary = prediction.source().description() + ", " + count + ", " +
                           prediction.method() + " on " + std::to_string(infos.size()) + " device" +
                           (infos.size() > 1 ? "s" : "") + " (" + infos.front().name + (infos.size() > 1 ? ", …" : "") + ")";
     if (processor.geometric_head) {
