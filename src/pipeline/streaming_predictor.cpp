@@ -47,6 +47,7 @@ struct StreamingPredictor::State {
     if (error) std::rethrow_exception(error);
   }
   std::vector<PairResult> enqueue(Pushed frame);
+  bool try_enqueue(Pushed& frame);  // leaves `frame` as it was when the queue is full
   class Frames;
 };
 
@@ -144,7 +145,7 @@ StreamingPredictor::~StreamingPredictor() {
 std::vector<PairResult> StreamingPredictor::State::enqueue(State::Pushed frame) {
   State& s = *this;
   std::unique_lock<std::mutex> lock(s.mutex);
-  if (s.closed) throw runtime_error("a frame was pushed after finish()");
+  if (s.closed) throw runtime_error("a frame was pushed after close() or finish()");
   std::vector<PairResult> out;
   while (s.queue.size() >= s.capacity && s.running) {
     for (auto& r : s.take_results()) out.push_back(std::move(r));
@@ -169,25 +170,49 @@ std::vector<PairResult> StreamingPredictor::push_error(std::int64_t t_ns, std::s
   return state_->enqueue(State::Pushed{t_ns, HostImage{}, std::move(why)});
 }
 
-bool StreamingPredictor::try_push(std::int64_t t_ns, HostImage image) {
-  State& s = *state_;
-  std::lock_guard<std::mutex> lock(s.mutex);
-  if (s.closed) throw runtime_error("a frame was pushed after finish()");
-  s.throw_if_failed();
-  if (s.queue.size() >= s.capacity) return false;
-  if (s.running) {
-    s.queue.push_back(State::Pushed{t_ns, std::move(image), {}});
-    ++s.pushed;
-    s.changed.notify_all();
+bool StreamingPredictor::State::try_enqueue(Pushed& frame) {
+  std::lock_guard<std::mutex> lock(mutex);
+  if (closed) throw runtime_error("a frame was pushed after close() or finish()");
+  throw_if_failed();
+  if (queue.size() >= capacity) return false;
+  if (running) {
+    queue.push_back(std::move(frame));
+    ++pushed;
+    changed.notify_all();
   }
   return true;
 }
 
-std::vector<PairResult> StreamingPredictor::poll() {
+bool StreamingPredictor::try_push(std::int64_t t_ns, HostImage image) {
+  State::Pushed frame{t_ns, std::move(image), {}};
+  return state_->try_enqueue(frame);
+}
+
+bool StreamingPredictor::try_push_error(std::int64_t t_ns, std::string why) {
+  if (why.empty()) why = "the frame could not be decoded";
+  State::Pushed frame{t_ns, HostImage{}, std::move(why)};
+  return state_->try_enqueue(frame);
+}
+
+std::vector<PairResult> StreamingPredictor::poll(std::chrono::milliseconds wait) {
   State& s = *state_;
-  std::lock_guard<std::mutex> lock(s.mutex);
+  std::unique_lock<std::mutex> lock(s.mutex);
+  s.changed.wait_for(lock, wait, [&s] { return !s.results.empty() || !s.running; });
   s.throw_if_failed();
   return s.take_results();
+}
+
+void StreamingPredictor::close() {
+  State& s = *state_;
+  std::lock_guard<std::mutex> lock(s.mutex);
+  s.closed = true;
+  s.changed.notify_all();
+}
+
+bool StreamingPredictor::done() const {
+  State& s = *state_;
+  std::lock_guard<std::mutex> lock(s.mutex);
+  return s.closed && !s.running && s.results.empty();
 }
 
 std::vector<PairResult> StreamingPredictor::finish() {
@@ -195,7 +220,7 @@ std::vector<PairResult> StreamingPredictor::finish() {
   std::vector<PairResult> out;
   {
     std::unique_lock<std::mutex> lock(s.mutex);
-    s.closed = true;
+    s.closed = true;  // once more, in case close() was not called
     s.changed.notify_all();
     while (true) {
       for (auto& r : s.take_results()) out.push_back(std::move(r));

@@ -11,6 +11,7 @@
 // memory stays flat however long the stream runs.
 #pragma once
 
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -42,10 +43,17 @@ class StreamingPredictor {
   // A frame that could not be decoded: its two pairs are answered with PairStatus::DecodeError,
   // as a damaged file frame's are; `why` is the reason they carry.
   std::vector<PairResult> push_error(std::int64_t t_ns, std::string why);
-  // push() that never waits: false (the frame not taken) when the queue is full. Takes no results.
+  // push() and push_error() that never wait: false (the frame not taken) when the queue is full.
+  // They take no results.
   bool try_push(std::int64_t t_ns, HostImage image);
-  // The results finished so far, without pushing.
-  std::vector<PairResult> poll();
+  bool try_push_error(std::int64_t t_ns, std::string why);
+  // The results finished so far, without pushing; waits up to `wait` for the first of them (a
+  // caller that must stay responsive, as Python's stream() to Ctrl-C, waits in short slices).
+  std::vector<PairResult> poll(std::chrono::milliseconds wait = std::chrono::milliseconds(0));
+  // No more frames; returns at once (the pairs in flight go on; poll() takes them).
+  void close();
+  // Closed, every pair computed and every result taken.
+  bool done() const;
   // No more frames: waits for every pair and returns the results not yet taken. Call once.
   std::vector<PairResult> finish();
 
