@@ -70,7 +70,7 @@ def standard_output(cli, work, problems):
 
 def output_file(cli, work, problems):
     """-o: the journal holds whole rows while the run goes on; Ctrl-C puts the file in place."""
-    target = os.path.join(work, "live.csv")
+    target = os.path.join(work, "interrupted.csv")
     partial = target + ".partial"
     run = subprocess.Popen([cli] + ARGS + ["-o", target], cwd=work, stdout=subprocess.DEVNULL,
                            stderr=subprocess.PIPE)
@@ -88,7 +88,7 @@ def output_file(cli, work, problems):
     if run.returncode != 0:
         problems.append(f"-o: exit {run.returncode} after Ctrl-C, expected 0: {err.strip()}")
     if os.path.exists(partial) or not os.path.exists(target):
-        problems.append("-o: after Ctrl-C the journal was not put in place as live.csv")
+        problems.append("-o: after Ctrl-C the journal was not put in place as interrupted.csv")
         return
     check_rows(data_rows(open(target, encoding="utf-8").read()), stopped_count(err), "-o", problems)
 
