@@ -22,11 +22,14 @@ def stream(
     head: Optional[str] = None,
     model: Optional[str] = None,
     solver: str = "motion-field",
-    fx: float = 0.0,
-    fy: float = 0.0,
-    cx: float = 0.0,
-    cy: float = 0.0,
+    fx: Optional[float] = None,
+    fy: Optional[float] = None,
+    cx: Optional[float] = None,
+    cy: Optional[float] = None,
+    calibration: Optional[PathLike] = None,
+    calibration_camera: str = "",
     rate_hz: float = 0.0,
+    camera: str = "cam0",
     device: Union[None, str, int] = None,
     max_pairs: int = 0,
     lanes: int = 2,
@@ -49,7 +52,11 @@ def stream(
     stops the computation when the iterator is dropped."""
     if isinstance(weights, (str, os.PathLike)):
         weights = [weights]
+    def number(value):
+        return None if value is None else float(value)
+
     return _native._Stream(
         os.fspath(sequence), [os.fspath(w) for w in weights], model or "", flow or "", head or "", solver,
-        float(fx), float(fy), float(cx), float(cy), float(rate_hz), "" if device is None else str(device),
-        int(max_pairs), int(lanes), float(flow_check))
+        number(fx), number(fy), number(cx), number(cy), "" if calibration is None else os.fspath(calibration),
+        calibration_camera, camera, float(rate_hz), "" if device is None else str(device), int(max_pairs),
+        int(lanes), float(flow_check))

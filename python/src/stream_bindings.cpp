@@ -139,9 +139,11 @@ void register_stream(py::module_& m) {
   using namespace inertialnet;
   py::class_<Stream>(m, "_Stream")
       .def(py::init([](const std::string& sequence, const std::vector<std::string>& weights, const std::string& model,
-                       const std::string& flow, const std::string& head, const std::string& solver, double fx,
-                       double fy, double cx, double cy, double rate_hz, const std::string& device,
-                       std::int64_t max_pairs, int lanes, double flow_check) {
+                       const std::string& flow, const std::string& head, const std::string& solver,
+                       std::optional<double> fx, std::optional<double> fy, std::optional<double> cx,
+                       std::optional<double> cy, const std::string& calibration, const std::string& calibration_camera,
+                       const std::string& camera, double rate_hz, const std::string& device, std::int64_t max_pairs,
+                       int lanes, double flow_check) {
         if (max_pairs < 0) {
           throw invalid_input("max_pairs must be a count of pairs (0 for all), got " + std::to_string(max_pairs));
         }
@@ -156,7 +158,10 @@ void register_stream(py::module_& m) {
         s.fx = fx;
         s.fy = fy;
         s.cx = cx;
-        s.cy = cy;
+        s.cy = cy;  // None: not given (cx = 0 is a principal point, as predict() takes it)
+        s.calibration = calibration;
+        s.calibration_camera = calibration_camera;
+        s.camera = camera;
         s.rate_hz = rate_hz;
         s.device = device;
         s.flow_check_px = flow_check;

@@ -22,17 +22,17 @@ def test_stream_yields_predicts_rates_pair_by_pair(sequence):
     got = list(inertialnet.stream(sequence))
     assert len(got) == len(want) == 4
     assert any(status == "ok" for _, _, status in got), "no pair answered: the comparison would prove nothing"
-    for (t, rates, status), row in zip(got, want):
-        assert t == row["timestamp_ns"]
-        assert status == row["status"]
+    for k, (t, rates, status) in enumerate(got):
+        assert t == want.timestamps_ns[k]
+        assert status == want.status[k]
         assert rates.dtype == np.float64 and rates.shape == (3,)
-        for value, expected in zip(rates, (row["wx"], row["wy"], row["wz"])):
+        for value, expected in zip(rates, want.w[k]):
             assert (math.isnan(value) and math.isnan(expected)) or value == expected
 
 
 def test_stream_stops_at_max_pairs_and_says_bad_arguments(sequence):
     assert [t for t, _, _ in inertialnet.stream(sequence, max_pairs=2)] == \
-        list(inertialnet.predict(sequence, max_pairs=2)["timestamp_ns"])
+        list(inertialnet.predict(sequence, max_pairs=2).timestamps_ns)
     with pytest.raises(ValueError, match="max_pairs must be a count"):
         inertialnet.stream(sequence, max_pairs=-1)
     with pytest.raises(ValueError, match="no camera at /dev/video97"):
