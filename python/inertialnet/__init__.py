@@ -45,6 +45,7 @@ from ._inertialnet import (  # noqa: F401  (re-exported)
 from ._rates import Rates, read_rates, _rates_of_predict
 from ._sequence import Sequence
 from . import _inertialnet as _native
+from .streaming import stream  # noqa: F401  (re-exported)
 
 PathLike = Union[str, "os.PathLike[str]"]
 Weights = Union[PathLike, Iterable[PathLike]]
@@ -58,6 +59,7 @@ __all__ = [
     "flow_to_color", "predict", "read_flo", "read_flow", "read_image", "read_kitti_flow", "select_devices",
     "synth", "write_flo", "write_flow_png", "write_kitti_flow", "write_rates_csv",
 ]
+__all__ += ["stream"]  # streaming.py
 
 
 class FlowNet:

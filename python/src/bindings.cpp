@@ -981,6 +981,7 @@ py::tuple read_rates(const std::filesystem::path& path) {
 }  // namespace
 
 PYBIND11_MODULE(_inertialnet, m) {
+  void register_stream(py::module_&); register_stream(m);  // stream(): python/src/stream_bindings.cpp
   m.doc() = "InertialNet-CL: FlowNet2 optical flow and angular-rate heads on OpenCL (native module)";
 
   py::register_exception_translator([](std::exception_ptr p) {

@@ -6,6 +6,7 @@
 #include "inertialnet/io/bag.hpp"
 #include "inertialnet/io/bag_source.hpp"
 #include "inertialnet/io/kitti_timestamps.hpp"
+#include "inertialnet/io/live_source.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "io/image_mat.hpp"
 #include "io/video_file.hpp"
@@ -126,6 +127,15 @@ class VideoFrames : public FrameSource {
 
 std::unique_ptr<FrameSource> open_frame_source(const std::filesystem::path& path, std::optional<double> rate_hz,
                                                const std::string& camera, const BagTopics& bag) {
+  // A camera or a capture pipeline is no file: named by its prefix (io/live_source.hpp).
+  if (is_live_source(path.string())) {
+    if (camera != "cam0") {
+      throw invalid_input("--camera " + camera + " picks a camera of a EuRoC sequence (mav0/" + camera + "); " +
+                          path.string() + " is a live source");
+    }
+    if (bag.any()) throw invalid_input("the topic options name topics of a ROS bag; " + path.string() + " is a live source");
+    return open_live_source(path.string(), rate_hz);
+  }
   std::error_code error;
   if (!std::filesystem::exists(path, error)) throw invalid_input("sequence '" + path.string() + "' does not exist");
   std::unique_ptr<FrameSource> source;

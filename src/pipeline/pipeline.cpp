@@ -4,6 +4,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <exception>
+#include <limits>
 #include <mutex>
 #include <thread>
 
@@ -26,12 +27,14 @@ struct Schedule {
   std::atomic<bool> stop{false};
   std::exception_ptr error;
 
-  std::size_t last_pair = 0;  // pairs are 1..last_pair; pair k uses frames k−1 and k
+  // Pairs are 1..last_pair; pair k uses frames k−1 and k. A live source's last pair is known
+  // when it ends: until then last_pair is as far as the run may go.
+  std::size_t last_pair = 0;
   std::size_t window = 0;
 
   std::size_t next_decode = 0;
   std::map<std::size_t, std::shared_ptr<const Frame>> frames;
-  std::vector<int> uses;  // pairs still to take each decoded frame
+  std::map<std::size_t, int> uses;  // pairs still to take each decoded frame
 
   std::size_t next_pair = 1;
   std::size_t next_emit = 1;
@@ -57,6 +60,17 @@ void decode_loop(Schedule& s, FrameSource& source) {
     if (s.stop || s.next_decode > s.last_pair) return;
     const std::size_t index = s.next_decode++;
     lock.unlock();
+    if (!source.wait_for(index, s.stop)) {
+      // A live source ended (or the run is stopping): its last frame ends the last pair.
+      if (index < 2 && !s.stop) {
+        throw invalid_input(source.description() + " ended before its " + (index == 0 ? "first" : "second") +
+                            " frame: there is no frame pair to predict");
+      }
+      lock.lock();
+      s.last_pair = std::min(s.last_pair, index - 1);
+      s.changed.notify_all();
+      return;
+    }
     const auto start = Clock::now();
     auto frame = std::make_shared<Frame>();
     frame->index = index;
@@ -73,6 +87,9 @@ void decode_loop(Schedule& s, FrameSource& source) {
     lock.lock();
     s.stats.decode_seconds += seconds;
     s.frames[index] = std::move(frame);
+    // The first frame starts one pair, the last ends one; a live source's last frame, not known
+    // as such, stays until the run ends.
+    s.uses[index] = index == 0 || index == s.last_pair ? 1 : 2;
     s.changed.notify_all();
   }
 }
@@ -92,13 +109,16 @@ void process_pairs(Schedule& s, Device& device, PairProcessor& processor) {
     s.changed.wait(lock, [&] { return s.stop || s.next_pair > s.last_pair || s.pair_in_window(s.next_pair); });
     if (s.stop || s.next_pair > s.last_pair) return;
     const std::size_t pair = s.next_pair++;
-    s.changed.wait(lock, [&] { return s.stop || (s.frames.count(pair - 1) && s.frames.count(pair)); });
-    if (s.stop) return;
+    s.changed.wait(lock, [&] { return s.stop || pair > s.last_pair || (s.frames.count(pair - 1) && s.frames.count(pair)); });
+    if (s.stop || pair > s.last_pair) return;
     const auto previous = s.frames.at(pair - 1);
     const auto current = s.frames.at(pair);
     // Each frame serves two pairs; the second to take it lets it go.
     for (const std::size_t f : {pair - 1, pair}) {
-      if (--s.uses[f] == 0) s.frames.erase(f);
+      if (--s.uses[f] == 0) {
+        s.frames.erase(f);
+        s.uses.erase(f);
+      }
     }
     lock.unlock();
 
@@ -137,19 +157,16 @@ int default_lanes_per_device(const std::vector<DeviceInfo>& devices) {
 PipelineStats run_pipeline(FrameSource& source, const std::vector<Device*>& devices, const ProcessorFactory& factory,
                            const std::function<void(const PairResult&)>& sink, const PipelineOptions& options) {
   if (devices.empty()) throw invalid_input("the pipeline needs at least one device");
-  if (source.size() < 2) throw invalid_input(source.description() + " has fewer than two frames");
+  if (!source.open_ended() && source.size() < 2) throw invalid_input(source.description() + " has fewer than two frames");
   if (options.lanes_per_device < 1 || options.decode_threads < 1) {
     throw invalid_input("the pipeline needs at least one lane per device and one decode thread");
   }
   const auto start = Clock::now();
   Schedule s;
-  s.last_pair = source.size() - 1;
+  s.last_pair = source.open_ended() ? std::numeric_limits<std::size_t>::max() - 1 : source.size() - 1;
   if (options.max_pairs > 0) s.last_pair = std::min(s.last_pair, options.max_pairs);
   const int lanes = options.lanes_per_device * static_cast<int>(devices.size());
   s.window = static_cast<std::size_t>(options.window > 0 ? options.window : 4 * lanes);
-  s.uses.assign(s.last_pair + 1, 2);
-  s.uses.front() = 1;  // the first frame starts one pair, the last ends one
-  s.uses.back() = 1;
 
   std::vector<std::thread> threads;
   auto guarded = [&s](auto body) {
@@ -174,15 +191,21 @@ PipelineStats run_pipeline(FrameSource& source, const std::vector<Device*>& devi
   {
     std::unique_lock<std::mutex> lock(s.mutex);
     while (s.next_emit <= s.last_pair) {
-      s.changed.wait_for(lock, std::chrono::milliseconds(50), [&] { return s.stop || s.finished.count(s.next_emit); });
-      if (options.cancel && options.cancel->load()) {
+      s.changed.wait_for(lock, std::chrono::milliseconds(50),
+                         [&] { return s.stop || s.next_emit > s.last_pair || s.finished.count(s.next_emit); });
+      if (options.cancel && options.cancel->load() && !s.stats.cancelled) {
+        // Nothing new starts; the pairs already finished are handed over in order, then the run
+        // ends (a live source's Ctrl-C ends it with every computed pair written).
         s.stats.cancelled = true;
         s.stop = true;
-        break;
+        s.changed.notify_all();
       }
-      if (s.stop) break;
+      if (s.stop && !s.stats.cancelled) break;
       auto found = s.finished.find(s.next_emit);
-      if (found == s.finished.end()) continue;
+      if (found == s.finished.end()) {
+        if (s.stop) break;
+        continue;
+      }
       PairResult result = std::move(found->second);
       s.finished.erase(found);
       ++s.next_emit;

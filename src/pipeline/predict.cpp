@@ -56,6 +56,13 @@ std::pair<Frame, Frame> first_decodable_pair(const PredictSettings& s) {
   throw invalid_input(source->description() + " has no two consecutive frames that decode");
 }
 
+// The first frame, for the image size: a live source's own (a camera opens once; it holds the
+// frame it opened with and hands it to the pipeline again), any other's from a fresh copy.
+HostImage first_image(FrameSource& source, const PredictSettings& s) {
+  if (source.open_ended()) return source.decode(0);
+  return first_decodable_pair(s).first.image;
+}
+
 // The camera of the geometric head and the rotation into the body frame, from the settings'
 // sources in their order of precedence: --calibration (each --fx … replacing one of its values),
 // else --fx … alone (an ideal pinhole, what is not given assumed), else the sequence's own
@@ -71,7 +78,7 @@ std::string pixels_text(double v) {
   return text;
 }
 
-CameraChoice choose_camera(const PredictSettings& s, const FrameSource& source, std::vector<std::string>& notes) {
+CameraChoice choose_camera(const PredictSettings& s, FrameSource& source, std::vector<std::string>& notes) {
   // An fx or fy of 0 is never a focal length: "not given" (the Python binding's default).
   const std::optional<double> fx = s.fx && *s.fx != 0 ? s.fx : std::nullopt;
   const std::optional<double> fy = s.fy && *s.fy != 0 ? s.fy : std::nullopt;
@@ -87,7 +94,7 @@ CameraChoice choose_camera(const PredictSettings& s, const FrameSource& source, 
     notes.insert(notes.end(), file.notes.begin(), file.notes.end());
     const std::string name = s.calibration.string();
     if (own) notes.push_back("--calibration " + name + " replaces " + source.description() + "'s " + own_name + ".");
-    const HostImage first = first_decodable_pair(s).first.image;
+    const HostImage first = first_image(source, s);
     choice.camera = fit_to_frames(file.camera, first.width, first.height, "--calibration " + name, notes);
     // Values given one by one replace the file's: a focal length refined since, say.
     const auto replace = [&notes, &name](double& value, const std::optional<double>& given, const char* flag) {
@@ -116,7 +123,7 @@ CameraChoice choose_camera(const PredictSettings& s, const FrameSource& source, 
     return choice;
   }
   if (fx || fy) {
-    const HostImage first = first_decodable_pair(s).first.image;
+    const HostImage first = first_image(source, s);
     CameraIntrinsics& camera = choice.camera;
     camera.width = first.width;
     camera.height = first.height;
@@ -156,7 +163,7 @@ CameraChoice choose_camera(const PredictSettings& s, const FrameSource& source, 
   }
   // The geometric head allocates per pixel of the calibrated size: compare it with the images
   // before, so that a wrong resolution is a clear message, not gigabytes asked for.
-  const HostImage first = first_decodable_pair(s).first.image;
+  const HostImage first = first_image(source, s);
   if (first.width != choice.camera.width || first.height != choice.camera.height) {
     throw invalid_input(source.description() + ": " + own_name + " gives the resolution " +
                         std::to_string(choice.camera.width) + "x" + std::to_string(choice.camera.height) +
@@ -227,6 +234,7 @@ Prediction::Prediction(const PredictSettings& s) : settings_(s) {
 Prediction::~Prediction() = default;
 
 std::size_t Prediction::pairs(std::size_t max_pairs) const {
+  if (source_->open_ended()) return max_pairs;
   const std::size_t all = source_->size() - 1;
   return max_pairs ? std::min(max_pairs, all) : all;
 }
@@ -275,7 +283,10 @@ std::vector<std::pair<std::string, std::string>> Prediction::csv_metadata() cons
 }
 
 void Prediction::warm_up(const std::function<void(const DeviceInfo& device, double seconds)>& report) {
-  const auto [first, second] = first_decodable_pair(settings_);
+  // A live source is not opened twice: its first frame, paired with itself, compiles the same kernels.
+  const auto [first, second] = source_->open_ended() ? std::pair<Frame, Frame>{Frame{0, source_->timestamp_ns(0), source_->decode(0), {}},
+                                                                             Frame{0, source_->timestamp_ns(0), source_->decode(0), {}}}
+                                                     : first_decodable_pair(settings_);
   const std::atomic<bool> keep_going{false};
   const auto factory = rates_processor(weights_of_, processor_);
   for (const auto& device : devices_) {
@@ -288,6 +299,11 @@ void Prediction::warm_up(const std::function<void(const DeviceInfo& device, doub
 }
 
 PipelineStats Prediction::run(const std::function<void(const PairResult&)>& sink, const PipelineOptions& options) {
+  return run(*source_, sink, options);
+}
+
+PipelineStats Prediction::run(FrameSource& source, const std::function<void(const PairResult&)>& sink,
+                              const PipelineOptions& options) {
   const auto factory = rates_processor(weights_of_, processor_);
   std::vector<Device*> devices;
   for (const auto& d : devices_) devices.push_back(d.get());
@@ -303,7 +319,7 @@ PipelineStats Prediction::run(const std::function<void(const PairResult&)>& sink
     }
     sink(r);
   };
-  return run_pipeline(*source_, devices, factory, checked, options);
+  return run_pipeline(source, devices, factory, checked, options);
 }
 
 RatesRow rates_row(const PairResult& r) {

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include "commands.hpp"
 #include "common.hpp"
@@ -147,7 +148,10 @@ void append_row(RatesTable& table, const RatesLayout& layout, const RatesRow& ro
 
 Command register_predict(CLI::App& app, const GlobalOptions& global) {
   auto o = std::make_shared<PredictOptions>();
-  app.add_option("sequence", o->sequence, "EuRoC folder, image folder, video or ROS bag")->required();
+  app.add_option("sequence", o->sequence,
+                 "EuRoC folder, image folder, video, ROS bag, or a live source: /dev/videoN, camera:N, gst:PIPELINE "
+                 "(ending in appsink) or capture:STRING (any OpenCV capture), read until Ctrl-C or its end")
+      ->required();
   app.add_option("-w,--weights", o->weights,
                  "weights (safetensors) holding FlowNet2 and/or the InertialNet head; repeat for several files");
   app.add_option("--model", o->model, "flow network (default FlowNet2)")->transform(choice("model", flow_model_names()));
@@ -234,9 +238,14 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
     const RatesProcessorOptions& processor = prediction.processor();
 
     const std::size_t pairs = prediction.pairs(o->max_pairs);
+    // A live source runs until Ctrl-C or its end; Ctrl-C is then its normal end, not an interruption.
+    const bool live = prediction.source().open_ended();
     const auto& infos = prediction.device_infos();
     if (!have_weights) info("no weights given: weight-free DIS optical flow + geometric head");
-    std::string summary = prediction.source().description() + ", " + std::to_string(pairs) + " pairs, " +
+    const std::string count = !live      ? std::to_string(pairs) + " pairs"
+                              : pairs > 0 ? "up to " + std::to_string(pairs) + " pairs"
+                                          : std::string("pairs until Ctrl-C or its end");
+    std::string summary = prediction.source().description() + ", " + count + ", " +
                           prediction.method() + " on " + std::to_string(infos.size()) + " device" +
                           (infos.size() > 1 ? "s" : "") + " (" + infos.front().name + (infos.size() > 1 ? ", …" : "") + ")";
     if (processor.geometric_head) {
@@ -286,7 +295,9 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
     }
     if (csv && !file_writer) std::cout << rates_csv_header(layout);
 
-    Progress progress("predict", pairs);
+    // A live run's rows are its progress (its length is unknown, so there is no bar to draw).
+    std::optional<Progress> progress;
+    if (!live) progress.emplace("predict", pairs);
     std::size_t done = 0;
     UnansweredTally tally;
     auto sink = [&](const PairResult& r) {
@@ -302,7 +313,8 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
       tally.add(r);
       for (const auto& line : unanswered_messages(r)) warning(line);
       if (r.flow) save_flow(o->save_flow, o->flow_format, r.t1_ns, *r.flow);
-      progress.update(++done);
+      ++done;
+      if (progress) progress->update(done);
     };
 
     PipelineOptions options;
@@ -315,7 +327,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
       try {
         return prediction.run(sink, options);
       } catch (const Error&) {
-        progress.finish();
+        if (progress) progress->finish();
         if (file_writer && file_writer->rows() > 0) {
           info("the " + std::to_string(file_writer->rows()) + " rows computed before the error are in " +
                file_writer->journal().string() + "; " + o->output + " is untouched");
@@ -323,7 +335,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
         throw;
       }
     }();
-    progress.finish();  // the summary below starts on a line of its own
+    if (progress) progress->finish();  // the summary below starts on a line of its own
 
     if (o->stats) {
       std::cerr << "pairs: " << stats.pairs << " in " << stats.seconds << " s = " << stats.pairs_per_second()
@@ -349,7 +361,9 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
     }
     // An interrupted run, or one in which no pair could be answered, leaves a complete output of
     // an earlier run in place: its rows stay in the journal beside it.
-    if (stats.cancelled) {
+    if (stats.cancelled && live) {
+      info("stopped after " + std::to_string(stats.pairs) + " pairs (Ctrl-C)");
+    } else if (stats.cancelled) {
       std::cerr << "inertialnet: interrupted after " << stats.pairs << " of " << pairs << " pairs; "
                 << (file_writer ? "the rows so far are in " + file_writer->journal().string() + " (" + o->output +
                                       " is untouched)"

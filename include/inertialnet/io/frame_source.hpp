@@ -3,6 +3,7 @@
 // Frames carry int64 nanosecond timestamps; decoding yields planar RGB (grayscale replicated).
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -37,6 +38,18 @@ class FrameSource {
   // What was assumed or overridden in opening the source (an assumed frame rate, a rate that
   // overrides timestamped names or a video's own frame times), one sentence each, for the user.
   virtual std::vector<std::string> notes() const { return {}; }
+
+  // A live source (a camera, a capture pipeline, frames a caller pushes) does not know its length
+  // until it ends: size() counts the frames arrived so far, and wait_for(i) blocks until frame i
+  // has arrived (true: timestamp_ns(i) and decode(i) may be asked for) or the source has ended
+  // before it (false). It gives up and answers false soon after `stop` turns true (within a frame
+  // period or 50 ms), so that a stopping pipeline does not wait for a camera. Such sources are
+  // sequential(). A source that knows its frames answers index < size() at once.
+  virtual bool open_ended() const { return false; }
+  virtual bool wait_for(std::size_t index, const std::atomic<bool>& stop) {
+    (void)stop;
+    return index < size();
+  }
 };
 
 // Opens `path`: a EuRoC folder (mav0/cam0/data.csv, or the camera asked for), a folder of images (sorted by name;
@@ -51,6 +64,8 @@ class FrameSource {
 // A ROS bag (bag.hpp: a .bag, .db3 or .mcap file, or a rosbag2 folder, told by content) is read
 // from the topics `bag` names (bag_source.hpp: header stamps; --rate and --camera are refused);
 // topics given for any other input are refused.
+// A live source (/dev/videoN, camera:N, gst:PIPELINE, capture:STRING; io/live_source.hpp) is
+// opened as such.
 std::unique_ptr<FrameSource> open_frame_source(const std::filesystem::path& path,
                                                std::optional<double> rate_hz = std::nullopt,
                                                const std::string& camera = "cam0", const BagTopics& bag = {});

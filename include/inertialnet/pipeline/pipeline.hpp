@@ -12,7 +12,7 @@
 // InvalidInput from FrameSource::decode) is no error of the run: it goes to the processor marked
 // as such, and its two pairs are answered with PairStatus::DecodeError. Any other error in any
 // stage, or the cancel flag (SIGINT), stops every stage; results already emitted stay emitted,
-// and the error is rethrown to the caller.
+// and the error is rethrown to the caller; on cancel, the pairs finished by then are emitted first.
 #pragma once
 
 #include <array>

@@ -24,7 +24,7 @@
 namespace inertialnet {
 
 struct PredictSettings {
-  std::filesystem::path sequence;    // EuRoC folder, image folder or video
+  std::filesystem::path sequence;    // EuRoC folder, image folder, video or live source (io/live_source.hpp)
   std::vector<std::string> weights;  // safetensors files; empty: the weight-free path
   std::string model;                 // flow network; "" takes it from the weights (else FlowNet2)
   std::string flow;                  // "flownet2" or "dis"; "": flownet2 with weights, dis without
@@ -67,7 +67,8 @@ class Prediction {
   Prediction& operator=(const Prediction&) = delete;
 
   FrameSource& source() { return *source_; }
-  // Pairs a run computes: every pair, or at most `max_pairs` (0: all).
+  // Pairs a run computes: every pair, or at most `max_pairs` (0: all). A live source's count is
+  // not known: `max_pairs` (0: until it ends or the run is stopped).
   std::size_t pairs(std::size_t max_pairs = 0) const;
   const std::vector<DeviceInfo>& device_infos() const { return infos_; }
   const RatesProcessorOptions& processor() const { return processor_; }
@@ -96,6 +97,10 @@ class Prediction {
   // cannot be answered has a status other than ok: PairResult::rates); a rate marked ok that is
   // not finite stops the run with runtime_error before it reaches the sink.
   PipelineStats run(const std::function<void(const PairResult&)>& sink, const PipelineOptions& options = {});
+  // The same on other frames (a StreamingPredictor's pushed ones) with these settings, devices and
+  // camera: one code path for every source.
+  PipelineStats run(FrameSource& source, const std::function<void(const PairResult&)>& sink,
+                    const PipelineOptions& options = {});
 
  private:
   PredictSettings settings_;
