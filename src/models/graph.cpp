@@ -8,7 +8,7 @@
 #include "inertialnet/ops/conv2d.hpp"
 #include "inertialnet/ops/conv_transpose2d.hpp"
 #include "inertialnet/ops/elementwise.hpp"
-#include "inertialnet/ops/gemm_plan_cache.hpp"
+#include "inertialnet/ops/gemm/plan_cache.hpp"
 #include "inertialnet/ops/linear.hpp"
 #include "inertialnet/ops/normalize.hpp"
 #include "inertialnet/ops/warp.hpp"

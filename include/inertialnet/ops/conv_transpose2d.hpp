@@ -12,7 +12,7 @@
 #include <cstddef>
 
 #include "inertialnet/ops/activation.hpp"
-#include "inertialnet/ops/gemm_plan.hpp"
+#include "inertialnet/ops/gemm/plan.hpp"
 #include "inertialnet/runtime/queue.hpp"
 #include "inertialnet/runtime/tensor.hpp"
 
@@ -26,7 +26,7 @@ struct ConvTranspose2dOptions {
   // the device's largest allocation is smaller). Above it, a sample is processed a block of
   // output channels at a time.
   std::size_t max_column_floats = 0;
-  // The weights prepared for their backend once per layer (ops/gemm_plan.hpp); null: the
+  // The weights prepared for their backend once per layer (ops/gemm/plan.hpp); null: the
   // device's backend, with the weights packed on this call when it needs them packed.
   const GemmWeights* prepared = nullptr;
 };

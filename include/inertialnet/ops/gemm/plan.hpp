@@ -12,7 +12,7 @@
 // Under $INERTIALNET_PLAN=auto the backend of a layer comes from timing: the layer runs on its
 // real shape with the weights prepared for each candidate of gemm_candidates() (one warm-up,
 // then the median of kPlanTimedRuns), the fastest is kept with its prepared weights, and the
-// choice is cached on disk per device and driver (ops/gemm_plan_cache.hpp), so a later start
+// choice is cached on disk per device and driver (ops/gemm/plan_cache.hpp), so a later start
 // only reads it.
 #pragma once
 
@@ -24,8 +24,8 @@
 #include <string>
 #include <vector>
 
-#include "inertialnet/ops/gemm_backend.hpp"
-#include "inertialnet/ops/gemm_packed.hpp"
+#include "inertialnet/ops/gemm/backend.hpp"
+#include "inertialnet/ops/gemm/packed_gemm.hpp"
 #include "inertialnet/runtime/queue.hpp"
 #include "inertialnet/runtime/tensor.hpp"
 

@@ -1,8 +1,8 @@
-#include "inertialnet/ops/gemm_plan.hpp"
+#include "inertialnet/ops/gemm/plan.hpp"
 
 #include <vector>
 
-#include "inertialnet/ops/gemm_plan_cache.hpp"
+#include "inertialnet/ops/gemm/plan_cache.hpp"
 #include "inertialnet/runtime/device.hpp"
 #include "ops/median_timing.hpp"
 #include "ops/winograd.hpp"
