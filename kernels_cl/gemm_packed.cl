@@ -13,31 +13,8 @@
 
 #include "common.cl"
 
-#if MR == 1
-#define EACH_ROW(X) X(0)
-#elif MR == 2
-#define EACH_ROW(X) X(0) X(1)
-#elif MR == 4
-#define EACH_ROW(X) X(0) X(1) X(2) X(3)
-#elif MR == 6
-#define EACH_ROW(X) X(0) X(1) X(2) X(3) X(4) X(5)
-#elif MR == 8
-#define EACH_ROW(X) X(0) X(1) X(2) X(3) X(4) X(5) X(6) X(7)
-#elif MR == 12
-#define EACH_ROW(X) X(0) X(1) X(2) X(3) X(4) X(5) X(6) X(7) X(8) X(9) X(10) X(11)
-#elif MR == 14
-#define EACH_ROW(X) X(0) X(1) X(2) X(3) X(4) X(5) X(6) X(7) X(8) X(9) X(10) X(11) X(12) X(13)
-#else
-#error "MR must be 1, 2, 4, 6, 8, 12 or 14"
-#endif
+#include "packed_tile.cl"
 
-#define DECLARE(r) float16 lo##r = (float16)(0.0f), hi##r = (float16)(0.0f);
-#define ACCUMULATE(r)                      \
-  {                                        \
-    const float16 a = (float16)(ap[r]);    \
-    lo##r = fma(a, b_lo, lo##r);           \
-    hi##r = fma(a, b_hi, hi##r);           \
-  }
 #define STORE(r) store_row(c, c_offset + (row0 + r) * ldc + col0, lo##r, hi##r, row0 + r < m, cols, alpha, beta, bias, bias_offset + row0 + r);
 
 // One row of a tile: `cols` (1..32) valid columns starting at c[index].

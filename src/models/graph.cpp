@@ -8,7 +8,7 @@
 #include "inertialnet/ops/conv2d.hpp"
 #include "inertialnet/ops/conv_transpose2d.hpp"
 #include "inertialnet/ops/elementwise.hpp"
-#include "inertialnet/ops/gemm_plan_cache.hpp"
+#include "inertialnet/ops/gemm/plan_cache.hpp"
 #include "inertialnet/ops/linear.hpp"
 #include "inertialnet/ops/normalize.hpp"
 #include "inertialnet/ops/warp.hpp"
@@ -339,7 +339,8 @@ void Executor::run(Queue& queue, const std::map<std::string, Tensor>& inputs, co
               conv_transpose2d_plan_key(scratch_in.shape(), weight.shape(), base.stride, base.padding), base,
               [&](const ConvTranspose2dOptions& o) { conv_transpose2d(queue, scratch_in, weight, bias, scratch_out, o); });
         }
-        gemm_weights_[i] = &prepared->conv_transpose2d(queue, node.weight, weight, timed ? &layer : nullptr);
+        gemm_weights_[i] = &prepared->conv_transpose2d(queue, node.weight, weight, graph_.value(node.inputs[0]).shape,
+                                                         base.stride, base.padding, timed ? &layer : nullptr);
       }
     }
   }

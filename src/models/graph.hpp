@@ -21,7 +21,7 @@
 #include "inertialnet/ops/conv2d.hpp"
 #include "inertialnet/ops/conv_transpose2d.hpp"
 #include "inertialnet/ops/correlation.hpp"
-#include "inertialnet/ops/gemm_plan.hpp"
+#include "inertialnet/ops/gemm/plan.hpp"
 #include "inertialnet/ops/pool.hpp"
 #include "inertialnet/ops/upsample.hpp"
 #include "inertialnet/runtime/queue.hpp"

@@ -6,7 +6,7 @@
 
 #include "inertialnet/runtime/device.hpp"
 #include "inertialnet/ops/bias_activation.hpp"
-#include "inertialnet/ops/gemm.hpp"
+#include "inertialnet/ops/gemm/gemm.hpp"
 #include "ops/op_support.hpp"
 #include "ops/winograd.hpp"
 

@@ -5,7 +5,7 @@
 
 #include "inertialnet/ops/conv2d.hpp"
 #include "inertialnet/ops/elementwise.hpp"
-#include "inertialnet/ops/gemm.hpp"
+#include "inertialnet/ops/gemm/gemm.hpp"
 #include "inertialnet/runtime/device.hpp"
 #include "ops/op_support.hpp"
 

@@ -6,7 +6,8 @@
 #include <string>
 
 #include "inertialnet/runtime/device.hpp"
-#include "inertialnet/ops/gemm.hpp"
+#include "inertialnet/ops/gemm/gemm.hpp"
+#include "ops/deconv_subpixel.hpp"
 #include "ops/op_support.hpp"
 
 namespace inertialnet {
@@ -57,6 +58,29 @@ void conv_transpose2d(Queue& queue, const Tensor& input, const Tensor& weight, c
                         ") gives " + to_string(expected));
   }
 
+  const GemmBackend backend = options.prepared ? options.prepared->backend : gemm_backend(queue.device().info());
+  const bool eligible = detail::subpixel_eligible(weight.shape(), options.stride, options.padding);
+  if (options.algorithm == DeconvAlgorithm::SubPixel && !eligible) {
+    throw invalid_input("conv_transpose2d: the sub-pixel algorithm needs a 4×4 kernel, stride 2 and padding 1, got "
+                        "weight " + to_string(weight.shape()) + ", stride " + std::to_string(options.stride) +
+                        ", padding " + std::to_string(options.padding));
+  }
+  bool subpixel = options.algorithm == DeconvAlgorithm::SubPixel;
+  if (options.algorithm == DeconvAlgorithm::Default && eligible && uses_packed_kernels(backend)) {
+    // The form the layer's weights were prepared in, else the choice by shape (a weight set
+    // prepared for another frame size keeps its form rather than packing on every call).
+    if (options.prepared && options.prepared->subpixel.data.defined()) subpixel = true;
+    else if (options.prepared && options.prepared->packed.data.defined()) subpixel = false;
+    else subpixel = detail::subpixel_preferred(input.shape(), weight.shape(), options.stride, options.padding);
+  }
+  if (subpixel) {
+    detail::report_backend(queue, to_string(GemmBackend::Packed));
+    const bool prepared = options.prepared && options.prepared->subpixel.data.defined();
+    const PackedPanels weights = prepared ? options.prepared->subpixel : detail::subpixel_weights(queue, weight, nullptr);
+    detail::conv_transpose2d_subpixel(queue, input, weights, bias, output, options);
+    return;
+  }
+
   Device& device = queue.device();
   const auto in_channels = static_cast<std::size_t>(weight.dim(0));
   const auto out_channels = static_cast<std::size_t>(weight.dim(1));
@@ -67,15 +91,16 @@ void conv_transpose2d(Queue& queue, const Tensor& input, const Tensor& weight, c
 
   std::size_t block =
       std::clamp<std::size_t>(detail::column_budget(device, options.max_column_floats) / (taps * in_pixels), 1, out_channels);
-  const GemmBackend backend = options.prepared ? options.prepared->backend : gemm_backend(device.info());
   detail::report_backend(queue, to_string(without_winograd(backend)));
   // The packed backend multiplies Wᵀ packed once per layer (or now) by the input packed per
   // sample; a block of channels is then a range of whole A panels.
   PackedPanels packed_weight, packed_input;
   if (uses_packed_kernels(backend)) {
     const bool prepared = options.prepared && options.prepared->packed.data.defined();
-    packed_weight = prepared ? options.prepared->packed
-                             : prepare_conv_transpose2d_weights(queue, weight, GemmBackend::Packed).packed;
+    // Stride 1, padding 0: the Wᵀ panels of this path, never the sub-pixel form.
+    packed_weight =
+        prepared ? options.prepared->packed
+                 : prepare_conv_transpose2d_weights(queue, weight, GemmBackend::Packed, input.shape(), 1, 0).packed;
     const auto width = static_cast<std::size_t>(packed_weight.width);
     const std::size_t step = width / std::gcd(taps, width);
     // Rounding up to whole panels can exceed the column budget by less than one panel's rows.

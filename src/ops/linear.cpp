@@ -5,8 +5,8 @@
 
 #include "inertialnet/runtime/device.hpp"
 #include "inertialnet/ops/bias_activation.hpp"
-#include "inertialnet/ops/gemm.hpp"
-#include "inertialnet/ops/gemm_packed.hpp"
+#include "inertialnet/ops/gemm/gemm.hpp"
+#include "inertialnet/ops/gemm/packed_gemm.hpp"
 #include "ops/op_support.hpp"
 
 namespace inertialnet {

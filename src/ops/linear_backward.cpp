@@ -4,7 +4,7 @@
 #include <string>
 
 #include "inertialnet/ops/elementwise.hpp"
-#include "inertialnet/ops/gemm.hpp"
+#include "inertialnet/ops/gemm/gemm.hpp"
 #include "inertialnet/ops/linear.hpp"
 #include "inertialnet/runtime/device.hpp"
 #include "ops/op_support.hpp"

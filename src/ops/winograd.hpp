@@ -4,7 +4,7 @@
 // plus two transforms (kernels_cl/winograd.cl).
 //
 // The weights are transformed (U = G g Gᵀ) and packed into 16 sets of A panels once per layer
-// (ops/gemm_plan.hpp). Per call, the input transform writes V = Bᵀ d B of a range of 2×2 output
+// (ops/gemm/plan.hpp). Per call, the input transform writes V = Bᵀ d B of a range of 2×2 output
 // tiles straight into 16 sets of packed B panels, the GEMMs write the 16 products, and the output
 // transform (Aᵀ m A) adds the bias, applies the activation and stores into the output view.
 //
@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "inertialnet/ops/conv2d.hpp"
-#include "inertialnet/ops/gemm_packed.hpp"
+#include "inertialnet/ops/gemm/packed_gemm.hpp"
 
 namespace inertialnet::detail {
 

@@ -51,7 +51,7 @@ std::vector<std::string> apply_clblast_parameters(const DeviceInfo& device, cons
 
 // Undoes apply_clblast_parameters for `kernel` on `device`: the set in use before its first
 // override (the shipped table's, or CLBlast's database) applies again. For a stored set that
-// CLBlast accepted but cannot compile (ops/gemm.cpp falls back to the defaults). Returns whether
+// CLBlast accepted but cannot compile (ops/gemm/gemm.cpp falls back to the defaults). Returns whether
 // there was an override to undo.
 bool restore_clblast_parameters(const DeviceInfo& device, const std::string& kernel);
 

@@ -1,6 +1,7 @@
-// conv_transpose2d (CLBlast GEMM + gather col2im with fused bias/activation) against the scatter
-// definition of tests/reference/conv.cpp: every FlowNet2 up-convolution at a 64×64 input, other
-// kernels/strides/paddings, odd sizes, batches, channel slices, channel blocks, bad shapes.
+// conv_transpose2d (GEMM + gather col2im with fused bias/activation, and the sub-pixel form of
+// the 4×4 / stride 2 / padding 1 layers) against the scatter definition of tests/reference/conv.cpp:
+// every FlowNet2 up-convolution at a 64×64 input on each algorithm, other kernels/strides/paddings,
+// odd sizes, batches, channel slices, channel and window blocks, bad shapes.
 #include <algorithm>
 #include <cmath>
 #include <functional>
@@ -10,6 +11,7 @@
 
 #include "inertialnet/ops/conv_transpose2d.hpp"
 #include "reference/conv.hpp"
+#include "ops/deconv_subpixel.hpp"
 #include "ops/op_testing.hpp"
 #include "support/flownet_layers.hpp"
 #include "support/testing.hpp"
@@ -30,6 +32,7 @@ struct Placement {
   int in_before = 0, in_after = 0;
   int out_before = 0, out_after = 0;
   std::size_t max_column_floats = 0;
+  DeconvAlgorithm algorithm = DeconvAlgorithm::Default;
 };
 
 // A FlowNet2 layer of the shared table as a test case.
@@ -57,6 +60,7 @@ void expect_deconv_matches(const DeconvCase& c, const Placement& p) {
   Tensor w = Tensor::from_host(queue, {c.ci, c.co, c.k, c.k}, weight);
   Tensor b = c.bias ? Tensor::from_host(queue, {c.co}, bias) : Tensor();
   ConvTranspose2dOptions options{c.stride, c.padding, c.activation, p.max_column_floats};
+  options.algorithm = p.algorithm;
   conv_transpose2d(queue, in.view, w, b, out.view, options);
   EXPECT_TRUE(testing::untouched_outside(queue, out)) << "elements outside the output slice were written";
   const auto got = testing::view_values(queue, out);
@@ -71,6 +75,19 @@ void expect_deconv_matches(const DeconvCase& c, const Placement& p) {
 class FlowNetDeconvShapes : public ::testing::TestWithParam<DeconvCase> {};
 
 TEST_P(FlowNetDeconvShapes, MatchTheReference) { expect_deconv_matches(GetParam(), Placement{}); }
+
+// Each algorithm forced, whatever the plan would choose (the default follows the backend).
+TEST_P(FlowNetDeconvShapes, SubPixelMatchesTheReference) {
+  Placement p;
+  p.algorithm = DeconvAlgorithm::SubPixel;
+  expect_deconv_matches(GetParam(), p);
+}
+
+TEST_P(FlowNetDeconvShapes, Col2imMatchesTheReference) {
+  Placement p;
+  p.algorithm = DeconvAlgorithm::Col2im;
+  expect_deconv_matches(GetParam(), p);
+}
 
 // FlowNet2's up-convolutions at a 64×64 network input. FlowNetC, FlowNetS and FlowNetSD share the
 // decoder shapes (FlowNetC: 1/64 → 1/4 resolution); the up layers differ only in their bias.
@@ -125,6 +142,55 @@ TEST(ConvTranspose2d, ConvenienceOverloadAllocatesTheOutput) {
                                  std::sqrt(12.0)));
 }
 
+TEST(ConvTranspose2d, SubPixelOnOddSizesSlicesAndWindowBlocks) {
+  const auto sub = DeconvAlgorithm::SubPixel;
+  // Odd heights and widths (the (H+1)×(W+1) window grid is not a multiple of 32), a batch.
+  expect_deconv_matches({"odd", 5, 7, 37, 23, 4, 2, 1, true, ActivationSpec::leaky_relu(0.1f)}, {3, 0, 0, 0, 0, 0, sub});
+  expect_deconv_matches({"single_pixel", 9, 3, 1, 1, 4, 2, 1, true, ActivationSpec::none()}, {3, 0, 0, 0, 0, 0, sub});
+  expect_deconv_matches({"one_row", 3, 13, 1, 41, 4, 2, 1, false, ActivationSpec::relu()}, {2, 0, 0, 0, 0, 0, sub});
+  // FlowNet's upsample_flow: 2 channels in, 2 out, no bias, into the last channels of a concat.
+  expect_deconv_matches({"flow_up_slice", 2, 2, 9, 11, 4, 2, 1, false, ActivationSpec::none()}, {3, 1, 0, 9, 0, 0, sub});
+  expect_deconv_matches({"slice", 6, 10, 37, 23, 4, 2, 1, true, ActivationSpec::leaky_relu(0.1f)}, {3, 2, 3, 5, 4, 0, sub});
+  // A budget of one panel of 4·ci rows: 38·24 windows in blocks of 32, the last one partial.
+  expect_deconv_matches({"window_blocks", 5, 8, 37, 23, 4, 2, 1, true, ActivationSpec::leaky_relu(0.1f)},
+                        {2, 1, 1, 2, 2, 4 * 5 * 32, sub});
+}
+
+TEST(ConvTranspose2d, SubPixelIsTheDefaultOnlyWhereItMeasuredFaster) {
+  // FlowNet2 at 512×384: deconv5 (6×8) and deconv4 (12×16) lost, deconv3 (24×32) was even,
+  // deconv2 (48×64) and FlowNetFusion's layers (96×128, 192×256) won (docs/performance.md).
+  const Shape weight{386, 64, 4, 4};
+  EXPECT_FALSE(detail::subpixel_preferred({1, 386, 6, 8}, weight, 2, 1));
+  EXPECT_FALSE(detail::subpixel_preferred({1, 386, 12, 16}, weight, 2, 1));
+  EXPECT_FALSE(detail::subpixel_preferred({1, 386, 24, 32}, weight, 2, 1));
+  EXPECT_TRUE(detail::subpixel_preferred({1, 386, 48, 64}, weight, 2, 1));
+  EXPECT_TRUE(detail::subpixel_preferred({1, 386, 192, 256}, weight, 2, 1));
+  // Never where the layer has no sub-pixel form.
+  EXPECT_FALSE(detail::subpixel_preferred({1, 386, 192, 256}, {386, 64, 3, 3}, 2, 1));
+  EXPECT_FALSE(detail::subpixel_preferred({1, 386, 192, 256}, weight, 2, 0));
+}
+
+TEST(ConvTranspose2d, SubPixelNeedsFourByFourStrideTwoPaddingOne) {
+  Queue& queue = testing::test_queue();
+  Device& device = testing::test_device();
+  const Tensor input = Tensor::empty(device, {1, 6, 4, 4});
+  ConvTranspose2dOptions options{};
+  options.algorithm = DeconvAlgorithm::SubPixel;
+  // 3×3, stride 2, padding 1: output 7×7.
+  testing::expect_invalid_input(
+      [&] {
+        conv_transpose2d(queue, input, Tensor::empty(device, {6, 3, 3, 3}), Tensor(), Tensor::empty(device, {1, 3, 7, 7}),
+                         options);
+      },
+      "sub-pixel algorithm needs a 4×4 kernel, stride 2 and padding 1");
+  options.padding = 0;  // 4×4, stride 2, padding 0: output 10×10.
+  testing::expect_invalid_input(
+      [&] {
+        conv_transpose2d(queue, input, Tensor::empty(device, {6, 3, 4, 4}), Tensor(),
+                         Tensor::empty(device, {1, 3, 10, 10}), options);
+      },
+      "padding 0");
+}
 
 TEST(ConvTranspose2d, BadShapesAreInvalidInput) {
   Queue& queue = testing::test_queue();

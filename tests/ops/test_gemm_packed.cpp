@@ -6,7 +6,7 @@
 #include <ostream>
 #include <string>
 
-#include "inertialnet/ops/gemm_packed.hpp"
+#include "inertialnet/ops/gemm/packed_gemm.hpp"
 #include "inertialnet/runtime/program_cache.hpp"
 #include "reference/conv.hpp"
 #include "reference/gemm.hpp"

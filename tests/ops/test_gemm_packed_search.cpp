@@ -3,8 +3,8 @@
 // what packing and the GEMM then use, with the same results as the defaults.
 #include <cmath>
 
-#include "inertialnet/ops/gemm_packed.hpp"
-#include "inertialnet/ops/gemm_packed_search.hpp"
+#include "inertialnet/ops/gemm/packed_gemm.hpp"
+#include "inertialnet/ops/gemm/packed_gemm_search.hpp"
 #include "support/testing.hpp"
 
 namespace inertialnet {

@@ -7,7 +7,7 @@
 #include <string>
 
 #include "inertialnet/ops/conv2d.hpp"
-#include "inertialnet/ops/gemm_plan_cache.hpp"
+#include "inertialnet/ops/gemm/plan_cache.hpp"
 #include "reference/conv.hpp"
 #include "support/testing.hpp"
 

@@ -17,8 +17,8 @@
 #include <vector>
 
 #include "inertialnet/ops/conv2d.hpp"
-#include "inertialnet/ops/gemm_backend.hpp"
-#include "inertialnet/ops/gemm_plan.hpp"
+#include "inertialnet/ops/gemm/backend.hpp"
+#include "inertialnet/ops/gemm/plan.hpp"
 #include "ops/op_testing.hpp"
 #include "reference/conv.hpp"
 #include "support/flownet_layers.hpp"

@@ -4,7 +4,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "inertialnet/ops/gemm.hpp"
+#include "inertialnet/ops/gemm/gemm.hpp"
 #include "support/testing.hpp"
 
 namespace inertialnet {

@@ -15,6 +15,13 @@ std::string fixed(double value, int decimals) {
   return buffer;
 }
 
+const KindGemmReference* reference_of(const BenchResult& r, const std::string& kind) {
+  for (const auto& reference : r.gemm_references) {
+    if (reference.kind == kind) return &reference;
+  }
+  return nullptr;
+}
+
 double profiled_seconds(const std::vector<LayerTime>& layers) {
   double total = 0;
   for (const auto& l : layers) total += l.seconds;
@@ -51,6 +58,23 @@ std::string format_bench_text(const BenchResult& r, bool layers) {
   out += "GEMM tuning: " + (r.gemm_tuning.empty() ? std::string("defaults") : r.gemm_tuning) + "\n\n";
   out += "per layer kind (one profiled pair, device time " + fixed(profiled_seconds(r.layers), 3) + " s):\n";
   out += format_kind_table(group_by_kind(r.layers));
+  if (!r.gemm_references.empty()) {
+    out += "\nthe packed GEMM alone on each kind's heaviest product (operands packed beforehand):\n";
+    char row[256];
+    std::snprintf(row, sizeof row, "%-22s %9s %9s  %-24s %s\n", "kind", "GFLOP/s", "of GEMM", "M×N×K", "layer");
+    out += row;
+    for (const auto& k : group_by_kind(r.layers)) {
+      const KindGemmReference* reference = reference_of(r, k.kind);
+      if (!reference) continue;
+      const double gflops = k.seconds > 0 ? k.flops * 1e-9 / k.seconds : 0;
+      const std::string product =
+          std::to_string(reference->m) + "×" + std::to_string(reference->n) + "×" + std::to_string(reference->k);
+      std::snprintf(row, sizeof row, "%-22s %9.1f %8.0f%%  %-24s %s\n", k.kind.c_str(), reference->gflops,
+                    reference->gflops > 0 ? 100 * gflops / reference->gflops : 0, product.c_str(),
+                    reference->layer.c_str());
+      out += row;
+    }
+  }
   if (layers) out += "\nper layer:\n" + format_layer_table(r.layers);
   return out;
 }
@@ -86,12 +110,25 @@ std::string format_bench_json(const std::vector<BenchResult>& results) {
     const double total = profiled_seconds(r.layers);
     nlohmann::json kinds = nlohmann::json::array(), layers = nlohmann::json::array();
     for (const auto& k : group_by_kind(r.layers)) {
-      kinds.push_back({{"kind", k.kind},
-                       {"layers", k.layers},
-                       {"seconds", k.seconds},
-                       {"share", total > 0 ? k.seconds / total : 0},
-                       {"gflops", k.seconds > 0 ? k.flops * 1e-9 / k.seconds : 0},
-                       {"backends", k.backends}});
+      const double gflops = k.seconds > 0 ? k.flops * 1e-9 / k.seconds : 0;
+      nlohmann::json kind = {{"kind", k.kind},
+                             {"layers", k.layers},
+                             {"seconds", k.seconds},
+                             {"share", total > 0 ? k.seconds / total : 0},
+                             {"gflops", gflops},
+                             {"backends", k.backends},
+                             {"gflop", k.flops * 1e-9},
+                             {"packed_gemm", nullptr},
+                             {"of_packed_gemm", nullptr}};
+      if (const KindGemmReference* reference = reference_of(r, k.kind)) {
+        kind["packed_gemm"] = {{"layer", reference->layer},
+                               {"m", reference->m},
+                               {"n", reference->n},
+                               {"k", reference->k},
+                               {"gflops", reference->gflops}};
+        kind["of_packed_gemm"] = reference->gflops > 0 ? gflops / reference->gflops : 0;
+      }
+      kinds.push_back(std::move(kind));
     }
     for (const auto& l : r.layers) {
       layers.push_back({{"name", l.layer.name},

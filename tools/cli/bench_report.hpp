@@ -26,7 +26,14 @@
 //                                            file); "" for none
 //       "profile": {                         one more pair on a profiling queue, device time
 //         "seconds": number                  the sum over layers
-//         "kinds": [ { "kind", "layers", "seconds", "share", "gflops", "backends": [string] } ]
+//         "kinds": [ { "kind", "layers", "seconds", "share", "gflops", "backends": [string],
+//                      "gflop": number       the kind's work in the profiled pair (GFLOP)
+//                      "packed_gemm": { "layer", "m", "n", "k", "gflops" } | null
+//                                            the packed GEMM kernel alone on the product of the
+//                                            kind's heaviest layer (operands packed beforehand:
+//                                            the best that product reaches on this device); null
+//                                            for kinds without a GEMM (bench_gemm_reference.hpp)
+//                      "of_packed_gemm": number | null   gflops / packed_gemm.gflops } ]
 //         "layers": [ { "name", "kind", "seconds", "flops", "gflops", "backend" } ]
 //       } } ] }
 // "backend" is the GEMM backend a layer ran on ("clblast", …; "" for layers without a GEMM).
@@ -36,6 +43,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_gemm_reference.hpp"
 #include "inertialnet/runtime/layer_profiler.hpp"
 
 namespace inertialnet::cli {
@@ -53,6 +61,7 @@ struct BenchResult {
 
   std::size_t total_bytes() const { return weight_bytes + prepared_weight_bytes + head_weight_bytes + activation_bytes; }
   std::vector<LayerTime> layers;  // the profiled pair
+  std::vector<KindGemmReference> gemm_references;  // the packed GEMM on each GEMM kind's product
 
   double seconds_per_pair() const { return upload + flow + head_seconds + download; }
   double pairs_per_second() const { return seconds_per_pair() > 0 ? 1.0 / seconds_per_pair() : 0; }

@@ -112,6 +112,7 @@ BenchResult run_bench(const DeviceInfo& info, const GlobalOptions& global, const
   profiling_queue->set_profiler(&profiler);
   pair(*profiling_queue, false);
   r.layers = profiler.collect();
+  r.gemm_references = packed_gemm_references(queue, kind, width, height, r.layers);
 
   const FlowNetMemory memory = net.memory();
   r.network_width = memory.network_width;

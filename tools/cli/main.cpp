@@ -10,7 +10,7 @@
 #include "docgen.hpp"
 #include "global_options.hpp"
 #include "help_text.hpp"
-#include "inertialnet/ops/gemm_backend.hpp"
+#include "inertialnet/ops/gemm/backend.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/runtime/program_cache.hpp"
 #include "inertialnet/runtime/version.hpp"

@@ -23,7 +23,7 @@ namespace inertialnet {
 struct FlowNetMemory {
   std::size_t weight_bytes = 0;
   // The weights again in the layout their GEMM backend reads (packed panels, Winograd
-  // transforms; ops/gemm_plan.hpp), made on the first compute() and shared by every network on
+  // transforms; ops/gemm/plan.hpp), made on the first compute() and shared by every network on
   // the same WeightSet: device memory on top of weight_bytes (≈ 650 MB at FlowNet2 on the
   // packed plan).
   std::size_t prepared_weight_bytes = 0;

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "inertialnet/models/parameters.hpp"
-#include "inertialnet/ops/gemm_shape.hpp"
+#include "inertialnet/ops/gemm/shape.hpp"
 
 namespace inertialnet {
 

@@ -14,7 +14,7 @@
 
 #include "inertialnet/runtime/device.hpp"
 #include "inertialnet/models/parameters.hpp"
-#include "inertialnet/ops/gemm_plan.hpp"
+#include "inertialnet/ops/gemm/plan.hpp"
 #include "inertialnet/runtime/tensor.hpp"
 
 namespace inertialnet {

@@ -14,7 +14,7 @@
 #include <cstddef>
 
 #include "inertialnet/ops/activation.hpp"
-#include "inertialnet/ops/gemm_plan.hpp"
+#include "inertialnet/ops/gemm/plan.hpp"
 #include "inertialnet/runtime/queue.hpp"
 #include "inertialnet/runtime/tensor.hpp"
 
@@ -28,7 +28,7 @@ struct Conv2dOptions {
   // where the device's largest allocation is smaller). Above it, a sample is processed a range
   // of output pixels at a time.
   std::size_t max_column_floats = 0;
-  // The weights prepared for their backend once per layer (ops/gemm_plan.hpp); null: the
+  // The weights prepared for their backend once per layer (ops/gemm/plan.hpp); null: the
   // device's backend, with the weights packed on this call when it needs them packed.
   const GemmWeights* prepared = nullptr;
 };

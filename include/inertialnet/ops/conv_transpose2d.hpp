@@ -6,17 +6,28 @@
 // it (no atomics, deterministic), adds the bias and applies the activation in the same pass.
 // The columns are a pooled temporary of one sample's size.
 //
+// On the packed backends the 4×4 / stride 2 / padding 1 layers (every FlowNet up-convolution)
+// on inputs large enough run the sub-pixel decomposition instead: four 2×2 convolutions in one
+// packed GEMM whose store writes the interleaved output directly, with no column matrix
+// (src/ops/deconv_subpixel.hpp says when and why).
+//
 // Input and output may be channel slices of larger tensors; they must not overlap.
 #pragma once
 
 #include <cstddef>
 
 #include "inertialnet/ops/activation.hpp"
-#include "inertialnet/ops/gemm_plan.hpp"
+#include "inertialnet/ops/gemm/plan.hpp"
 #include "inertialnet/runtime/queue.hpp"
 #include "inertialnet/runtime/tensor.hpp"
 
 namespace inertialnet {
+
+// How a layer runs: Default is the sub-pixel form on the packed backends where it has that form
+// and measured faster (inputs of at least about 48×64, docs/performance.md), GEMM + col2im
+// elsewhere; the others force one (tests). SubPixel on a layer without that form is invalid_input; on
+// the CLBlast backend it runs the packed kernels.
+enum class DeconvAlgorithm { Default, Col2im, SubPixel };
 
 struct ConvTranspose2dOptions {
   int stride = 2;
@@ -26,9 +37,10 @@ struct ConvTranspose2dOptions {
   // the device's largest allocation is smaller). Above it, a sample is processed a block of
   // output channels at a time.
   std::size_t max_column_floats = 0;
-  // The weights prepared for their backend once per layer (ops/gemm_plan.hpp); null: the
+  // The weights prepared for their backend once per layer (ops/gemm/plan.hpp); null: the
   // device's backend, with the weights packed on this call when it needs them packed.
   const GemmWeights* prepared = nullptr;
+  DeconvAlgorithm algorithm = DeconvAlgorithm::Default;
 };
 
 // [N, co, Ho, Wo] for `input` [N, ci, H, W] and `weight` [ci, co, kh, kw]:

@@ -26,7 +26,7 @@
 // the file and the key in our words, and ignored (defaults apply); one that names another device
 // or driver is ignored silently (a copied cache). A set that passes the checks yet fails in
 // CLBlast is dropped by a probe before the first CLBlast call, or at any failing call
-// (ops/gemm.cpp). With the disk cache off
+// (ops/gemm/gemm.cpp). With the disk cache off
 // ($INERTIALNET_NO_CACHE, --no-cache) the file is neither read nor written.
 #pragma once
 
@@ -45,7 +45,7 @@ struct DeviceTuning {
   // CLBlast kernel family ("Xgemm") → its full parameter set; empty: CLBlast's defaults (or the
   // shipped table).
   std::map<std::string, std::map<std::string, std::size_t>> clblast;
-  // Build options of the packed GEMM (ops/gemm_packed.hpp): "MR", "PANELS_FIRST".
+  // Build options of the packed GEMM (ops/gemm/packed_gemm.hpp): "MR", "PANELS_FIRST".
   std::map<std::string, int> packed;
   // The whole document as read (what `tune --show` prints); empty when nothing was read.
   std::string document;

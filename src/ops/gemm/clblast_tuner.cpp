@@ -1,4 +1,4 @@
-#include "inertialnet/ops/clblast_gemm_tuner.hpp"
+#include "inertialnet/ops/gemm/clblast_tuner.hpp"
 
 #include <clblast.h>
 
@@ -6,7 +6,7 @@
 #include <exception>
 #include <unordered_map>
 
-#include "inertialnet/ops/gemm.hpp"
+#include "inertialnet/ops/gemm/gemm.hpp"
 #include "inertialnet/runtime/device.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "ops/median_timing.hpp"

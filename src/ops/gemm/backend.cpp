@@ -1,4 +1,4 @@
-#include "inertialnet/ops/gemm_backend.hpp"
+#include "inertialnet/ops/gemm/backend.hpp"
 
 #include <cstdlib>
 

@@ -1,10 +1,10 @@
-#include "inertialnet/ops/gemm_packed_search.hpp"
+#include "inertialnet/ops/gemm/packed_gemm_search.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 
-#include "inertialnet/ops/gemm_packed.hpp"
+#include "inertialnet/ops/gemm/packed_gemm.hpp"
 #include "inertialnet/runtime/device.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "ops/median_timing.hpp"

@@ -1,4 +1,4 @@
-// The timed GEMM plans of one device and driver ($INERTIALNET_PLAN=auto, ops/gemm_backend.hpp),
+// The timed GEMM plans of one device and driver ($INERTIALNET_PLAN=auto, ops/gemm/backend.hpp),
 // kept on disk beside the program cache so that a layer shape is timed once per machine:
 //
 //   <cache directory>/gemm-plans/<fnv1a64(platform, device, driver) in hex>.json
@@ -18,7 +18,7 @@
 #include <string>
 
 #include "inertialnet/core/tensor_spec.hpp"
-#include "inertialnet/ops/gemm_backend.hpp"
+#include "inertialnet/ops/gemm/backend.hpp"
 #include "inertialnet/runtime/device_info.hpp"
 
 namespace inertialnet {

@@ -1,5 +1,5 @@
 // Which implementation runs a layer's matrix product: CLBlast (any OpenCL device; the choice on
-// GPUs) or the project's packed-panel kernels written for CPU devices (ops/gemm_packed.hpp,
+// GPUs) or the project's packed-panel kernels written for CPU devices (ops/gemm/packed_gemm.hpp,
 // with a direct convolution for layers of very few output channels and a GEMV for
 // one-sample fully connected layers).
 //
@@ -13,7 +13,7 @@
 //
 // $INERTIALNET_PLAN=auto opts in to timing: each GEMM layer of a model times every candidate of
 // gemm_candidates() on its real shape when the model is prepared and keeps the fastest, cached
-// per device and driver on disk (ops/gemm_plan_cache.hpp). Timing is opt-in so that tests stay
+// per device and driver on disk (ops/gemm/plan_cache.hpp). Timing is opt-in so that tests stay
 // deterministic and a first run costs no extra seconds; where a layer is not prepared by a
 // model (a bare op call), "auto" means the deterministic choice.
 #pragma once

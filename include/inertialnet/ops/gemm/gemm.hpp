@@ -1,5 +1,5 @@
 // Single-precision GEMM, row-major: C = alpha·op(A)·op(B) + beta·C with op(A) m×k, op(B) k×n
-// and C m×n, through CLBlast or the packed-panel kernels (ops/gemm_backend.hpp says which).
+// and C m×n, through CLBlast or the packed-panel kernels (ops/gemm/backend.hpp says which).
 // Convolutions and fully connected layers end here.
 //
 // Matrices are views into device buffers (buffer, element offset, leading dimension); every
@@ -9,7 +9,7 @@
 
 #include <cstddef>
 
-#include "inertialnet/ops/gemm_backend.hpp"
+#include "inertialnet/ops/gemm/backend.hpp"
 #include "inertialnet/runtime/queue.hpp"
 #include "inertialnet/runtime/tensor.hpp"
 
@@ -28,7 +28,7 @@ struct MatrixView {
 };
 
 // On the device's backend (gemm_backend()). The packed backend packs both operands on every
-// call; layers that multiply by the same weights every time pack them once (ops/gemm_plan.hpp).
+// call; layers that multiply by the same weights every time pack them once (ops/gemm/plan.hpp).
 void gemm(Queue& queue, Transpose transpose_a, Transpose transpose_b, std::size_t m, std::size_t n,
           std::size_t k, float alpha, const MatrixView& a, const MatrixView& b, float beta,
           const MatrixView& c);

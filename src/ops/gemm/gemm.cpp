@@ -1,4 +1,4 @@
-#include "inertialnet/ops/gemm.hpp"
+#include "inertialnet/ops/gemm/gemm.hpp"
 
 #include <clblast.h>
 
@@ -12,9 +12,9 @@
 #include <string>
 #include <unordered_map>
 
-#include "inertialnet/ops/gemm_packed.hpp"
+#include "inertialnet/ops/gemm/packed_gemm.hpp"
 #include "inertialnet/runtime/device.hpp"
-#include "ops/gemm_support.hpp"
+#include "ops/gemm/operand_check.hpp"
 #include "runtime/clblast_tuning.hpp"
 
 namespace inertialnet {

@@ -3,7 +3,7 @@
 
 #include <cstddef>
 
-#include "inertialnet/ops/gemm.hpp"
+#include "inertialnet/ops/gemm/gemm.hpp"
 
 namespace inertialnet::detail {
 

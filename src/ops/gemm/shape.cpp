@@ -1,4 +1,4 @@
-#include "inertialnet/ops/gemm_shape.hpp"
+#include "inertialnet/ops/gemm/shape.hpp"
 
 #include <algorithm>
 

@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "inertialnet/ops/activation.hpp"
-#include "inertialnet/ops/gemm.hpp"
+#include "inertialnet/ops/gemm/gemm.hpp"
 #include "inertialnet/runtime/queue.hpp"
 #include "inertialnet/runtime/tensor.hpp"
 

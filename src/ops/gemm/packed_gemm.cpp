@@ -1,4 +1,4 @@
-#include "inertialnet/ops/gemm_packed.hpp"
+#include "inertialnet/ops/gemm/packed_gemm.hpp"
 
 #include <algorithm>
 #include <cstdint>
@@ -6,7 +6,7 @@
 #include <string>
 
 #include "inertialnet/runtime/device.hpp"
-#include "ops/gemm_support.hpp"
+#include "ops/gemm/operand_check.hpp"
 
 namespace inertialnet {
 

@@ -12,7 +12,7 @@
 // Under $INERTIALNET_PLAN=auto the backend of a layer comes from timing: the layer runs on its
 // real shape with the weights prepared for each candidate of gemm_candidates() (one warm-up,
 // then the median of kPlanTimedRuns), the fastest is kept with its prepared weights, and the
-// choice is cached on disk per device and driver (ops/gemm_plan_cache.hpp), so a later start
+// choice is cached on disk per device and driver (ops/gemm/plan_cache.hpp), so a later start
 // only reads it.
 #pragma once
 
@@ -24,8 +24,8 @@
 #include <string>
 #include <vector>
 
-#include "inertialnet/ops/gemm_backend.hpp"
-#include "inertialnet/ops/gemm_packed.hpp"
+#include "inertialnet/ops/gemm/backend.hpp"
+#include "inertialnet/ops/gemm/packed_gemm.hpp"
 #include "inertialnet/runtime/queue.hpp"
 #include "inertialnet/runtime/tensor.hpp"
 
@@ -33,10 +33,12 @@ namespace inertialnet {
 
 // A layer's weights as its backend reads them. `packed` is defined only where the layer runs
 // the packed GEMM on im2col panels, `winograd` (16 matrices) only where it runs Winograd;
-// everything else reads the original weight tensor.
+// `subpixel` (the [4·co × 4·ci] phase weights) only where a 4×4 / stride 2 / padding 1
+// transposed convolution runs the sub-pixel form; everything else reads the original weight tensor.
 struct GemmWeights {
   GemmBackend backend = GemmBackend::CLBlast;
   PackedPanels packed;
+  PackedPanels subpixel;
   std::vector<PackedPanels> winograd;
 };
 
@@ -45,10 +47,12 @@ struct GemmWeights {
 inline constexpr std::int64_t kDirectConvMaxChannels = 4;
 
 // Prepares conv2d weights [co, ci, kh, kw] (of a layer of `stride`) / conv_transpose2d weights
-// [ci, co, kh, kw] for `backend`, packing on `queue` into long-lived storage of `device`. Wait
-// for `queue` before another queue uses the result.
+// [ci, co, kh, kw] (of a layer on `input` with `stride` and `padding`) for `backend`, packing on
+// `queue` into long-lived storage of `device`. Wait for `queue` before another queue uses the
+// result.
 GemmWeights prepare_conv2d_weights(Queue& queue, const Tensor& weight, GemmBackend backend, int stride);
-GemmWeights prepare_conv_transpose2d_weights(Queue& queue, const Tensor& weight, GemmBackend backend);
+GemmWeights prepare_conv_transpose2d_weights(Queue& queue, const Tensor& weight, GemmBackend backend,
+                                             const Shape& input, int stride, int padding);
 
 class GemmPlanCache;
 
@@ -74,6 +78,7 @@ class PreparedWeights {
   const GemmWeights& conv2d(Queue& queue, const std::string& name, const Tensor& weight, int stride,
                             const PlannedLayer* layer = nullptr);
   const GemmWeights& conv_transpose2d(Queue& queue, const std::string& name, const Tensor& weight,
+                                      const Shape& input, int stride, int padding,
                                       const PlannedLayer* layer = nullptr);
   std::size_t packed_bytes() const;
 

@@ -1,4 +1,4 @@
-#include "inertialnet/ops/gemm_plan_cache.hpp"
+#include "inertialnet/ops/gemm/plan_cache.hpp"
 
 #include <cstdio>
 #include <fstream>

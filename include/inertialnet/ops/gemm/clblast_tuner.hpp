@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "inertialnet/ops/gemm_shape.hpp"
+#include "inertialnet/ops/gemm/shape.hpp"
 #include "inertialnet/runtime/queue.hpp"
 
 namespace inertialnet {

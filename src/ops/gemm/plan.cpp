@@ -1,9 +1,10 @@
-#include "inertialnet/ops/gemm_plan.hpp"
+#include "inertialnet/ops/gemm/plan.hpp"
 
 #include <vector>
 
-#include "inertialnet/ops/gemm_plan_cache.hpp"
+#include "inertialnet/ops/gemm/plan_cache.hpp"
 #include "inertialnet/runtime/device.hpp"
+#include "ops/deconv_subpixel.hpp"
 #include "ops/median_timing.hpp"
 #include "ops/winograd.hpp"
 
@@ -55,14 +56,18 @@ GemmWeights prepare_conv2d_weights(Queue& queue, const Tensor& weight, GemmBacke
   return prepared;
 }
 
-GemmWeights prepare_conv_transpose2d_weights(Queue& queue, const Tensor& weight, GemmBackend backend) {
+GemmWeights prepare_conv_transpose2d_weights(Queue& queue, const Tensor& weight, GemmBackend backend,
+                                             const Shape& input, int stride, int padding) {
   if (weight.rank() != 4 || !weight.contiguous()) {
     throw invalid_input("conv_transpose2d weights must be a contiguous [ci, co, kh, kw] tensor, got " +
                         to_string(weight.shape()));
   }
   GemmWeights prepared;
   prepared.backend = backend;
-  if (uses_packed_kernels(backend)) {
+  if (uses_packed_kernels(backend) && detail::subpixel_preferred(input, weight.shape(), stride, padding)) {
+    // conv_transpose2d's default on the packed backends for this shape (ops/conv_transpose2d.hpp).
+    prepared.subpixel = detail::subpixel_weights(queue, weight, &queue.device());
+  } else if (uses_packed_kernels(backend)) {
     // The GEMM's A is Wᵀ: [co·kh·kw, ci] from W stored [ci, co·kh·kw].
     const auto depth = static_cast<std::size_t>(weight.dim(0));
     const std::size_t rows = static_cast<std::size_t>(weight.numel()) / depth;
@@ -105,9 +110,13 @@ const GemmWeights& PreparedWeights::conv2d(Queue& queue, const std::string& name
 }
 
 const GemmWeights& PreparedWeights::conv_transpose2d(Queue& queue, const std::string& name, const Tensor& weight,
+                                                      const Shape& input, int stride, int padding,
                                                       const PlannedLayer* layer) {
   return get(
-      queue, name, [&](GemmBackend backend) { return prepare_conv_transpose2d_weights(queue, weight, backend); },
+      queue, name,
+      [&](GemmBackend backend) {
+        return prepare_conv_transpose2d_weights(queue, weight, backend, input, stride, padding);
+      },
       layer);
 }
 
@@ -116,6 +125,7 @@ std::size_t PreparedWeights::packed_bytes() const {
   std::size_t bytes = 0;
   for (const auto& [name, w] : weights_) {
     if (w.packed.data.defined()) bytes += static_cast<std::size_t>(w.packed.data.numel()) * sizeof(float);
+    if (w.subpixel.data.defined()) bytes += static_cast<std::size_t>(w.subpixel.data.numel()) * sizeof(float);
     for (const PackedPanels& p : w.winograd) bytes += static_cast<std::size_t>(p.data.numel()) * sizeof(float);
   }
   return bytes;

@@ -1,0 +1,30 @@
+// The register tile of the packed-panel GEMM, shared by every kernel that runs its inner loop
+// (gemm_packed.cl, deconv_subpixel.cl) so that they differ only in how the tile is stored:
+// MR rows of A broadcast against 32 columns of B, 2·MR float16 accumulators (see gemm_packed.cl).
+// A header: included after common.cl, never built on its own. Build option: -DMR.
+
+#if MR == 1
+#define EACH_ROW(X) X(0)
+#elif MR == 2
+#define EACH_ROW(X) X(0) X(1)
+#elif MR == 4
+#define EACH_ROW(X) X(0) X(1) X(2) X(3)
+#elif MR == 6
+#define EACH_ROW(X) X(0) X(1) X(2) X(3) X(4) X(5)
+#elif MR == 8
+#define EACH_ROW(X) X(0) X(1) X(2) X(3) X(4) X(5) X(6) X(7)
+#elif MR == 12
+#define EACH_ROW(X) X(0) X(1) X(2) X(3) X(4) X(5) X(6) X(7) X(8) X(9) X(10) X(11)
+#elif MR == 14
+#define EACH_ROW(X) X(0) X(1) X(2) X(3) X(4) X(5) X(6) X(7) X(8) X(9) X(10) X(11) X(12) X(13)
+#else
+#error "MR must be 1, 2, 4, 6, 8, 12 or 14"
+#endif
+
+#define DECLARE(r) float16 lo##r = (float16)(0.0f), hi##r = (float16)(0.0f);
+#define ACCUMULATE(r)                      \
+  {                                        \
+    const float16 a = (float16)(ap[r]);    \
+    lo##r = fma(a, b_lo, lo##r);           \
+    hi##r = fma(a, b_hi, hi##r);           \
+  }

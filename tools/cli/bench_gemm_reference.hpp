@@ -1,0 +1,29 @@
+// The packed GEMM's own rate beside each GEMM-based layer kind of a `bench` profile: for every
+// kind, the product (M×N×K) of its heaviest layer is timed on the packed kernel alone, so a run
+// shows how far the layers (with their im2col, col2im, transforms and stores) are from what the
+// device's GEMM reaches on the same product (issue 24's "≥ 80 % of the packed GEMM's rate").
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "inertialnet/models/parameters.hpp"
+#include "inertialnet/runtime/layer_profiler.hpp"
+#include "inertialnet/runtime/queue.hpp"
+
+namespace inertialnet::cli {
+
+struct KindGemmReference {
+  std::string kind;
+  std::string layer;  // the heaviest layer of the kind, whose product was timed
+  std::size_t m = 0, n = 0, k = 0;
+  double gflops = 0;  // the packed GEMM's rate on m×n×k
+};
+
+// One entry per kind of `layers` that has a GEMM-based layer of `model` at width×height (the
+// model's products, models/gemm_shapes.hpp); kinds without one (correlation, warp, …) have none,
+// nor do kinds only the head runs (linear): its products are not the flow model's.
+std::vector<KindGemmReference> packed_gemm_references(Queue& queue, ModelKind model, std::int64_t width,
+                                                      std::int64_t height, const std::vector<LayerTime>& layers);
+
+}  // namespace inertialnet::cli
