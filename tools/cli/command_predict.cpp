@@ -215,6 +215,8 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
     settings.fy = o->camera.fy;
     settings.cx = o->camera.cx;
     settings.cy = o->camera.cy;
+    settings.calibration = o->camera.calibration.file;
+    settings.calibration_camera = o->camera.calibration.camera;
     settings.rate_hz = o->rate_hz;
     settings.camera = o->camera_name;
     settings.bag = o->bag;

@@ -4,6 +4,7 @@
 // --camchain, --rate; include/inertialnet/io/imu_sequence.hpp).
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -22,9 +23,17 @@ inline constexpr double kMinimumPositive = 1e-6;
 CLI::Validator finite_positive_up_to(double limit, const char* unit);  // "must be a finite positive number, got …"
 CLI::Validator finite_pixel_coordinate();                              // within 1e6 pixels of the origin
 
-// --fx --fy --cx --cy (0: not given).
+// --calibration FILE [--calibration-camera camN]: a calibration file (calibration_file.hpp).
+// Added by add_intrinsics_options; eval, which needs only its extrinsic, adds it alone.
+struct CalibrationCliOptions {
+  std::string file, camera;
+};
+void add_calibration_options(CLI::App& app, CalibrationCliOptions& o);
+
+// --fx --fy --cx --cy (each optional: --cx 0 is a principal point) and --calibration.
 struct IntrinsicsCliOptions {
-  double fx = 0, fy = 0, cx = 0, cy = 0;
+  std::optional<double> fx, fy, cx, cy;
+  CalibrationCliOptions calibration;
 };
 void add_intrinsics_options(CLI::App& app, IntrinsicsCliOptions& o);
 
@@ -42,6 +51,9 @@ struct ImuCliOptions {
   std::string camera = "cam0";  // --camera, added with the IMU options
   double rate_hz = 0;
   BagTopics bag;                // --image-topic, --imu-topic, --camera-info-topic
+  // --calibration, added by add_calibration_options (or add_intrinsics_options): its camera-IMU
+  // extrinsic, when the file has one, stands for --camchain.
+  CalibrationCliOptions calibration;
 };
 void add_imu_options(CLI::App& app, ImuCliOptions& o);
 // Reads the calibration given (invalid_input naming the option or file when it is bad).
