@@ -189,6 +189,9 @@ TEST_P(Ros2Bag, ReadsTopicsAndMessagesAsWritten) {
   }
   EXPECT_EQ(image_times, expected_image_times);
   EXPECT_EQ(imu_times, expected_imu_times);
+  // At the end a cursor stays at the end (it does not start over).
+  EXPECT_FALSE(images->next(message));
+  EXPECT_FALSE(imu->next(message));
   EXPECT_TRUE(read_all(*reader, {}).empty());
 }
 
@@ -241,6 +244,18 @@ TEST(Ros2BagFolder, RefusesWhatItCannotRead) {
   EXPECT_NE(message.find("compression_mode FILE"), std::string::npos) << message;
   message = invalid_input_from([] { bag::ros2_storage_file(bags() / "no_metadata_folder"); });
   EXPECT_NE(message.find("no metadata.yaml"), std::string::npos) << message;
+}
+
+// rosbag2's "message" compression: the folder says so; the storage file alone is caught at its
+// first message (a zstd frame where CDR belongs).
+TEST(Ros2Bag, PerMessageCompressionIsRefusedByName) {
+  std::string message = invalid_input_from([] { bag::ros2_storage_file(bags() / "sqlite_message_zstd"); });
+  EXPECT_NE(message.find("compression_mode message"), std::string::npos) << message;
+  for (const char* file : {"sqlite_message_zstd/sqlite_message_zstd.db3", "mcap_message_zstd/mcap_message_zstd.mcap"}) {
+    message = invalid_input_from([&] { open_and_read_everything(bags() / file); });
+    EXPECT_NE(message.find(fs::path(file).filename().string()), std::string::npos) << message;
+    EXPECT_NE(message.find("zstd-compressed messages on /"), std::string::npos) << message;
+  }
 }
 
 TEST(Ros2Sqlite, DamagedDatabasesAreInvalidInputNamingTheFile) {

@@ -86,10 +86,10 @@ def ros1(topic, message):
     return bytes(ts.serialize_ros1(message, TOPICS[topic]))
 
 
-def write_rosbag2(folder, storage, version=9, zstd=False):
+def write_rosbag2(folder, storage, version=9, zstd=False, compression_mode=CompressionMode.STORAGE):
     writer = Writer(out / folder, version=version, storage_plugin=storage)
     if zstd:
-        writer.set_compression(CompressionMode.STORAGE, CompressionFormat.ZSTD)  # before open()
+        writer.set_compression(compression_mode, CompressionFormat.ZSTD)  # before open()
     with writer:
         connections = {topic: writer.add_connection(topic, TOPICS[topic], typestore=ts) for topic in TOPICS}
         for topic, time, message in messages:
@@ -116,6 +116,9 @@ write_rosbag2('sqlite_v9', StoragePlugin.SQLITE3, version=9)
 write_rosbag2('sqlite_v8', StoragePlugin.SQLITE3, version=8)
 write_rosbag2('mcap_plain', StoragePlugin.MCAP)
 write_rosbag2('mcap_zstd', StoragePlugin.MCAP, zstd=True)
+# rosbag2's per-message compression: each message a zstd frame (refused, named).
+write_rosbag2('sqlite_message_zstd', StoragePlugin.SQLITE3, zstd=True, compression_mode=CompressionMode.MESSAGE)
+write_rosbag2('mcap_message_zstd', StoragePlugin.MCAP, zstd=True, compression_mode=CompressionMode.MESSAGE)
 write_mcap('lz4.mcap', CompressionType.LZ4)
 write_mcap('zstd_crc.mcap', CompressionType.ZSTD)
 write_mcap('plain_crc.mcap', CompressionType.NONE)

@@ -27,6 +27,7 @@
 
 #include "inertialnet/runtime/error.hpp"
 #include "io/bag/containers.hpp"
+#include "io/bag/rosbag2_message_compression.hpp"
 #include "io/crc32.hpp"
 #include "io/input_file.hpp"
 
@@ -364,7 +365,7 @@ MessageFields parse_message(const Record& record, const RecordScanner& scanner) 
 class McapCursor : public BagCursor {
  public:
   McapCursor(const fs::path& file, std::map<std::uint16_t, const BagConnection*> wanted)
-      : scanner_(file), wanted_(std::move(wanted)) {}
+      : scanner_(file), wanted_(std::move(wanted)), description_("MCAP file " + quoted(file)) {}
 
   bool next(BagMessage& message) override {
     Record record;
@@ -376,6 +377,7 @@ class McapCursor : public BagCursor {
       message.connection = found->second;
       message.log_time_ns = static_cast<std::int64_t>(fields.log_time);
       message.data.assign(fields.data, fields.data + fields.size);
+      refuse_compressed_message(message, description_);
       return true;
     }
     return false;
@@ -384,6 +386,7 @@ class McapCursor : public BagCursor {
  private:
   RecordScanner scanner_;
   std::map<std::uint16_t, const BagConnection*> wanted_;
+  std::string description_;
 };
 
 class McapReader : public BagReader {

@@ -19,6 +19,7 @@
 
 #include "inertialnet/runtime/error.hpp"
 #include "io/bag/containers.hpp"
+#include "io/bag/rosbag2_message_compression.hpp"
 #include "io/input_file.hpp"
 #include "io/yaml_util.hpp"
 
@@ -100,10 +101,17 @@ class SqliteCursor : public BagCursor {
  public:
   SqliteCursor(Database db, const fs::path& file, const std::string& sql,
                std::vector<std::pair<std::int64_t, const BagConnection*>> wanted)
-      : statement_(std::move(db), file, sql, "reading its messages"), wanted_(std::move(wanted)) {}
+      : statement_(std::move(db), file, sql, "reading its messages"),
+        wanted_(std::move(wanted)),
+        description_("ROS 2 bag " + io_detail::quoted(file)) {}
 
   bool next(BagMessage& message) override {
-    if (!statement_.step()) return false;
+    // Stepping a statement past its end would run the query again from the start (SQLite resets
+    // it automatically), so the end is remembered.
+    if (done_ || !statement_.step()) {
+      done_ = true;
+      return false;
+    }
     const std::int64_t topic_id = sqlite3_column_int64(statement_.get(), 0);
     message.connection = nullptr;
     for (const auto& entry : wanted_) {
@@ -112,16 +120,20 @@ class SqliteCursor : public BagCursor {
     message.log_time_ns = sqlite3_column_int64(statement_.get(), 1);
     const auto* data = static_cast<const std::uint8_t*>(sqlite3_column_blob(statement_.get(), 2));
     const int size = sqlite3_column_bytes(statement_.get(), 2);
-    // Fetching a blob may fail on a damaged page (a null pointer with a non-zero size, or an error
-    // code on the connection); an empty message is a null pointer with size 0.
+    // step() has read the row (a damaged page fails there); the blob can still fail to be handed
+    // over for want of memory (a null pointer with a non-zero size). An empty message is a null
+    // pointer with size 0.
     if (data == nullptr && size > 0) statement_.fail();
     message.data.assign(data, data + size);
+    refuse_compressed_message(message, description_);
     return true;
   }
 
  private:
   Statement statement_;
   std::vector<std::pair<std::int64_t, const BagConnection*>> wanted_;
+  std::string description_;
+  bool done_ = false;
 };
 
 class SqliteReader : public BagReader {
@@ -177,7 +189,10 @@ class SqliteReader : public BagReader {
       ids += (ids.empty() ? "" : ", ") + std::to_string(ids_[i]);
     }
     // Ordered as rosbag2's own reader orders them (by timestamp); equal timestamps keep the order
-    // they were written in (id). The ids are integers from the table, not user text.
+    // they were written in (id). rosbag2's timestamp_idx serves this order as it stands (an index
+    // entry is its timestamp, then the rowid, which id is), so SQLite sorts nothing, blobs least
+    // (EXPLAIN QUERY PLAN: "SCAN messages USING INDEX timestamp_idx"). The ids are integers from
+    // the topics table, not user text.
     const std::string sql = "SELECT topic_id, timestamp, data FROM messages WHERE topic_id IN (" + ids +
                             ") ORDER BY timestamp, id";
     return std::make_unique<SqliteCursor>(db_, file_, sql, std::move(wanted));
