@@ -76,6 +76,7 @@ class _Sequence:
     camera_to_body: Optional[npt.NDArray[np.float64]]
     description: str
     path: str
+    image_topic: str
     rate_hz: float
     sequential: bool
 

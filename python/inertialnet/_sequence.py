@@ -28,6 +28,9 @@ class Sequence(collections.abc.Sequence):
 
     A Sequence is path-like: ``predict(seq)`` and ``evaluate(rates, seq)`` take it (with its
     ``rate_hz``). Missing paths raise ``FileNotFoundError``.
+
+    A ROS bag reads the frames of ``image_topic`` (``""``: the bag's only image topic) at their
+    header stamps; ``camera`` comes from its CameraInfo, ``camera_to_body`` is None.
     """
 
     def __init__(self, path: PathLike, rate_hz: float = 0.0, image_topic: str = ""):

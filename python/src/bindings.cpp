@@ -696,8 +696,10 @@ class PyInertialNetHead {
 class PySequence {
  public:
   PySequence(const std::filesystem::path& path, double rate_hz, const std::string& image_topic)
-      : path_(existing_sequence(path)), rate_(rate_of(rate_hz)), image_topic_(image_topic),
-        source_(open_frame_source(path_, rate_, "cam0", BagTopics{image_topic, "", ""})) {}
+      : path_(existing_sequence(path)),
+        rate_(rate_of(rate_hz)),
+        topics_{image_topic, "", ""},
+        source_(open_frame_source(path_, rate_, "cam0", topics_)) {}
   std::size_t size() const { return source_->size(); }
   py::array_t<std::int64_t> timestamps() const {
     py::array_t<std::int64_t> out(static_cast<py::ssize_t>(source_->size()));
@@ -737,6 +739,7 @@ class PySequence {
   }
   std::string description() const { return source_->description(); }
   std::string path() const { return path_.string(); }
+  std::string image_topic() const { return topics_.image; }
   double rate_hz() const { return rate_.value_or(0.0); }
   bool sequential() const { return source_->sequential(); }
 
@@ -749,7 +752,7 @@ class PySequence {
     if (!source_->sequential()) return source_->decode(index);
     if (last_ && index == *last_) return source_->decode(index);  // the frame decoded last, again
     if (last_ && index < *last_) {
-      source_ = open_frame_source(path_, rate_, "cam0", BagTopics{image_topic_, "", ""});
+      source_ = open_frame_source(path_, rate_, "cam0", topics_);
       last_.reset();
     }
     for (std::size_t k = last_ ? *last_ + 1 : 0; k < index; ++k) source_->decode(k);
@@ -759,7 +762,7 @@ class PySequence {
 
   std::filesystem::path path_;
   std::optional<double> rate_;
-  std::string image_topic_;  // a ROS bag's image topic ("": its only one)
+  BagTopics topics_;  // a ROS bag's image topic ("": its only one)
   std::unique_ptr<FrameSource> source_;
   std::optional<std::size_t> last_;  // a sequential source's frame decoded last
 };
@@ -1105,6 +1108,7 @@ PYBIND11_MODULE(_inertialnet, m) {
       .def(py::init<const std::filesystem::path&, double, const std::string&>(), py::arg("path"), py::arg("rate_hz") = 0.0,
            py::arg("image_topic") = "")
       .def_property_readonly("path", &PySequence::path)
+      .def_property_readonly("image_topic", &PySequence::image_topic)
       .def_property_readonly("rate_hz", &PySequence::rate_hz)
       .def_property_readonly("sequential", &PySequence::sequential)
       .def("__len__", &PySequence::size)

@@ -83,11 +83,10 @@ CameraChoice choose_camera(const PredictSettings& s, FrameSource& source, std::v
   const std::optional<double> fx = s.fx && *s.fx != 0 ? s.fx : std::nullopt;
   const std::optional<double> fy = s.fy && *s.fy != 0 ? s.fy : std::nullopt;
   const std::optional<CameraCalibration> own = source.calibration();
-  const bool bag = is_bag(s.sequence);
-  const std::string own_name = bag ? "CameraInfo" : s.camera + "/sensor.yaml";
+  const std::string own_name = is_bag(s.sequence) ? std::string("CameraInfo") : s.camera + "/sensor.yaml";
   // A calibration without extrinsics (a bag's CameraInfo: T_BS all zero) leaves the rates in the
-  // camera frame, as for an image folder with --fx.
-  const bool own_extrinsic = own && own->T_BS != std::array<double, 16>{};
+  // camera frame, as for an image folder.
+  const bool own_extrinsics = own && own->T_BS != std::array<double, 16>{};
   CameraChoice choice;
   if (!s.calibration.empty()) {
     CalibrationFile file = read_calibration_file(s.calibration, s.calibration_camera);
@@ -110,7 +109,7 @@ CameraChoice choose_camera(const PredictSettings& s, FrameSource& source, std::v
     choice.camera.validate();
     // A EuRoC sequence's body frame is its sensor.yaml's T_BS, for eval as for predict (eval refuses
     // another extrinsic for it); an image folder or a video takes the file's.
-    if (own_extrinsic) {
+    if (own_extrinsics) {
       choice.camera_to_body = own->rotation_BS();
       if (file.camera_imu) {
         notes.push_back("the rates are turned into the body frame with " + source.description() + "'s " + own_name +
@@ -170,7 +169,7 @@ CameraChoice choose_camera(const PredictSettings& s, FrameSource& source, std::v
                         ", which does not match the images (" + std::to_string(first.width) + "x" +
                         std::to_string(first.height) + ").");
   }
-  if (own_extrinsic) choice.camera_to_body = own->rotation_BS();
+  if (own_extrinsics) choice.camera_to_body = own->rotation_BS();
   return choice;
 }
 
@@ -207,8 +206,6 @@ Prediction::Prediction(const PredictSettings& s) : settings_(s) {
   processor_.flow_check_px = s.flow_check_px;
   source_ = open_frame_source(s.sequence, s.rate_hz > 0 ? std::optional<double>(s.rate_hz) : std::nullopt, s.camera, s.bag);
   notes_ = source_->notes();
-  // Where the source's calibration comes from, for the messages below.
-  const std::string calibration_file = is_bag(s.sequence) ? "its CameraInfo" : s.camera + "/sensor.yaml";
   if (processor_.geometric_head) {
     const CameraChoice choice = choose_camera(s, *source_, notes_);
     processor_.camera = choice.camera;

@@ -112,11 +112,11 @@ Command register_calibrate_time(CLI::App& app, const GlobalOptions& global) {
     if (!o->input.imu_time_unit.empty()) input += " --imu-time-unit " + o->input.imu_time_unit;
     if (!o->input.T_cam_imu.empty()) input += " --T-cam-imu '" + o->input.T_cam_imu + "'";
     if (!o->input.camchain.empty()) input += " --camchain " + o->input.camchain;
-    if (!o->input.calibration.file.empty()) input += " --calibration " + o->input.calibration.file;
-    if (!o->input.calibration.camera.empty()) input += " --calibration-camera " + o->input.calibration.camera;
     if (!o->input.bag.image.empty()) input += " --image-topic " + o->input.bag.image;
     if (!o->input.bag.imu.empty()) input += " --imu-topic " + o->input.bag.imu;
     if (!o->input.bag.camera_info.empty()) input += " --camera-info-topic " + o->input.bag.camera_info;
+    if (!o->input.calibration.file.empty()) input += " --calibration " + o->input.calibration.file;
+    if (!o->input.calibration.camera.empty()) input += " --calibration-camera " + o->input.calibration.camera;
     std::cout << "apply it with: inertialnet eval RATES.csv " << o->sequence << input << " --time-offset " << e.offset_s
               << "\n";
     for (const auto& w : report.warnings) warning(w);

@@ -50,10 +50,10 @@ struct ImuCliOptions {
   std::string imu, imu_time_unit, T_cam_imu, camchain;
   std::string camera = "cam0";  // --camera, added with the IMU options
   double rate_hz = 0;
+  BagTopics bag;                // --image-topic, --imu-topic, --camera-info-topic
   // --calibration, added by add_calibration_options (or add_intrinsics_options): its camera-IMU
   // extrinsic, when the file has one, stands for --camchain.
   CalibrationCliOptions calibration;
-  BagTopics bag;                // --image-topic, --imu-topic, --camera-info-topic
 };
 void add_imu_options(CLI::App& app, ImuCliOptions& o);
 // Reads the calibration given (invalid_input naming the option or file when it is bad).

@@ -216,14 +216,35 @@ class Ros1Bag : public BagReader {
       return packed;
     }
     if (chunk.compression == "bz2") {
-      std::vector<std::uint8_t> out(chunk.size);
-      unsigned int produced = chunk.size;
-      const int status = BZ2_bzBuffToBuffDecompress(reinterpret_cast<char*>(out.data()), &produced,
-                                                    reinterpret_cast<char*>(packed.data()), static_cast<unsigned int>(packed.size()), 0, 0);
-      if (status != BZ_OK || produced != chunk.size) {
-        throw invalid_input(at + ": its bz2 chunk does not decompress to the " + std::to_string(chunk.size) +
-                            " bytes it declares (bzip2 status " + std::to_string(status) + ")");
+      // bzip2 can expand far more than any bound worth allocating up front: the output grows with
+      // what the stream makes (doubling), so a damaged size field allocates nothing by itself. One
+      // byte beyond the declared size is room enough to tell a stream that makes more.
+      std::vector<std::uint8_t> out;
+      bz_stream stream{};
+      if (BZ2_bzDecompressInit(&stream, 0, 0) != BZ_OK) throw runtime_error("cannot start a bzip2 decompression");
+      stream.next_in = reinterpret_cast<char*>(packed.data());
+      stream.avail_in = static_cast<unsigned int>(packed.size());
+      std::size_t produced = 0;
+      int status = BZ_OK;
+      while (status == BZ_OK) {
+        if (produced == out.size()) {
+          const std::size_t limit = static_cast<std::size_t>(chunk.size) + 1;
+          if (out.size() == limit) break;
+          out.resize(std::min(limit, std::max<std::size_t>(65536, 2 * out.size())));
+        }
+        stream.next_out = reinterpret_cast<char*>(out.data() + produced);
+        stream.avail_out = static_cast<unsigned int>(out.size() - produced);
+        status = BZ2_bzDecompress(&stream);
+        const bool stalled = stream.avail_out > 0 && stream.avail_in == 0;  // the input ended first
+        produced = out.size() - stream.avail_out;
+        if (status == BZ_OK && stalled) break;
       }
+      BZ2_bzDecompressEnd(&stream);
+      if (status != BZ_STREAM_END || produced != chunk.size) {
+        throw invalid_input(at + ": its bz2 chunk does not decompress to the " + std::to_string(chunk.size) +
+                            " bytes it declares" + (status < 0 ? " (bzip2 error " + std::to_string(status) + ")" : std::string()));
+      }
+      out.resize(produced);
       return out;
     }
     if (chunk.compression == "lz4") {
