@@ -132,8 +132,14 @@ CameraChoice choose_camera(const PredictSettings& s, const FrameSource& source, 
     camera.validate();
     return choice;
   }
-  if (s.cx || s.cy) {
+  if ((s.cx || s.cy) && !own) {
     throw invalid_input("--cx and --cy need a focal length: give --fx (and --fy), or --calibration FILE.");
+  }
+  if (s.cx || s.cy) {
+    // Not refused: the Python binding still passes cx = cy = 0 for "not given" (it would refuse
+    // every EuRoC sequence); said, so that a principal point given alone is not lost unseen.
+    notes.push_back("--cx/--cy without --fx or --calibration are not used: " + source.description() + "'s " +
+                    own_name + " gives the camera (--calibration " + own_name + " --cx … replaces one value).");
   }
   if (!own) {
     throw invalid_input("the geometric head needs the camera: " + source.description() + " has no " + own_name +

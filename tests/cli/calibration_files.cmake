@@ -188,6 +188,10 @@ expect_no_match("--cx not given")
 expect_other_rows(fx_alone.csv cx0_alone.csv "--fx --cx 0")
 run(2 ${CLI} predict plain/mav0/cam0/data --cx 0)
 expect_match("--cx and --cy need a focal length: give --fx \\(and --fy\\), or --calibration FILE")
+# On a EuRoC sequence the principal point alone is not used, and says so.
+run(0 ${CLI} predict plain --cx 0 -o plain_cx0.csv)
+expect_match("note: --cx/--cy without --fx or --calibration are not used: EuRoC sequence plain[^\n]*'s cam0/sensor.yaml gives the camera")
+expect_same_rows(plain.csv plain_cx0.csv "--cx alone on a EuRoC sequence")
 run(2 ${CLI} predict plain/mav0/cam0/data)
 expect_match("give --calibration FILE \\(EuRoC sensor.yaml, Kalibr camchain, OpenCV YAML/XML\\) or --fx")
 
