@@ -231,6 +231,10 @@ run(2 ${CLI} eval from_kalibr.csv radtan/mav0/cam0/data ${imu} --calibration cam
     --camchain camchain-imucam.yaml)
 expect_match("--calibration camchain-imucam.yaml holds a camera-IMU extrinsic, and --camchain gives one too")
 
+# A EuRoC sequence's rotation is its T_BS, in eval as in predict.
+run(2 ${CLI} eval radtan.csv radtan --calibration camchain-imucam.yaml)
+expect_match("camchain-imucam.yaml \\(cam0\\): radtan is a EuRoC sequence, whose camera rotation comes from mav0/cam0/sensor.yaml's T_BS")
+
 # --- calibrate-time predicts with the file --------------------------------------------------
 run(0 ${CLI} calibrate-time radtan/mav0/cam0/data ${imu} --calibration camchain-imucam.yaml --range 0.02)
 expect_match("no rates file given: predicting 7 pairs")
