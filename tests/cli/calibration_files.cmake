@@ -7,7 +7,7 @@
 # the sequence's sensor.yaml: the images stay the same, the rates change (checked), and they must
 # change the same way through every file. Also: the notes of --fx alone, --cx 0 used, files that
 # are refused naming file and key.
-#   cmake -DCLI=<inertialnet> -DWORK=<scratch dir> -P calibration_files.cmake
+#   cmake -DCLI=<inertialnet> -DWORK=<scratch dir> [-DMAKE_VIDEO=<make_test_video>] -P calibration_files.cmake
 include(${CMAKE_CURRENT_LIST_DIR}/run_helpers.cmake)
 file(REMOVE_RECURSE "${WORK}")
 file(MAKE_DIRECTORY "${WORK}")
@@ -240,6 +240,20 @@ run(0 ${CLI} calibrate-time radtan/mav0/cam0/data ${imu} --calibration camchain-
 expect_match("no rates file given: predicting 7 pairs")
 expect_match("time_offset_s")
 expect_match("apply it with: inertialnet eval RATES.csv radtan/mav0/cam0/data --imu radtan/mav0/imu0/data.csv --calibration camchain-imucam.yaml --time-offset")
+
+# --- A video: the same file reads the same way (make_test_video: 188x120 frames at 20 Hz) ----------
+if(MAKE_VIDEO)
+  run(0 ${MAKE_VIDEO} .)
+  file(WRITE "${WORK}/video.xml"
+       "<?xml version=\"1.0\"?>\n<opencv_storage>\n<image_width>188</image_width>\n<image_height>120</image_height>\n"
+       "<camera_matrix type_id=\"opencv-matrix\">\n  <rows>3</rows>\n  <cols>3</cols>\n  <dt>d</dt>\n"
+       "  <data>150. 0. 0. 0. 150. 60. 0. 0. 1.</data></camera_matrix>\n"
+       "<distortion_coefficients type_id=\"opencv-matrix\">\n  <rows>5</rows>\n  <cols>1</cols>\n  <dt>d</dt>\n"
+       "  <data>0. 0. 0. 0. 0.</data></distortion_coefficients>\n</opencv_storage>\n")
+  run(0 ${CLI} predict clip.avi --calibration video.xml --max-pairs 8 -o video_file.csv)
+  run(0 ${CLI} predict clip.avi --fx 150 --fy 150 --cx 0 --cy 60 --max-pairs 8 -o video_flags.csv)
+  expect_same_rows(video_file.csv video_flags.csv "a video with --calibration")
+endif()
 
 # --- Refused, naming file and key -----------------------------------------------------------
 file(WRITE "${WORK}/bad_kalibr.yaml"
