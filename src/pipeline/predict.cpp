@@ -1,12 +1,14 @@
 #include "inertialnet/pipeline/predict.hpp"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cmath>
 #include <optional>
 
+#include "inertialnet/io/bag.hpp"
 #include "inertialnet/io/calibration_file.hpp"
 #include "inertialnet/io/camera.hpp"
 #include "inertialnet/models/flow_consistency.hpp"
@@ -36,7 +38,7 @@ const char* kNoWeightsHelp =
 // because a video decodes in order from its start and the pipeline starts at frame 0 again.
 std::pair<Frame, Frame> first_decodable_pair(const PredictSettings& s) {
   auto source =
-      open_frame_source(s.sequence, s.rate_hz > 0 ? std::optional<double>(s.rate_hz) : std::nullopt, s.camera);
+      open_frame_source(s.sequence, s.rate_hz > 0 ? std::optional<double>(s.rate_hz) : std::nullopt, s.camera, s.bag);
   std::optional<Frame> previous;
   std::optional<Error> first_error;
   for (std::size_t i = 0; i < source->size(); ++i) {
@@ -70,11 +72,15 @@ std::string pixels_text(double v) {
 }
 
 CameraChoice choose_camera(const PredictSettings& s, const FrameSource& source, std::vector<std::string>& notes) {
-  // An fx or fy of 0 is never a focal length: "not given" (the Python binding's default).
+  // An fx or fy of 0 is never a focal length: "not given", what 0 meant before these were optional.
   const std::optional<double> fx = s.fx && *s.fx != 0 ? s.fx : std::nullopt;
   const std::optional<double> fy = s.fy && *s.fy != 0 ? s.fy : std::nullopt;
   const std::optional<CameraCalibration> own = source.calibration();
-  const std::string own_name = s.camera + "/sensor.yaml";
+  const bool bag = is_bag(s.sequence);
+  const std::string own_name = bag ? "CameraInfo" : s.camera + "/sensor.yaml";
+  // A calibration without extrinsics (a bag's CameraInfo: T_BS all zero) leaves the rates in the
+  // camera frame, as for an image folder with --fx.
+  const bool own_extrinsic = own && own->T_BS != std::array<double, 16>{};
   CameraChoice choice;
   if (!s.calibration.empty()) {
     CalibrationFile file = read_calibration_file(s.calibration, s.calibration_camera);
@@ -97,7 +103,7 @@ CameraChoice choose_camera(const PredictSettings& s, const FrameSource& source, 
     choice.camera.validate();
     // A EuRoC sequence's body frame is its sensor.yaml's T_BS, for eval as for predict (eval refuses
     // another extrinsic for it); an image folder or a video takes the file's.
-    if (own) {
+    if (own_extrinsic) {
       choice.camera_to_body = own->rotation_BS();
       if (file.camera_imu) {
         notes.push_back("the rates are turned into the body frame with " + source.description() + "'s " + own_name +
@@ -136,13 +142,14 @@ CameraChoice choose_camera(const PredictSettings& s, const FrameSource& source, 
     throw invalid_input("--cx and --cy need a focal length: give --fx (and --fy), or --calibration FILE.");
   }
   if (s.cx || s.cy) {
-    // Not refused: the Python binding still passes cx = cy = 0 for "not given" (it would refuse
-    // every EuRoC sequence); said, so that a principal point given alone is not lost unseen.
+    // The sequence's calibration is whole (its distortion belongs to its principal point), so a
+    // principal point alone does not patch it; said, so that it is not lost unseen.
     notes.push_back("--cx/--cy without --fx or --calibration are not used: " + source.description() + "'s " +
                     own_name + " gives the camera (--calibration " + own_name + " --cx … replaces one value).");
   }
   if (!own) {
-    throw invalid_input("the geometric head needs the camera: " + source.description() + " has no " + own_name +
+    throw invalid_input("the geometric head needs the camera: " + source.description() + " has no " +
+                        (bag ? "CameraInfo topic beside its images (--camera-info-topic)" : own_name) +
                         "; give --calibration FILE (EuRoC sensor.yaml, Kalibr camchain, OpenCV YAML/XML) or --fx "
                         "(and --fy --cx --cy)");
   }
@@ -162,7 +169,7 @@ CameraChoice choose_camera(const PredictSettings& s, const FrameSource& source, 
                         ", which does not match the images (" + std::to_string(first.width) + "x" +
                         std::to_string(first.height) + ").");
   }
-  choice.camera_to_body = own->rotation_BS();
+  if (own_extrinsic) choice.camera_to_body = own->rotation_BS();
   return choice;
 }
 
@@ -197,8 +204,10 @@ Prediction::Prediction(const PredictSettings& s) : settings_(s) {
   processor_.geometric.readout_time_s = s.readout_time_s;
   require_flow_check_setting(s.flow_check_px);
   processor_.flow_check_px = s.flow_check_px;
-  source_ = open_frame_source(s.sequence, s.rate_hz > 0 ? std::optional<double>(s.rate_hz) : std::nullopt, s.camera);
+  source_ = open_frame_source(s.sequence, s.rate_hz > 0 ? std::optional<double>(s.rate_hz) : std::nullopt, s.camera, s.bag);
   notes_ = source_->notes();
+  // Where the source's calibration comes from, for the messages below.
+  const std::string calibration_file = is_bag(s.sequence) ? "its CameraInfo" : s.camera + "/sensor.yaml";
   if (processor_.geometric_head) {
     const CameraChoice choice = choose_camera(s, *source_, notes_);
     processor_.camera = choice.camera;

@@ -43,6 +43,7 @@ RatesTable predict_weight_free(const CalibrateTimeOptions& o, const EurocSequenc
   settings.calibration_camera = o.camera.calibration.camera;
   settings.rate_hz = o.input.rate_hz;
   settings.camera = o.input.camera;
+  settings.bag = o.input.bag;
   settings.device = global.device;
   settings.no_cache = global.no_cache;
   Prediction prediction(settings);
@@ -69,7 +70,7 @@ RatesTable predict_weight_free(const CalibrateTimeOptions& o, const EurocSequenc
 
 Command register_calibrate_time(CLI::App& app, const GlobalOptions& global) {
   auto o = std::make_shared<CalibrateTimeOptions>();
-  app.add_option("sequence", o->sequence, "EuRoC-layout sequence with mav0/imu0, or an image folder or video with --imu")
+  app.add_option("sequence", o->sequence, "EuRoC-layout sequence with mav0/imu0, an image folder or video with --imu, or a ROS bag")
       ->required()
       ->check(CLI::ExistingPath);
   app.add_option("rates", o->rates, "rates CSV written by predict (default: predict weight-free now)")
@@ -113,6 +114,9 @@ Command register_calibrate_time(CLI::App& app, const GlobalOptions& global) {
     if (!o->input.camchain.empty()) input += " --camchain " + o->input.camchain;
     if (!o->input.calibration.file.empty()) input += " --calibration " + o->input.calibration.file;
     if (!o->input.calibration.camera.empty()) input += " --calibration-camera " + o->input.calibration.camera;
+    if (!o->input.bag.image.empty()) input += " --image-topic " + o->input.bag.image;
+    if (!o->input.bag.imu.empty()) input += " --imu-topic " + o->input.bag.imu;
+    if (!o->input.bag.camera_info.empty()) input += " --camera-info-topic " + o->input.bag.camera_info;
     std::cout << "apply it with: inertialnet eval RATES.csv " << o->sequence << input << " --time-offset " << e.offset_s
               << "\n";
     for (const auto& w : report.warnings) warning(w);

@@ -25,7 +25,7 @@ struct EvalCliOptions {
 Command register_eval(CLI::App& app, const GlobalOptions&) {
   auto o = std::make_shared<EvalCliOptions>();
   app.add_option("rates", o->rates, "rates CSV written by predict")->required()->check(CLI::ExistingFile);
-  app.add_option("sequence", o->sequence, "EuRoC sequence with mav0/imu0, or an image folder or video with --imu")
+  app.add_option("sequence", o->sequence, "EuRoC sequence with mav0/imu0, an image folder or video with --imu, or a ROS bag")
       ->required()
       ->check(CLI::ExistingPath);
   app.add_option("--plot", o->plot,

@@ -89,8 +89,17 @@ void add_camera_option(CLI::App& app, std::string& camera) {
       ->transform(choice("camera", {"cam0", "cam1"}));
 }
 
+void add_bag_topic_options(CLI::App& app, BagTopics& topics, bool imu) {
+  app.add_option("--image-topic", topics.image,
+                 "a ROS bag's sensor_msgs/Image or CompressedImage topic (default: its only one)");
+  if (imu) app.add_option("--imu-topic", topics.imu, "a ROS bag's sensor_msgs/Imu topic (default: its only one)");
+  app.add_option("--camera-info-topic", topics.camera_info,
+                 "a ROS bag's sensor_msgs/CameraInfo topic (default: the one beside the image topic)");
+}
+
 void add_imu_options(CLI::App& app, ImuCliOptions& o) {
   add_camera_option(app, o.camera);
+  add_bag_topic_options(app, o.bag, true);
   app.add_option("--imu", o.imu,
                  "gyro log on the frames' clock, for an image folder or a video (for a EuRoC folder it replaces "
                  "mav0/imu0/data.csv): a CSV of time, gx, gy, gz [rad/s] with or without accel x y z after them "
@@ -118,6 +127,7 @@ ImuSequenceOptions imu_sequence_options(const ImuCliOptions& o) {
   options.imu_csv = o.imu;
   if (o.rate_hz > 0) options.rate_hz = o.rate_hz;
   options.camera = o.camera;
+  options.bag = o.bag;
   if (!o.imu_time_unit.empty()) options.imu_time_unit = parse_time_unit(o.imu_time_unit);
   if (!o.T_cam_imu.empty()) options.camera_imu = parse_camera_imu(o.T_cam_imu, "--T-cam-imu");
   if (!o.camchain.empty()) options.camera_imu = read_kalibr_camchain(o.camchain);

@@ -40,7 +40,12 @@ void add_intrinsics_options(CLI::App& app, IntrinsicsCliOptions& o);
 // --camera cam0|cam1: which camera of a EuRoC sequence (predict, eval, calibrate-time).
 void add_camera_option(CLI::App& app, std::string& camera);
 
-// --imu FILE, --imu-time-unit s|ms|us|ns, --T-cam-imu M|FILE, --camchain FILE, --rate HZ.
+// --image-topic, --camera-info-topic and (with `imu`) --imu-topic: a ROS bag's topics
+// (bag_topics.hpp); predict has no IMU to read.
+void add_bag_topic_options(CLI::App& app, BagTopics& topics, bool imu);
+
+// --imu FILE, --imu-time-unit s|ms|us|ns, --T-cam-imu M|FILE, --camchain FILE, --rate HZ, and a
+// bag's topics.
 struct ImuCliOptions {
   std::string imu, imu_time_unit, T_cam_imu, camchain;
   std::string camera = "cam0";  // --camera, added with the IMU options
@@ -48,6 +53,7 @@ struct ImuCliOptions {
   // --calibration, added by add_calibration_options (or add_intrinsics_options): its camera-IMU
   // extrinsic, when the file has one, stands for --camchain.
   CalibrationCliOptions calibration;
+  BagTopics bag;                // --image-topic, --imu-topic, --camera-info-topic
 };
 void add_imu_options(CLI::App& app, ImuCliOptions& o);
 // Reads the calibration given (invalid_input naming the option or file when it is bad).

@@ -43,6 +43,7 @@ struct PredictSettings {
   std::optional<double> fx, fy, cx, cy;
   double rate_hz = 0;                // frame rate of image folders and videos; 0: from the source
   std::string camera = "cam0";       // a EuRoC sequence's camera: "cam0" or "cam1" (mav0/<camera>)
+  BagTopics bag;                     // a ROS bag's topics (bag_topics.hpp); empty: the bag's only ones
   // Rolling shutter: seconds from the first row's exposure to the last's (0: global shutter). The
   // geometric head corrects each flow vector's interval; the CSV states it for eval.
   double readout_time_s = 0;
