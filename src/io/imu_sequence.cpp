@@ -31,7 +31,8 @@ EurocSequence read_euroc_with_imu(const fs::path& path, const ImuSequenceOptions
   if (options.camera_imu) {
     throw invalid_input(options.camera_imu->source + ": " + path.string() + " is a EuRoC sequence, whose camera "
                         "rotation comes from mav0/" + options.camera + "/sensor.yaml's T_BS (predict's body-frame rates use it too); "
-                        "--T-cam-imu and --camchain are for image folders and videos. Edit T_BS to change it.");
+                        "--T-cam-imu, --camchain and a --calibration file's extrinsic are for image folders and videos. Edit "
+                        "T_BS to change it.");
   }
   EurocReadOptions read;
   read.check_images = false;

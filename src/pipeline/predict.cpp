@@ -79,7 +79,7 @@ std::string pixels_text(double v) {
 }
 
 CameraChoice choose_camera(const PredictSettings& s, FrameSource& source, std::vector<std::string>& notes) {
-  // An fx or fy of 0 is never a focal length: "not given" (the Python binding's default).
+  // An fx or fy of 0 is never a focal length: "not given", what 0 meant before these were optional.
   const std::optional<double> fx = s.fx && *s.fx != 0 ? s.fx : std::nullopt;
   const std::optional<double> fy = s.fy && *s.fy != 0 ? s.fy : std::nullopt;
   const std::optional<CameraCalibration> own = source.calibration();
@@ -144,8 +144,14 @@ CameraChoice choose_camera(const PredictSettings& s, FrameSource& source, std::v
     camera.validate();
     return choice;
   }
-  if (s.cx || s.cy) {
+  if ((s.cx || s.cy) && !own) {
     throw invalid_input("--cx and --cy need a focal length: give --fx (and --fy), or --calibration FILE.");
+  }
+  if (s.cx || s.cy) {
+    // The sequence's calibration is whole (its distortion belongs to its principal point), so a
+    // principal point alone does not patch it; said, so that it is not lost unseen.
+    notes.push_back("--cx/--cy without --fx or --calibration are not used: " + source.description() + "'s " +
+                    own_name + " gives the camera (--calibration " + own_name + " --cx … replaces one value).");
   }
   if (!own) {
     throw invalid_input("the geometric head needs the camera: " + source.description() + " has no " +

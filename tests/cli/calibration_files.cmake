@@ -7,7 +7,7 @@
 # the sequence's sensor.yaml: the images stay the same, the rates change (checked), and they must
 # change the same way through every file. Also: the notes of --fx alone, --cx 0 used, files that
 # are refused naming file and key.
-#   cmake -DCLI=<inertialnet> -DWORK=<scratch dir> -P calibration_files.cmake
+#   cmake -DCLI=<inertialnet> -DWORK=<scratch dir> [-DMAKE_VIDEO=<make_test_video>] -P calibration_files.cmake
 include(${CMAKE_CURRENT_LIST_DIR}/run_helpers.cmake)
 file(REMOVE_RECURSE "${WORK}")
 file(MAKE_DIRECTORY "${WORK}")
@@ -188,6 +188,10 @@ expect_no_match("--cx not given")
 expect_other_rows(fx_alone.csv cx0_alone.csv "--fx --cx 0")
 run(2 ${CLI} predict plain/mav0/cam0/data --cx 0)
 expect_match("--cx and --cy need a focal length: give --fx \\(and --fy\\), or --calibration FILE")
+# On a EuRoC sequence the principal point alone is not used, and says so.
+run(0 ${CLI} predict plain --cx 0 -o plain_cx0.csv)
+expect_match("note: --cx/--cy without --fx or --calibration are not used: EuRoC sequence plain[^\n]*'s cam0/sensor.yaml gives the camera")
+expect_same_rows(plain.csv plain_cx0.csv "--cx alone on a EuRoC sequence")
 run(2 ${CLI} predict plain/mav0/cam0/data)
 expect_match("give --calibration FILE \\(EuRoC sensor.yaml, Kalibr camchain, OpenCV YAML/XML\\) or --fx")
 
@@ -227,11 +231,29 @@ run(2 ${CLI} eval from_kalibr.csv radtan/mav0/cam0/data ${imu} --calibration cam
     --camchain camchain-imucam.yaml)
 expect_match("--calibration camchain-imucam.yaml holds a camera-IMU extrinsic, and --camchain gives one too")
 
+# A EuRoC sequence's rotation is its T_BS, in eval as in predict.
+run(2 ${CLI} eval radtan.csv radtan --calibration camchain-imucam.yaml)
+expect_match("camchain-imucam.yaml \\(cam0\\): radtan is a EuRoC sequence, whose camera rotation comes from mav0/cam0/sensor.yaml's T_BS")
+
 # --- calibrate-time predicts with the file --------------------------------------------------
 run(0 ${CLI} calibrate-time radtan/mav0/cam0/data ${imu} --calibration camchain-imucam.yaml --range 0.02)
 expect_match("no rates file given: predicting 7 pairs")
 expect_match("time_offset_s")
 expect_match("apply it with: inertialnet eval RATES.csv radtan/mav0/cam0/data --imu radtan/mav0/imu0/data.csv --calibration camchain-imucam.yaml --time-offset")
+
+# --- A video: the same file reads the same way (make_test_video: 188x120 frames at 20 Hz) ----------
+if(MAKE_VIDEO)
+  run(0 ${MAKE_VIDEO} .)
+  file(WRITE "${WORK}/video.xml"
+       "<?xml version=\"1.0\"?>\n<opencv_storage>\n<image_width>188</image_width>\n<image_height>120</image_height>\n"
+       "<camera_matrix type_id=\"opencv-matrix\">\n  <rows>3</rows>\n  <cols>3</cols>\n  <dt>d</dt>\n"
+       "  <data>150. 0. 0. 0. 150. 60. 0. 0. 1.</data></camera_matrix>\n"
+       "<distortion_coefficients type_id=\"opencv-matrix\">\n  <rows>5</rows>\n  <cols>1</cols>\n  <dt>d</dt>\n"
+       "  <data>0. 0. 0. 0. 0.</data></distortion_coefficients>\n</opencv_storage>\n")
+  run(0 ${CLI} predict clip.avi --calibration video.xml --max-pairs 8 -o video_file.csv)
+  run(0 ${CLI} predict clip.avi --fx 150 --fy 150 --cx 0 --cy 60 --max-pairs 8 -o video_flags.csv)
+  expect_same_rows(video_file.csv video_flags.csv "a video with --calibration")
+endif()
 
 # --- Refused, naming file and key -----------------------------------------------------------
 file(WRITE "${WORK}/bad_kalibr.yaml"

@@ -6,11 +6,13 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <iterator>
 
 #include <opencv2/core.hpp>
 
 #include "eval/synthetic_euroc.hpp"
 #include "inertialnet/io/calibration_file.hpp"
+#include "inertialnet/runtime/error.hpp"
 #include "support/testing.hpp"
 
 namespace fs = std::filesystem;
@@ -280,4 +282,25 @@ TEST(CalibrationFile, FitToFramesScalesAProportionalResizeOnly) {
   EXPECT_TRUE(contains(message, "--calibration fit.yaml is calibrated for 752x480 images; the frames are 640x480, "
                                 "which is not a proportional resize"))
       << message;
+}
+
+TEST(CalibrationFile, EveryPrefixOfAFileIsReadOrRefusedNeverACrash) {
+  // A file cut short (a copy interrupted, an editor's autosave) goes through OpenCV's YAML and XML
+  // parsers at every length: each is read or refused with invalid_input, nothing else escapes.
+  for (const char* name : {"whole.yaml", "whole.xml"}) {
+    const fs::path whole = write_with_opencv(name, kEurocRadtan);
+    std::ifstream in(whole, std::ios::binary);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::size_t refused = 0;
+    for (std::size_t n = 0; n < text.size(); ++n) {
+      const fs::path cut = write(std::string("cut_") + name, text.substr(0, n));
+      try {
+        read_calibration_file(cut);
+      } catch (const Error& e) {
+        ASSERT_EQ(e.kind(), ErrorKind::InvalidInput) << name << " cut at " << n << ": " << e.what();
+        ++refused;
+      }
+    }
+    EXPECT_GT(refused, text.size() / 2) << name;
+  }
 }

@@ -252,5 +252,5 @@ TEST(ImuSequence, EurocInputTakesTheImuFileInImu0sFrame) {
 
   options.camera_imu = parse_camera_imu("1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1");
   EXPECT_TRUE(contains(invalid_input_message([&] { read_sequence_with_imu(dir.path() / "seq", options); }),
-                       "--T-cam-imu and --camchain are for image folders and videos"));
+                       "--T-cam-imu, --camchain and a --calibration file's extrinsic are for image folders and videos"));
 }

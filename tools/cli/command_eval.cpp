@@ -45,7 +45,7 @@ Command register_eval(CLI::App& app, const GlobalOptions&) {
   app.add_option("--gyro-bias", o->gyro_bias, "gyro bias x,y,z in rad/s (IMU frame), or auto: a constant fitted against the predictions by least squares; "
                  "default: ground truth, else a static start (vibration allowed when the images show no rotation)");
   app.add_flag("--camera-frame", o->camera_frame,
-               "rotate the gyro into the camera frame with cam0's T_BS (or --T-cam-imu / --camchain)");
+               "rotate the gyro into the camera frame with cam0's T_BS (or --T-cam-imu / --camchain / --calibration)");
   add_imu_options(app, o->input);
   add_calibration_options(app, o->input.calibration);
   app.add_option("--head", o->head, "compare columns wx<_HEAD>…, e.g. --head geometric");

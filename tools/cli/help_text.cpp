@@ -23,6 +23,7 @@ std::string help_examples(const std::string& subcommand) {
        "  inertialnet predict data/seq -o out/rates.csv                        # DIS + geometric head\n"
        "  inertialnet predict data/seq -w flownet2.safetensors -w head.safetensors --head both -o rates.csv\n"
        "  inertialnet predict video.mp4 --fx 458 --rate 20 --stats\n"
+       "  inertialnet predict video.mp4 --calibration camera.yaml   # Kalibr camchain, OpenCV YAML/XML, sensor.yaml\n"
        "  inertialnet predict data/seq --flow DIS --save-flow out/flows -q\n"
        "  inertialnet predict clip.mp4 --fx 900 --format gcsv -o clip.gcsv     # Gyroflow gyro log\n"
        "  inertialnet predict /dev/video0 --fx 600 | tail -f                  # live until Ctrl-C\n"},
@@ -40,7 +41,7 @@ std::string help_examples(const std::string& subcommand) {
       {"calibrate-time",
        "  inertialnet calibrate-time data/seq                  # predicts weight-free, then estimates\n"
        "  inertialnet calibrate-time data/seq rates.csv --range 0.3\n"
-       "  inertialnet calibrate-time clip.mp4 --imu imu.csv --camchain camchain-imucam.yaml --fx 458\n"},
+       "  inertialnet calibrate-time clip.mp4 --imu imu.csv --calibration camchain-imucam.yaml\n"},
       {"viz",
        "  inertialnet viz out/flows/*.flo -o out/pictures --shared-scale   # one scale for a sequence\n"
        "  inertialnet viz ab.flo --legend --max-magnitude 20\n"},
