@@ -155,7 +155,7 @@ CameraChoice choose_camera(const PredictSettings& s, FrameSource& source, std::v
   }
   if (!own) {
     throw invalid_input("the geometric head needs the camera: " + source.description() + " has no " +
-                        (bag ? "CameraInfo topic beside its images (--camera-info-topic)" : own_name) +
+                        (is_bag(s.sequence) ? "CameraInfo topic beside its images (--camera-info-topic)" : own_name) +
                         "; give --calibration FILE (EuRoC sensor.yaml, Kalibr camchain, OpenCV YAML/XML) or --fx "
                         "(and --fy --cx --cy)");
   }
