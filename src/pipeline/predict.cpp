@@ -154,8 +154,7 @@ CameraChoice choose_camera(const PredictSettings& s, FrameSource& source, std::v
                     own_name + " gives the camera (--calibration " + own_name + " --cx … replaces one value).");
   }
   if (!own) {
-    throw invalid_input("the geometric head needs the camera: " + source.description() + " has no " +
-                        (is_bag(s.sequence) ? "CameraInfo topic beside its images (--camera-info-topic)" : own_name) +
+    throw invalid_input("the geometric head needs the camera: " + source.description() + " has no " + own_name +
                         "; give --calibration FILE (EuRoC sensor.yaml, Kalibr camchain, OpenCV YAML/XML) or --fx "
                         "(and --fy --cx --cy)");
   }
