@@ -31,9 +31,11 @@ void add_intrinsics_options(CLI::App& app, IntrinsicsCliOptions& o);
 // --camera cam0|cam1: which camera of a EuRoC sequence (predict, eval, calibrate-time).
 void add_camera_option(CLI::App& app, std::string& camera);
 
-// --imu FILE, --imu-time-unit s|ms|us|ns, --T-cam-imu M|FILE, --camchain FILE, --rate HZ.
+// --imu FILE, --imu-time-unit s|ms|us|ns, --imu-columns T,GX,GY,GZ, --imu-units TIME,GYRO,
+// --T-cam-imu M|FILE, --camchain FILE, --rate HZ.
 struct ImuCliOptions {
   std::string imu, imu_time_unit, T_cam_imu, camchain;
+  std::string imu_columns, imu_units;  // as given; split in imu_sequence_options
   std::string camera = "cam0";  // --camera, added with the IMU options
   double rate_hz = 0;
 };
