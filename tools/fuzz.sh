@@ -14,7 +14,7 @@ cd "$(dirname "$0")/.."
 seconds="${1:-30}"
 shift || true
 build="${FUZZ_BUILD_DIR:-build-asan}"
-all_targets=(safetensors camera_csv imu_csv gyro_log sensor_yaml rates_csv image device_spec flo)
+all_targets=(safetensors camera_csv imu_csv gyro_log sensor_yaml rates_csv image device_spec flo gpmf)
 targets=("$@")
 [ ${#targets[@]} -eq 0 ] && targets=("${all_targets[@]}")
 
