@@ -13,7 +13,11 @@ of --payload samples start at their first sample's time, so the reader's fit rec
 --expected FILE writes what a correct reader returns, rotated back into the camera frame: a CSV
 `t_ns,gx,gy,gz` (times from the first frame, rad/s after quantization).
 
-Usage: write_gopro_mp4.py SEQ OUT.mp4 [--expected CSV] [--payload N] [--scal S]
+--orin ABC stores the triple in that order instead and says so in an ORIN item (gpmf-parser's
+GPMF_common.h: "input channel data orientation, lowercase is negative, e.g. Zxy"), as HERO8 and
+later do; the expected samples are the same.
+
+Usage: write_gopro_mp4.py SEQ OUT.mp4 [--expected CSV] [--payload N] [--scal S] [--orin ABC]
 Standard library only (struct, csv): nothing shared with the C++ reader but the published format.
 """
 import argparse
@@ -88,6 +92,7 @@ def main():
     ap.add_argument("--expected")
     ap.add_argument("--payload", type=int, default=20)
     ap.add_argument("--scal", type=int, default=10000)
+    ap.add_argument("--orin", default="")
     a = ap.parse_args()
     mav0 = os.path.join(a.sequence, "mav0")
     frames = read_rows(os.path.join(mav0, "cam0", "data.csv"))
@@ -111,11 +116,13 @@ def main():
         w = [float(v) for v in r[1:4]]
         cam = [sum(R_bc[j][i] * w[j] for j in range(3)) for i in range(3)]
         X, Y, Z = -cam[0], -cam[2], -cam[1]  # GoPro labels from camera x, y, z
-        q = [int(round(v * a.scal)) for v in (Z, X, Y)]  # HERO5 stores Z, X, Y
+        labelled = {"X": X, "Y": Y, "Z": Z}
+        order = a.orin or "ZXY"  # HERO5 stores Z, X, Y
+        q = [int(round((1 if c.isupper() else -1) * labelled[c.upper()] * a.scal)) for c in order]
         assert all(-32768 <= v <= 32767 for v in q), "gyro beyond int16 at this SCAL"
         stored.append(q)
-        Zq, Xq, Yq = (v / a.scal for v in q)
-        expected.append((-Xq, -Zq, -Yq))
+        back = {c.upper(): (1 if c.isupper() else -1) * v / a.scal for c, v in zip(order, q)}
+        expected.append((-back["X"], -back["Z"], -back["Y"]))
     step = t_imu[1] - t_imu[0]
     assert t_imu[0] == 0 and all(t_imu[k] == k * step for k in range(len(t_imu))), "gyro not uniform from frame 0"
 
@@ -130,7 +137,8 @@ def main():
                                   klv("SCAL", "s", 2, 1, struct.pack(">h", 418)),
                                   klv("ACCL", "s", 6, len(chunk), accl)),
                              nest("STRM", klv("TSMP", "L", 4, 1, struct.pack(">I", k + len(chunk))),
-                                  text("STNM", "Gyroscope (z,x,y)"), text("SIUN", "rad/s"),
+                                  text("STNM", "Gyroscope"), *([text("ORIN", a.orin)] if a.orin else []),
+                                  text("SIUN", "rad/s"),
                                   klv("SCAL", "s", 2, 1, struct.pack(">h", a.scal)),
                                   klv("GYRO", "s", 6, len(chunk), gyro))))
         payload_starts.append(t_imu[k])

@@ -13,8 +13,8 @@
 // origin, which is where the video's frame times start (video_file.cpp), so `eval rec.mp4 --imu
 // rec.mp4` pairs them. Edit lists are not applied (GoPro writes none that shift a track).
 //
-// Axes: a stored triple is in the order an `ORIN` string in the stream gives (e.g. "ZXY"; a
-// lower-case letter is the negated axis), or, without one, HERO5 Black/Session's Z,X,Y (gpmf-parser
+// Axes: a stored triple is in the order an `ORIN` string in the stream gives (gpmf-parser's
+// GPMF_common.h: "input channel data orientation, lowercase is negative, e.g. Zxy"), or, without one, HERO5 Black/Session's Z,X,Y (gpmf-parser
 // README; HERO6 stores Y,-X,Z and Fusion -Y,X,Z without saying so: a note names the assumption).
 // The samples are returned in GoPro's labelled frame (X, Y, Z of the README's "IMU Orientation Uses
 // These Axis Labels"), and GyroLog::imu_to_camera is the rotation those labels give into our
