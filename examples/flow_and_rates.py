@@ -34,7 +34,7 @@ for k in range(1, len(seq)):
     print(f"{t[k]}  wx {w[0]:+.4f}  wy {w[1]:+.4f}  wz {w[2]:+.4f} rad/s")
     previous = frame
 
-# The same in one call (what `inertialnet predict` does): a structured array.
+# The same in one call (what `inertialnet predict` does): Rates (.w is (N, 3) rad/s).
 rates = inertialnet.predict(sequence)
 print("predict() agrees with the loop:", np.allclose([rates[c][-1] for c in ("wx", "wy", "wz")], w))
 

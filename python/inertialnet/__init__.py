@@ -5,13 +5,16 @@ CPU through PoCL); OpenCV's DIS flow and a geometric head run without weights. T
 compute exactly what the ``inertialnet`` command line computes: ``predict`` gives the numbers of
 ``inertialnet predict``, ``evaluate`` those of ``inertialnet eval``.
 
-Images are NumPy ``uint8`` arrays: ``(H, W)`` gray, ``(H, W, 3)`` RGB (``order="bgr"`` for
-OpenCV's order), ``(H, W, 4)`` with alpha dropped, or batches ``(N, H, W, C)``. Flow is float32
-``(H, W, 2)``: u (right) and v (down) in pixels. Rates are float64 rad/s.
+Images are NumPy ``uint8`` (or ``uint16``) arrays, or floats in [0, 1]: ``(H, W)`` gray,
+``(H, W, 3)`` RGB (``order="bgr"`` for OpenCV's order), ``(H, W, 4)`` with alpha dropped, or
+batches ``(N, H, W, C)``. Flow is float32 ``(H, W, 2)`` or ``(N, H, W, 2)``: u (right) and v
+(down) in pixels, NaN where unknown. Rates are float64 rad/s: :class:`Rates` from ``predict``.
 
-Errors keep the library's messages: bad input raises ``ValueError``, a failure of the device or
-driver ``RuntimeError``, exhausted host memory ``MemoryError``. Ctrl-C stops every long call
-(``predict``, networks and DIS flow on batches) within a pair or a layer: ``KeyboardInterrupt``.
+Errors keep the library's messages, with keyword arguments where the CLI names its options: bad
+input raises ``ValueError`` (``TypeError`` for an argument of the wrong type), a missing file
+``FileNotFoundError``, a failure of the device or driver ``RuntimeError``, exhausted host memory
+``MemoryError``. Ctrl-C stops every long call (``predict``, networks, heads and DIS flow on
+batches) within a pair or a layer: ``KeyboardInterrupt``.
 """
 
 from __future__ import annotations
@@ -25,7 +28,6 @@ from ._inertialnet import (  # noqa: F401  (re-exported)
     Camera,
     Device,
     GeometricHead,
-    Sequence,
     __version__,
     devices,
     dis_flow,
@@ -40,13 +42,17 @@ from ._inertialnet import (  # noqa: F401  (re-exported)
     write_flow_png,
     write_kitti_flow,
 )
+from ._rates import Rates, read_rates, _rates_of_predict
+from ._sequence import Sequence
 from . import _inertialnet as _native
 
 PathLike = Union[str, "os.PathLike[str]"]
 Weights = Union[PathLike, Iterable[PathLike]]
 DeviceLike = Union[None, str, int, Device]
+SequenceLike = Union[PathLike, Sequence]
 
 __all__ = [
+    "Rates", "read_rates",  # _rates.py
     "Camera", "Device", "FlowNet", "FlowNet2", "FlowNet2C", "FlowNet2S", "FlowNet2SD", "FlowNet2CS",
     "FlowNet2CSS", "GeometricHead", "InertialNetHead", "Sequence", "devices", "dis_flow", "evaluate",
     "flow_to_color", "predict", "read_flo", "read_flow", "read_image", "read_kitti_flow", "select_devices",
@@ -133,9 +139,9 @@ class InertialNetHead:
 
     def rates(self, flow: np.ndarray, camera: Optional[Camera] = None, dt: Optional[float] = None) -> np.ndarray:
         """ω in rad/s: ``(3,)`` for one flow ``(H, W, 2)``, ``(N, 3)`` for a batch. The flow must have
-        the size the head was built for (``config``) and a finite, known vector at every pixel: NaN,
-        infinity or an unknown-flow mark (above 1e9, as ``dis_flow(flow_check=…)`` and KITTI files
-        write them) is a ``ValueError`` naming the first such index. ``camera`` and ``dt`` are
+        the size the head was built for (``config``) and a finite, known vector at every pixel: NaN
+        (what ``dis_flow(flow_check=…)`` and the flow readers give for unknown flow), infinity or a
+        value above 1e9 is a ``ValueError`` naming the first such index. ``camera`` and ``dt`` are
         accepted for symmetry with :class:`GeometricHead` and ignored: the learned head knows its
         camera and rate."""
         del camera, dt
@@ -145,21 +151,43 @@ class InertialNetHead:
     def config(self) -> dict:
         return self._head.config
 
+    def __repr__(self) -> str:
+        c = self.config
+        return f"<inertialnet.InertialNetHead {c['input_width']}x{c['input_height']}>"
+
+
+def _device_spec(device: DeviceLike) -> str:
+    """``device=`` of predict as the spec string the library takes: None, a spec, an index or a
+    :class:`Device` (its global index), as the model constructors take it."""
+    if device is None:
+        return ""
+    if isinstance(device, Device):
+        return str(device.info["index"])
+    if isinstance(device, bool) or not isinstance(device, (str, int)):
+        raise TypeError(f"device must be None, a device spec string, an index or an inertialnet.Device, "
+                        f"not {type(device).__name__}")
+    return str(device)
+
 
 def predict(
-    sequence: PathLike,
+    sequence: SequenceLike,
     weights: Weights = (),
     *,
     flow: Optional[str] = None,
     head: Optional[str] = None,
     model: Optional[str] = None,
     solver: str = "motion-field",
-    fx: float = 0.0,
-    fy: float = 0.0,
-    cx: float = 0.0,
-    cy: float = 0.0,
+    fx: Optional[float] = None,
+    fy: Optional[float] = None,
+    cx: Optional[float] = None,
+    cy: Optional[float] = None,
+    calibration: Optional[PathLike] = None,
+    calibration_camera: str = "",
     rate_hz: float = 0.0,
-    device: Union[None, str, int] = None,
+    camera: str = "cam0",
+    time_offset: Optional[float] = None,
+    readout_time: float = 0.0,
+    device: DeviceLike = None,
     max_pairs: int = 0,
     lanes: int = 2,
     decode_threads: int = 2,
@@ -169,82 +197,137 @@ def predict(
 ):
     """Angular rates of every frame pair of a sequence, as ``inertialnet predict`` computes them.
 
-    Returns a NumPy structured array with one row per frame pair and the fields ``timestamp_ns``
-    (int64, the pair's second frame), ``wx, wy, wz`` (float64, rad/s) and ``status`` (str:
-    ``"ok"``, or why the pair has no answer, e.g. ``"no_texture"``; its rates are then NaN), plus
-    ``wx_geometric, wy_geometric, wz_geometric, status_geometric`` with ``head="both"``. The
-    arguments are the CLI's options: without weights, DIS flow and the geometric head;
+    ``sequence`` is a path (EuRoC folder, image folder, video) or a :class:`Sequence` (its
+    ``rate_hz`` is used unless one is given). Returns :class:`Rates`: one row per frame pair,
+    ``.timestamps_ns`` (the pair's second frame), ``.w`` (N, 3) rad/s, ``.status`` (``"ok"``, or
+    why the pair has no answer, e.g. ``"no_texture"``; its rates are then NaN), and what the CLI's
+    rates CSV states: ``.estimator``, ``.frame``, ``.time_offset_s``, ``.readout_time_s``. With
+    ``head="both"`` the geometric head's columns follow (``rates["wx_geometric"]``,
+    ``rates.head("geometric")``). The arguments are the CLI's options: without weights, DIS flow
+    and the geometric head; ``camera`` is ``--camera`` (a EuRoC sequence's cam0 or cam1);
+    ``calibration`` is ``--calibration`` (EuRoC sensor.yaml, Kalibr camchain, OpenCV YAML/XML;
+    ``calibration_camera`` picks a camchain's camera) and ``fx``, ``fy``, ``cx``, ``cy`` are
+    ``--fx`` … (None: not given; ``cx=0`` is a principal point at the corner);
+    ``time_offset`` and ``readout_time`` are ``--time-offset`` and ``--readout-time`` (seconds;
+    stated in the rates for :func:`evaluate`, the readout time also corrects the geometric head);
     ``flow_check`` is ``--flow-check`` (the DIS forward-backward check for the geometric head,
     pixels at 752 columns; 0: off). With ``keep_flow=True`` returns ``(rates, flows)``, flows a
     list of ``(H, W, 2)`` arrays (as computed, without the check's marks).
 
-    ``rate_hz``, ``fx`` and ``fy`` are 0 (not given) or what the CLI accepts for ``--rate``,
+    ``rate_hz``, ``fx`` and ``fy`` are 0 or None (not given) or what the CLI accepts for ``--rate``,
     ``--fx``, ``--fy`` (finite, positive, at most 1e6); ``max_pairs`` is 0 (all) or a count:
-    anything else is a ``ValueError``.
+    anything else is a ``ValueError``. A missing sequence or weights file is a
+    ``FileNotFoundError``.
 
     ``progress(done, total)``, if given, is called on the calling thread as pairs complete (at
     most every 50 ms, and once at the end): ``done`` pairs of ``total``. An exception it raises
     stops the run and propagates. Ctrl-C stops the run within a pair or two and raises
     ``KeyboardInterrupt``; the pairs computed so far are dropped."""
+    if isinstance(sequence, Sequence) and not rate_hz:
+        rate_hz = sequence.rate_hz
     if isinstance(weights, (str, os.PathLike)):
         weights = [weights]
-    columns, t_ns, values, flows, statuses = _native._predict(
+    columns, t_ns, values, flows, statuses, metadata = _native._predict(
         os.fspath(sequence), [os.fspath(w) for w in weights], model or "", flow or "", head or "", solver,
-        float(fx), float(fy), float(cx), float(cy), float(rate_hz), "" if device is None else str(device),
-        keep_flow, max_pairs, int(lanes), int(decode_threads), float(flow_check), progress)
-    # Fields as in the rates CSV: wx,wy,wz,status then wx_geometric,…,status_geometric.
-    dtype = [("timestamp_ns", np.int64)]
-    status_fields = []
-    for e in range(len(columns) // 3):
-        dtype += [(name, np.float64) for name in columns[3 * e:3 * e + 3]]
-        status_fields.append("status" + columns[3 * e][2:])
-        dtype.append((status_fields[-1], "U16"))
-    rates = np.zeros(len(t_ns), dtype=dtype)
-    rates["timestamp_ns"] = t_ns
-    for i, name in enumerate(columns):
-        rates[name] = values[:, i]
-    for e, name in enumerate(status_fields):
-        rates[name] = [row[e] for row in statuses]
+        *(None if v is None else float(v) for v in (fx, fy, cx, cy)), float(rate_hz), _device_spec(device),
+        keep_flow, max_pairs, int(lanes), int(decode_threads), float(flow_check), progress,
+        None if time_offset is None else float(time_offset), float(readout_time), camera,
+        "" if calibration is None else os.fspath(calibration), calibration_camera)
+    rates = _rates_of_predict(columns, t_ns, values, statuses, metadata)
     return (rates, flows) if keep_flow else rates
 
 
-def write_rates_csv(path: PathLike, rates: np.ndarray) -> None:
-    """Writes a structured array from :func:`predict` as the CLI's rates CSV (atomically)."""
-    names = list(rates.dtype.names)
-    status_names = [n for n in names[1:] if n == "status" or n.startswith("status_")]
-    numeric = [n for n in names[1:] if n not in status_names]
-    values = np.stack([rates[n] for n in numeric], axis=1) if len(rates) else np.zeros((0, len(numeric)))
-    statuses = [[str(s) for s in rates[n]] for n in status_names]
-    _native._write_rates_csv(os.fspath(path), numeric, rates[names[0]], values, status_names, statuses)
+def write_rates_csv(path: PathLike, rates: Union[Rates, np.ndarray]) -> None:
+    """Writes :class:`Rates` (or a structured array with the CSV's fields) as the CLI's rates
+    CSV, atomically; the same as ``rates.to_csv(path)``."""
+    _as_rates(rates).to_csv(path)
+
+
+def _as_rates(rates: Union[Rates, np.ndarray]) -> Rates:
+    return rates if isinstance(rates, Rates) else Rates.from_records(np.asarray(rates))
+
+
+def _t_cam_imu_text(T_cam_imu) -> str:
+    """``T_cam_imu=`` as the library's parser takes --T-cam-imu: a 4x4 matrix (anything NumPy
+    reads as one, or 16 numbers) as 16 numbers, a path or a string of numbers as it is."""
+    if T_cam_imu is None:
+        return ""
+    if isinstance(T_cam_imu, (str, os.PathLike)):
+        return os.fspath(T_cam_imu)
+    matrix = np.asarray(T_cam_imu, dtype=np.float64)
+    if matrix.size != 16:
+        raise ValueError(f"T_cam_imu must be a 4x4 matrix (IMU to camera), 16 numbers or a YAML file; "
+                         f"got an array of shape {matrix.shape}")
+    return " ".join(repr(float(v)) for v in matrix.ravel())
 
 
 def evaluate(
-    rates: Union[PathLike, np.ndarray],
-    sequence: PathLike,
+    rates: Union[PathLike, Rates, np.ndarray],
+    sequence: SequenceLike,
     *,
     target: Optional[str] = None,
     head: Optional[str] = None,
-    gyro_bias: Optional[_Seq[float]] = None,
+    gyro_bias: Union[None, str, _Seq[float]] = None,
     camera_frame: bool = False,
+    time_offset: Union[None, float, str] = None,
+    time_offset_range: float = 0.2,
+    readout_time: Optional[float] = None,
+    imu: Optional[PathLike] = None,
+    imu_time_unit: Optional[str] = None,
+    T_cam_imu=None,
+    camchain: Optional[PathLike] = None,
+    calibration: Optional[PathLike] = None,
+    calibration_camera: str = "",
+    camera: str = "cam0",
+    rate_hz: float = 0.0,
     plot: Optional[PathLike] = None,
     series: bool = False,
 ) -> dict:
-    """The paper's metrics, as ``inertialnet eval --json``: ``rates`` is a rates CSV or the array
-    from :func:`predict`, ``sequence`` a EuRoC folder with ``imu0``. ``head="geometric"`` compares
-    the ``wx_geometric, …`` columns. ``target`` is "spline" or "mean"; ``None`` picks the one that
-    fits the estimator the CSV states, as the CLI does (an array states none: spline). Returns the
-    ``inertialnet.eval/1`` document as a dict: its ``estimators`` list holds one report
-    (``series=True`` adds the per-frame values)."""
+    """The paper's metrics, as ``inertialnet eval --json``.
+
+    ``rates`` is :class:`Rates` from :func:`predict`, a rates CSV, or a structured array with the
+    CSV's fields; ``sequence`` a EuRoC folder with ``imu0``, or an image folder or a video with
+    ``imu``. What the rates state (estimator, frame, time offset, readout time) is used as
+    ``inertialnet eval`` uses it from the CSV: ``evaluate(predict(seq), seq)`` gives eval's numbers
+    on predict's CSV. The keywords are eval's options: ``target`` ("spline" or "mean"; None picks
+    the one that fits the estimator), ``head="geometric"`` (the ``wx_geometric, …`` columns),
+    ``gyro_bias`` (x, y, z rad/s in the IMU frame, or "auto"), ``camera_frame``, ``time_offset``
+    (seconds, t_imu = t_cam + offset, or "auto" to estimate it within ±``time_offset_range``;
+    None: the rates' own), ``readout_time`` (seconds; None: the rates' own), ``imu`` (a gyro log:
+    EuRoC CSV, gyro-only CSV, Gyroflow .gcsv; ``imu_time_unit`` s|ms|us|ns), ``T_cam_imu`` (IMU to
+    camera: a 4x4 matrix, 16 numbers, or a YAML file), ``camchain`` (a Kalibr camchain's cam0),
+    ``calibration`` (a calibration file whose camera-IMU extrinsic, if it has one, stands for
+    ``camchain``; ``calibration_camera`` picks a camchain's camera), ``camera`` (a EuRoC sequence's cam0 or cam1), ``rate_hz`` (a folder's or video's
+    frame rate, as predict was given it), ``plot`` (a PNG).
+
+    Returns the ``inertialnet.eval/1`` document as a dict: its ``estimators`` list holds one
+    report (``series=True`` adds the per-frame values). A missing file is a ``FileNotFoundError``."""
     import json
     import tempfile
 
-    if isinstance(rates, np.ndarray):
+    if isinstance(sequence, Sequence) and not rate_hz:
+        rate_hz = sequence.rate_hz
+    if not isinstance(rates, (str, os.PathLike)):
+        # Through the CLI's CSV writer, metadata and %.9g values included: the numbers of eval on
+        # the CSV that `inertialnet predict` writes.
         with tempfile.TemporaryDirectory() as folder:
             path = os.path.join(folder, "rates.csv")
-            write_rates_csv(path, rates)
-            return evaluate(path, sequence, target=target, head=head, gyro_bias=gyro_bias,
-                            camera_frame=camera_frame, plot=plot, series=series)
-    text = _native._evaluate_json(os.fspath(rates), os.fspath(sequence), target or "", head or "",
-                                  None if gyro_bias is None else list(gyro_bias), camera_frame,
-                                  "" if plot is None else os.fspath(plot), series)
+            _as_rates(rates).to_csv(path)
+            return evaluate(path, sequence, target=target, head=head, gyro_bias=gyro_bias, camera_frame=camera_frame,
+                            time_offset=time_offset, time_offset_range=time_offset_range,
+                            readout_time=readout_time, imu=imu, imu_time_unit=imu_time_unit, T_cam_imu=T_cam_imu,
+                            camchain=camchain, calibration=calibration, calibration_camera=calibration_camera,
+                            camera=camera, rate_hz=rate_hz, plot=plot, series=series)
+    if isinstance(gyro_bias, str):
+        bias = gyro_bias
+    else:
+        bias = None if gyro_bias is None else [float(b) for b in gyro_bias]
+    text = _native._evaluate_json(
+        os.fspath(rates), os.fspath(sequence), target or "", head or "", bias, camera_frame,
+        "" if plot is None else os.fspath(plot), series,
+        time_offset if time_offset is None or isinstance(time_offset, str) else float(time_offset),
+        float(time_offset_range), None if readout_time is None else float(readout_time),
+        "" if imu is None else os.fspath(imu), imu_time_unit or "", _t_cam_imu_text(T_cam_imu),
+        "" if camchain is None else os.fspath(camchain), camera, float(rate_hz),
+        "" if calibration is None else os.fspath(calibration), calibration_camera)
     return json.loads(text)

@@ -1,19 +1,22 @@
 // The Python module `inertialnet._inertialnet`: the library's API for NumPy users. The pure
-// Python package (python/inertialnet/__init__.py) re-exports it and adds the model classes and
-// the structured array of predict().
+// Python package (python/inertialnet/__init__.py) re-exports it and adds the model classes,
+// Sequence (_sequence.py) and the Rates of predict() (_rates.py).
 //
-// Conventions: images are NumPy uint8 (or uint16) arrays (H, W) gray, (H, W, C) with C = 1, 3 or 4
-// (alpha dropped), or batches (N, H, W, C); flow is float32 (H, W, 2) (u, v in pixels) or
-// (N, H, W, 2); rates are float64 (3,) in rad/s. Device work runs without the GIL, and every long
-// call on a worker thread that Ctrl-C stops (run_interruptibly). Library errors keep their
-// messages: invalid input becomes ValueError, runtime failures RuntimeError, exhausted host memory
-// MemoryError.
+// Conventions: images are NumPy uint8 (or uint16) arrays, or floats in [0, 1], (H, W) gray,
+// (H, W, C) with C = 1, 3 or 4 (alpha dropped), or batches (N, H, W, C); flow is float32 (H, W, 2)
+// (u, v in pixels; NaN where unknown) or (N, H, W, 2); rates are float64 (3,) or (N, 3) in rad/s.
+// Device work runs without the GIL, and every long call on a worker thread that Ctrl-C stops
+// (run_interruptibly). Library errors keep their messages, with keyword arguments where they name
+// CLI options (python_words): invalid input becomes ValueError, runtime failures RuntimeError,
+// exhausted host memory MemoryError; a missing path is FileNotFoundError (existing).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
 #include <algorithm>
+#include <cctype>
+#include <cerrno>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -21,6 +24,7 @@
 #include <cstdint>
 #include <exception>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <new>
@@ -30,6 +34,7 @@
 #include <vector>
 
 #include "inertialnet/inertialnet.hpp"
+#include "inertialnet/io/calibration_file.hpp"
 
 namespace py = pybind11;
 using namespace inertialnet;
@@ -142,6 +147,86 @@ std::optional<double> rate_of(double rate_hz) {
   return rate_hz;
 }
 
+// A path the call reads: FileNotFoundError (errno ENOENT, the path as its filename), as open()
+// raises it, where the library would answer a ValueError; `what` names the argument.
+std::filesystem::path existing(const std::filesystem::path& path, const char* what) {
+  std::error_code error;
+  if (!path.empty() && std::filesystem::exists(path, error)) return path;
+  const py::object exception = py::module_::import("builtins").attr("FileNotFoundError")(
+      ENOENT, std::string(what) + " does not exist", path.string());
+  PyErr_SetObject(PyExc_FileNotFoundError, exception.ptr());
+  throw py::error_already_set();
+}
+
+// The sequence of Sequence and predict: a path that must exist, unless it names a source by a
+// scheme ("camera:0", "gst:…": a word of letters and a colon before any '/'), which is no file and
+// which the frame source judges itself.
+std::filesystem::path existing_sequence(const std::filesystem::path& path) {
+  const std::string text = path.string();
+  const auto colon = text.find(':');
+  const bool scheme = colon != std::string::npos && colon >= 2 &&
+                      std::all_of(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(colon),
+                                  [](char c) { return std::islower(static_cast<unsigned char>(c)) != 0; });
+  return scheme ? path : existing(path, "the sequence");
+}
+
+// The library's messages are the CLI's and name its options ("give the IMU with --imu FILE");
+// in Python they name the keyword arguments instead ("imu=FILE"): `--imu-time-unit` becomes
+// `imu_time_unit=`, `--rate` `rate_hz=`, `--gyro-bias auto` `gyro_bias="auto"`, `--gyro-bias x,y,z`
+// `gyro_bias=(x, y, z)`; "eval " or "predict " before an option goes. Commands quoted in
+// backticks (`inertialnet weights --synthetic …`) are CLI commands to run and stay as they are.
+std::string python_words(const std::string& message) {
+  // Values that follow an option in the messages: placeholders stay as they are, words are quoted.
+  static const std::vector<std::string> placeholders = {"FILE", "N", "s|ms|us|ns"};
+  static const std::vector<std::string> values = {"auto", "flownet2", "dis", "inertialnet", "geometric",
+                                                  "both", "spline", "mean"};
+  std::string out;
+  bool quoted = false;
+  for (std::size_t i = 0; i < message.size();) {
+    const char c = message[i];
+    const bool starts = message.compare(i, 2, "--") == 0 && i + 2 < message.size() && std::isalpha(static_cast<unsigned char>(message[i + 2])) &&
+                        (i == 0 || std::string(" (`'\"").find(message[i - 1]) != std::string::npos);
+    if (c == '`') quoted = !quoted;
+    if (!starts || quoted) {
+      out += c;
+      ++i;
+      continue;
+    }
+    std::size_t end = i + 2;
+    while (end < message.size() && (std::isalnum(static_cast<unsigned char>(message[end])) || message[end] == '-')) ++end;
+    std::string name = message.substr(i + 2, end - i - 2);
+    for (char& ch : name) ch = ch == '-' ? '_' : ch;
+    if (name == "rate") name = "rate_hz";
+    for (const char* command : {"eval ", "predict "}) {
+      const std::string word(command);
+      if (out.size() >= word.size() && out.compare(out.size() - word.size(), word.size(), word) == 0) {
+        out.erase(out.size() - word.size());
+      }
+    }
+    out += name + "=";
+    i = end;
+    if (i < message.size() && message[i] == ' ') {
+      std::size_t value_end = i + 1;
+      while (value_end < message.size() && (std::isalnum(static_cast<unsigned char>(message[value_end])) ||
+                                             message[value_end] == ',' || message[value_end] == '|')) {
+        ++value_end;
+      }
+      const std::string value = message.substr(i + 1, value_end - i - 1);
+      if (value == "x,y,z") {
+        out += "(x, y, z)";
+        i = value_end;
+      } else if (std::find(placeholders.begin(), placeholders.end(), value) != placeholders.end()) {
+        out += value;
+        i = value_end;
+      } else if (std::find(values.begin(), values.end(), value) != values.end()) {
+        out += "\"" + value + "\"";
+        i = value_end;
+      }
+    }
+  }
+  return out;
+}
+
 // --- arrays ------------------------------------------------------------------------------------
 
 enum class ChannelOrder { RGB, BGR };
@@ -188,12 +273,31 @@ std::vector<HostImage> images_of(const py::array& array, const std::string& orde
   const std::size_t count = nd == 4 ? static_cast<std::size_t>(array.shape(0)) : 1;
   std::vector<HostImage> images(count);
   const bool wide = py::isinstance<py::array_t<std::uint16_t>>(array);
-  if (!wide && !py::isinstance<py::array_t<std::uint8_t>>(array)) {
-    throw invalid_input(std::string(what) + " must hold uint8 (or uint16) samples, not " +
-                        std::string(py::str(array.dtype())) + "; convert with .astype(numpy.uint8).");
+  // Float images are scikit-image's and matplotlib's convention: values in [0, 1]. The advice
+  // this once gave, .astype(numpy.uint8), turned such an image into zeros; they are scaled here
+  // (x · 255, exactly as a uint8 image of the same picture), and values outside [0, 1] refused.
+  const bool floating = array.dtype().kind() == 'f';
+  if (!wide && !floating && !py::isinstance<py::array_t<std::uint8_t>>(array)) {
+    throw invalid_input(std::string(what) + " must hold uint8 or uint16 samples, or floats in [0, 1], not " +
+                        std::string(py::str(array.dtype())) + ".");
+  }
+  py::array_t<float, py::array::c_style | py::array::forcecast> scaled;
+  if (floating) {
+    // astype copies: the caller's array is not scaled in place.
+    scaled = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(array.attr("astype")("float32"));
+    float* p = scaled.mutable_data();
+    for (py::ssize_t i = 0; i < scaled.size(); ++i) {
+      if (!(p[i] >= 0.0f && p[i] <= 1.0f)) {  // written so that NaN fails
+        throw invalid_input(std::string(what) + " holds " + got(p[i]) + ": a float image must hold values in [0, 1] "
+                            "(multiply by 1/255 first if its values are 0..255).");
+      }
+      p[i] *= 255.0f;
+    }
   }
   for (std::size_t n = 0; n < count; ++n) {
-    if (wide) {
+    if (floating) {
+      to_planar<float>(scaled, n, order, 1.0f, images[n]);
+    } else if (wide) {
       // 16-bit samples as the file loader takes them: 65535 / 257 = 255.
       to_planar<std::uint16_t>(py::array_t<std::uint16_t, py::array::c_style | py::array::forcecast>::ensure(array), n,
                                order, 257.0f, images[n]);
@@ -221,14 +325,36 @@ py::array_t<std::uint8_t> to_uint8_rgb(const HostImage& image) {
   return out;
 }
 
+// Unknown flow is NaN in Python, whatever marks it in the library and its files (1e10, as the
+// Middlebury .flo format writes it; KITTI's valid flag): a marker of 1e10 in an array made every
+// mean, norm and plot of it meaningless (flow.mean() was 2.6e8 on one unknown vector in 20). Both
+// components of an unknown vector are NaN.
+void copy_flow_out(const FlowField& flow, float* p) {
+  for (std::size_t i = 0; i < flow.pixel_count(); ++i) {
+    const bool unknown = is_unknown_flow(flow.u[i], flow.v[i]);
+    p[2 * i] = unknown ? std::numeric_limits<float>::quiet_NaN() : flow.u[i];
+    p[2 * i + 1] = unknown ? std::numeric_limits<float>::quiet_NaN() : flow.v[i];
+  }
+}
+
 py::array_t<float> flow_to_array(const FlowField& flow) {
   py::array_t<float> out({flow.height, flow.width, 2});
-  float* p = out.mutable_data();
-  for (std::size_t i = 0; i < flow.pixel_count(); ++i) {
-    p[2 * i] = flow.u[i];
-    p[2 * i + 1] = flow.v[i];
-  }
+  copy_flow_out(flow, out.mutable_data());
   return out;
+}
+
+// (H, W, 2) floats at `p` as a FlowField. An unknown vector (a NaN or infinite component, or one
+// above Middlebury's 1e9: is_unknown_flow) gets the library's mark for unknown flow in both
+// components (kUnknownFlowValue, what .flo files hold), so that the .flo and KITTI writers, the
+// colour coding and the heads treat Python's NaN as the unknown flow it is.
+FlowField flow_from_data(const float* p, int width, int height) {
+  FlowField flow(width, height);
+  for (std::size_t i = 0; i < flow.pixel_count(); ++i) {
+    const bool unknown = is_unknown_flow(p[2 * i], p[2 * i + 1]);
+    flow.u[i] = unknown ? kUnknownFlowValue : p[2 * i];
+    flow.v[i] = unknown ? kUnknownFlowValue : p[2 * i + 1];
+  }
+  return flow;
 }
 
 // (H, W, 2) float flow as a FlowField.
@@ -238,13 +364,7 @@ FlowField flow_from_array(const py::array& array) {
     throw invalid_input("a flow field must be a float array (H, W, 2) holding (u, v) in pixels; got " +
                         std::to_string(array.ndim()) + " dimensions.");
   }
-  FlowField flow(static_cast<int>(a.shape(1)), static_cast<int>(a.shape(0)));
-  const float* p = a.data();
-  for (std::size_t i = 0; i < flow.pixel_count(); ++i) {
-    flow.u[i] = p[2 * i];
-    flow.v[i] = p[2 * i + 1];
-  }
-  return flow;
+  return flow_from_data(a.data(), static_cast<int>(a.shape(1)), static_cast<int>(a.shape(0)));
 }
 
 // --- devices -----------------------------------------------------------------------------------
@@ -279,10 +399,14 @@ std::shared_ptr<Device> device_of(const py::object& device) {
 
 std::vector<std::string> paths_of(const py::object& weights) {
   if (py::isinstance<py::str>(weights) || py::hasattr(weights, "__fspath__")) {
-    return {py::str(py::module_::import("os").attr("fspath")(weights)).cast<std::string>()};
+    const std::string path = py::str(py::module_::import("os").attr("fspath")(weights)).cast<std::string>();
+    return {existing(path, "the weights file").string()};
   }
   std::vector<std::string> paths;
-  for (const auto& item : weights) paths.push_back(py::str(py::module_::import("os").attr("fspath")(item)).cast<std::string>());
+  for (const auto& item : weights) {
+    const std::string path = py::str(py::module_::import("os").attr("fspath")(item)).cast<std::string>();
+    paths.push_back(existing(path, "the weights file").string());
+  }
   if (paths.empty()) throw invalid_input("no weight file given");
   return paths;
 }
@@ -384,10 +508,8 @@ py::array_t<float> dis_flow(const py::array& first, const py::array& second, con
                           py::ssize_t{2}});
   float* p = out.mutable_data();
   for (const auto& f : flows) {
-    for (std::size_t i = 0; i < f.pixel_count(); ++i, p += 2) {
-      p[0] = f.u[i];
-      p[1] = f.v[i];
-    }
+    copy_flow_out(f, p);
+    p += 2 * f.pixel_count();
   }
   return out;
 }
@@ -443,23 +565,56 @@ class PyGeometricHead {
     options_.validate();
   }
 
-  // ω in the camera frame, or with camera_to_body in the body frame as predict reports it.
-  py::array_t<double> rates(const py::array& flow_array, const CameraIntrinsics& camera, double dt,
+  // ω in the camera frame, or with camera_to_body in the body frame as predict reports it: (3,)
+  // for one flow (H, W, 2), (N, 3) for a batch (N, H, W, 2) as dis_flow and FlowNet.flow return
+  // it, with one dt for all pairs or one per pair.
+  py::array_t<double> rates(const py::array& flow_array, const CameraIntrinsics& camera, const py::object& dt_object,
                             const py::object& camera_to_body) {
-    const FlowField flow = flow_from_array(flow_array);
+    const auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(flow_array);
+    if (!a || (a.ndim() != 3 && a.ndim() != 4) || a.shape(a.ndim() - 1) != 2) {
+      throw invalid_input("the flow must be a float array (H, W, 2) or a batch (N, H, W, 2); got " +
+                          std::to_string(flow_array.ndim()) + " dimensions.");
+    }
+    const bool batch = a.ndim() == 4;
+    const auto n = static_cast<std::size_t>(batch ? a.shape(0) : 1);
+    const int h = static_cast<int>(a.shape(batch ? 1 : 0)), width = static_cast<int>(a.shape(batch ? 2 : 1));
+    const auto dts = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(dt_object);
+    if (!dts || (dts.ndim() != 0 && !(batch && dts.ndim() == 1 && static_cast<std::size_t>(dts.size()) == n))) {
+      throw invalid_input("dt must be the frame interval in seconds" +
+                          std::string(batch ? ", one for the batch or one per pair (" + std::to_string(n) + ")" : "") +
+                          "; got " + (dts ? "an array of shape " + std::string(py::str(dts.attr("shape")))
+                                          : "a " + type_name(dt_object)) + ".");
+    }
+    std::vector<FlowField> flows;
+    for (std::size_t k = 0; k < n; ++k) {
+      flows.push_back(flow_from_data(a.data() + 2 * k * static_cast<std::size_t>(h) * static_cast<std::size_t>(width),
+                                     width, h));
+    }
     const auto r = mat3_of(camera_to_body);
-    Vec3 w;
+    std::vector<Vec3> w(n);
     run_interruptibly([&](const std::atomic<bool>& stop) {
       if (!head_ || !same_camera(head_->camera(), camera)) head_ = std::make_unique<GeometricHead>(*device_, camera, options_);
-      // The same upload as the pipeline's: the flow as a [1, 2, H, W] tensor.
       Queue& queue = device_->queue();
-      std::vector<float> planes(flow.u);
-      planes.insert(planes.end(), flow.v.begin(), flow.v.end());
-      const Tensor tensor = Tensor::from_host(queue, {1, 2, flow.height, flow.width}, planes);
-      w = head_->estimate(queue, tensor, dt, &stop).omega;
-      if (r) w = mul(*r, w);
+      for (std::size_t k = 0; k < n && !stop; ++k) {
+        // The same upload as the pipeline's: the flow as a [1, 2, H, W] tensor.
+        std::vector<float> planes(flows[k].u);
+        planes.insert(planes.end(), flows[k].v.begin(), flows[k].v.end());
+        const Tensor tensor = Tensor::from_host(queue, {1, 2, h, width}, planes);
+        const double dt = dts.ndim() == 0 ? *dts.data() : dts.data()[k];
+        w[k] = head_->estimate(queue, tensor, dt, &stop).omega;
+        if (r) w[k] = mul(*r, w[k]);
+      }
     });
-    return vec3_array(w);
+    if (!batch) return vec3_array(w.front());
+    py::array_t<double> out({static_cast<py::ssize_t>(n), py::ssize_t{3}});
+    for (std::size_t k = 0; k < n; ++k) std::copy(w[k].begin(), w[k].end(), out.mutable_data() + 3 * k);
+    return out;
+  }
+
+  std::string repr() const {
+    return std::string("<inertialnet.GeometricHead ") +
+           (options_.solver == GeometricSolver::OpenGV ? "opengv" : "motion-field") + " stride " +
+           std::to_string(options_.stride) + " on " + device_->info().name + ">";
   }
 
  private:
@@ -504,8 +659,8 @@ class PyInertialNetHead {
                                  std::to_string(i % w);
           throw invalid_input("flow[" + at + "] = (" + got(u) + ", " + got(v) +
                               ") is not a finite flow vector: the learned head needs a known flow at every pixel "
-                              "(NaN, infinity and the unknown-flow marks above 1e9 of dis_flow(flow_check=…) "
-                              "and KITTI files are refused).");
+                              "(NaN, which dis_flow(flow_check=…) and the flow readers give for unknown flow, infinity "
+                              "and values above 1e9 are refused).");
         }
         planar[2 * k * plane + i] = u;
         planar[(2 * k + 1) * plane + i] = v;
@@ -540,8 +695,9 @@ class PyInertialNetHead {
 
 class PySequence {
  public:
-  PySequence(const std::filesystem::path& path, double rate_hz)
-      : source_(open_frame_source(path, rate_of(rate_hz))) {}
+  PySequence(const std::filesystem::path& path, double rate_hz, const std::string& image_topic)
+      : path_(existing_sequence(path)), rate_(rate_of(rate_hz)), image_topic_(image_topic),
+        source_(open_frame_source(path_, rate_, "cam0", BagTopics{image_topic, "", ""})) {}
   std::size_t size() const { return source_->size(); }
   py::array_t<std::int64_t> timestamps() const {
     py::array_t<std::int64_t> out(static_cast<py::ssize_t>(source_->size()));
@@ -561,7 +717,7 @@ class PySequence {
     HostImage image;
     {
       py::gil_scoped_release release;
-      image = source_->decode(static_cast<std::size_t>(index));
+      image = decode(static_cast<std::size_t>(index));
     }
     return to_uint8_rgb(image);
   }
@@ -572,16 +728,40 @@ class PySequence {
   }
   py::object camera_to_body() const {
     const auto c = source_->calibration();
-    if (!c) return py::none();
+    // A bag's CameraInfo has no extrinsics (T_BS all zero): no rotation to the body.
+    if (!c || c->T_BS == std::array<double, 16>{}) return py::none();
     const Mat3 r = c->rotation_BS();
     py::array_t<double> out({3, 3});
     std::copy(r.begin(), r.end(), out.mutable_data());
     return std::move(out);
   }
   std::string description() const { return source_->description(); }
+  std::string path() const { return path_.string(); }
+  double rate_hz() const { return rate_.value_or(0.0); }
+  bool sequential() const { return source_->sequential(); }
 
  private:
+  // Random access on every source. A video decodes in order only (FrameSource::sequential): a
+  // frame after the last one decoded is reached by decoding the ones between, a frame before it
+  // by opening the video again from its start, so seq[k] costs up to k decodes there and a
+  // backward step the most; in-order access (iteration, predict) costs one decode a frame.
+  HostImage decode(std::size_t index) {
+    if (!source_->sequential()) return source_->decode(index);
+    if (last_ && index == *last_) return source_->decode(index);  // the frame decoded last, again
+    if (last_ && index < *last_) {
+      source_ = open_frame_source(path_, rate_, "cam0", BagTopics{image_topic_, "", ""});
+      last_.reset();
+    }
+    for (std::size_t k = last_ ? *last_ + 1 : 0; k < index; ++k) source_->decode(k);
+    last_ = index;
+    return source_->decode(index);
+  }
+
+  std::filesystem::path path_;
+  std::optional<double> rate_;
+  std::string image_topic_;  // a ROS bag's image topic ("": its only one)
   std::unique_ptr<FrameSource> source_;
+  std::optional<std::size_t> last_;  // a sequential source's frame decoded last
 };
 
 // predict()'s progress callback, progress(done, total), called on the calling thread between
@@ -614,7 +794,7 @@ class ProgressReport {
 
 // The rows of predict(): the column names, the timestamps, the values (rows × columns; NaN where
 // a pair has no answer), with keep_flow each pair's flow, and the status words (rows × estimators).
-// The Python side makes the structured array.
+// The Python side makes the Rates (_rates.py).
 py::tuple predict(const PredictSettings& settings, std::size_t max_pairs, int lanes, int decode_threads,
                   const py::object& progress) {
   std::vector<std::int64_t> t_ns;
@@ -622,10 +802,12 @@ py::tuple predict(const PredictSettings& settings, std::size_t max_pairs, int la
   std::vector<FlowField> flows;
   std::vector<std::string> columns;
   std::vector<std::string> statuses;
+  std::vector<std::pair<std::string, std::string>> metadata;
   ProgressReport report(progress);
   run_interruptibly([&](const std::atomic<bool>& stop) {
     Prediction prediction(settings);
     columns = prediction.columns();
+    metadata = prediction.csv_metadata();
     PipelineOptions options;
     options.lanes_per_device = lanes;
     options.decode_threads = decode_threads;
@@ -657,27 +839,143 @@ py::tuple predict(const PredictSettings& settings, std::size_t max_pairs, int la
     for (std::size_t e = 0; e < estimators; ++e) row.append(statuses[i * estimators + e]);
     status_rows.append(row);
   }
-  return py::make_tuple(columns, t, v, flow_list, status_rows);
+  // The metadata the rates CSV states (frame, estimator, time offset, readout time): the rates
+  // carry it, so that evaluate() reads them as `inertialnet eval` reads the CLI's CSV.
+  return py::make_tuple(columns, t, v, flow_list, status_rows, metadata);
 }
 
+// `inertialnet eval --json` with the CLI's options as arguments: time_offset is None (the rates
+// file's), a number of seconds or "auto"; readout_time None (the file's) or seconds; imu, camchain
+// paths ("": none); T_cam_imu 16 numbers or a YAML path as --T-cam-imu takes it ("": none).
 std::string evaluate_json(const std::filesystem::path& rates, const std::filesystem::path& sequence,
                           const std::string& target, const std::string& head, const py::object& gyro_bias,
-                          bool camera_frame, const std::string& plot, bool series) {
+                          bool camera_frame, const std::string& plot, bool series, const py::object& time_offset,
+                          double time_offset_range, const py::object& readout_time, const std::string& imu,
+                          const std::string& imu_time_unit, const std::string& T_cam_imu, const std::string& camchain,
+                          const std::string& camera, double rate_hz, const std::string& calibration,
+                          const std::string& calibration_camera) {
+  existing(rates, "the rates file");
+  existing(sequence, "the sequence");
   EvalOptions options;
   // No target: the one that fits the estimator the rates file states, as `inertialnet eval` picks.
   options.choose_target = target.empty();
   options.sync.target = parse_sync_target(target.empty() ? "spline" : target);
   options.sync.camera_frame = camera_frame;
-  if (!gyro_bias.is_none()) {
+  if (py::isinstance<py::str>(gyro_bias)) {
+    if (gyro_bias.cast<std::string>() != "auto") {
+      throw invalid_input("gyro_bias must be three values (x, y, z) in rad/s or \"auto\", got '" +
+                          gyro_bias.cast<std::string>() + "'");
+    }
+    options.sync.bias = BiasSource::LeastSquares;
+  } else if (!gyro_bias.is_none()) {
     const auto b = gyro_bias.cast<std::vector<double>>();
     if (b.size() != 3) throw invalid_input("gyro_bias must hold three values (x, y, z) in rad/s.");
     options.sync.bias = BiasSource::Given;
     options.sync.gyro_bias = {b[0], b[1], b[2]};
   }
+  // The CLI's checks of --time-offset and --readout-time (parse_seconds): finite seconds.
+  const auto seconds = [](const py::object& value, const char* name) {
+    const double x = value.cast<double>();
+    if (!std::isfinite(x)) throw invalid_input(std::string(name) + " must be a finite number of seconds, got " + got(x));
+    return x;
+  };
+  if (py::isinstance<py::str>(time_offset)) {
+    if (time_offset.cast<std::string>() != "auto") {
+      throw invalid_input("time_offset must be a number of seconds or \"auto\", got '" + time_offset.cast<std::string>() +
+                          "'");
+    }
+    options.estimate_time_offset = true;
+    options.time_offset_search.range_s = time_offset_range;
+  } else if (!time_offset.is_none()) {
+    options.time_offset_s = seconds(time_offset, "time_offset");
+  }
+  if (!readout_time.is_none()) options.readout_time_s = seconds(readout_time, "readout_time");
+  options.input.imu_csv = imu.empty() ? std::filesystem::path() : existing(imu, "the IMU file");
+  if (!imu_time_unit.empty()) {
+    const auto unit = parse_time_unit(imu_time_unit);
+    if (!unit) throw invalid_input("imu_time_unit must be s, ms, us or ns, got '" + imu_time_unit + "'");
+    options.input.imu_time_unit = unit;
+  }
+  if (!T_cam_imu.empty() && !camchain.empty()) {
+    throw invalid_input("T_cam_imu and camchain both give the camera-IMU rotation: give one of them.");
+  }
+  if (!T_cam_imu.empty()) options.input.camera_imu = parse_camera_imu(T_cam_imu, "T_cam_imu");
+  if (!camchain.empty()) options.input.camera_imu = read_kalibr_camchain(existing(camchain, "the camchain"));
+  if (!calibration.empty()) {
+    // As eval --calibration: the file's camera-IMU extrinsic, when it has one, stands for a
+    // camchain (tools/cli/input_options.cpp); a file without one leaves the others in charge.
+    const CalibrationFile file = read_calibration_file(existing(calibration, "the calibration file"), calibration_camera);
+    if (file.camera_imu) {
+      if (options.input.camera_imu) {
+        throw invalid_input("calibration=" + calibration + " holds a camera-IMU extrinsic, and " +
+                            (camchain.empty() ? "T_cam_imu=" : "camchain=") + " gives one too; give one of them.");
+      }
+      options.input.camera_imu = file.camera_imu;
+    }
+  }
+  options.input.camera = camera;
+  options.input.rate_hz = rate_of(rate_hz);
   options.head_suffix = head.empty() ? "" : "_" + head;
   options.plot = plot;
   py::gil_scoped_release release;
   return format_eval_json({evaluate(rates, sequence, options)}, series);
+}
+
+// A rates table from Python's columns: the numeric columns (wx, wy, wz first) with their values
+// (rows × columns), the status columns with their words, and the `# key: value` metadata.
+RatesTable rates_table(const std::vector<std::string>& columns, const py::array& t, const py::array& values,
+                       const std::vector<std::string>& status_names,
+                       const std::vector<std::vector<std::string>>& statuses,
+                       const std::vector<std::pair<std::string, std::string>>& metadata) {
+  const auto ta = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(t);
+  const auto va = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(values);
+  const auto rows = static_cast<std::size_t>(ta.size());
+  const std::size_t k = columns.size();
+  if (k < 3 || static_cast<std::size_t>(va.size()) != rows * k) {
+    throw invalid_input("a rates table needs wx, wy, wz and one value per row and column.");
+  }
+  RatesTable table;
+  table.t_ns.assign(ta.data(), ta.data() + rows);
+  table.extra_names.assign(columns.begin() + 3, columns.end());
+  table.extra.assign(k - 3, std::vector<double>(rows));
+  for (std::size_t r = 0; r < rows; ++r) {
+    const double* row = va.data() + r * k;
+    table.w.push_back({row[0], row[1], row[2]});
+    for (std::size_t c = 3; c < k; ++c) table.extra[c - 3][r] = row[c];
+  }
+  table.status_names = status_names;
+  table.statuses = statuses;
+  table.metadata = metadata;
+  return table;
+}
+
+// A rates CSV as Python's columns: (numeric column names, t, values rows × columns, status
+// names, status words per column, metadata).
+py::tuple read_rates(const std::filesystem::path& path) {
+  existing(path, "the rates file");
+  RatesTable table;
+  {
+    py::gil_scoped_release release;
+    table = read_rates_csv(path);
+  }
+  std::vector<std::string> columns = {"wx", "wy", "wz"};
+  columns.insert(columns.end(), table.extra_names.begin(), table.extra_names.end());
+  py::array_t<std::int64_t> t(static_cast<py::ssize_t>(table.size()));
+  std::copy(table.t_ns.begin(), table.t_ns.end(), t.mutable_data());
+  py::array_t<double> v({static_cast<py::ssize_t>(table.size()), static_cast<py::ssize_t>(columns.size())});
+  double* p = v.mutable_data();
+  for (std::size_t r = 0; r < table.size(); ++r) {
+    for (std::size_t c = 0; c < 3; ++c) *p++ = table.w[r][c];
+    for (const auto& column : table.extra) *p++ = column[r];
+  }
+  // A schema-1 file has no status column: every row is ok, as eval reads it.
+  std::vector<std::string> status_names = table.status_names;
+  std::vector<std::vector<std::string>> statuses = table.statuses;
+  if (status_names.empty()) {
+    status_names = {"status"};
+    statuses = {table.status()};
+  }
+  return py::make_tuple(columns, t, v, status_names, statuses, table.metadata);
 }
 
 }  // namespace
@@ -689,7 +987,8 @@ PYBIND11_MODULE(_inertialnet, m) {
     try {
       if (p) std::rethrow_exception(p);
     } catch (const Error& e) {
-      PyErr_SetString(e.kind() == ErrorKind::InvalidInput ? PyExc_ValueError : PyExc_RuntimeError, e.what());
+      PyErr_SetString(e.kind() == ErrorKind::InvalidInput ? PyExc_ValueError : PyExc_RuntimeError,
+                      python_words(e.what()).c_str());
     }
   });
   // pybind11 turns std::bad_alloc into a MemoryError that says only "std::bad_alloc"; this one
@@ -779,7 +1078,7 @@ PYBIND11_MODULE(_inertialnet, m) {
   m.def("dis_flow", &dis_flow, py::arg("img1"), py::arg("img2"), py::arg("order") = "rgb", py::arg("flow_check") = 0.0,
         "OpenCV DIS optical flow (no weights) from img1 to img2: float32 (H, W, 2), or (N, H, W, 2) for batches.\n"
         "flow_check > 0 also computes the flow back and marks each vector whose round trip misses by more than\n"
-        "that many pixels (at 752 columns, scaled with the width) as unknown (1e10), as predict does for the\n"
+        "that many pixels (at 752 columns, scaled with the width) as unknown (NaN), as predict does for the\n"
         "geometric head (its default 0.5); GeometricHead.rates skips unknown vectors.");
 
   py::class_<PyGeometricHead>(m, "GeometricHead", "Angular velocity from flow by geometry alone (no weights).")
@@ -787,19 +1086,26 @@ PYBIND11_MODULE(_inertialnet, m) {
            py::arg("solver") = "motion-field", py::arg("stride") = 4)
       .def("rates", &PyGeometricHead::rates, py::arg("flow"), py::arg("camera"), py::arg("dt"),
            py::arg("camera_to_body") = py::none(),
-           "ω (rad/s, (3,)) from the flow (H, W, 2) of a frame pair dt seconds apart; camera frame, or the body "
+           "ω (rad/s, (3,)) from the flow (H, W, 2) of a frame pair dt seconds apart, or (N, 3) from a batch "
+           "(N, H, W, 2) with one dt or N of them; camera frame, or the body "
            "frame with camera_to_body (a 3x3 rotation matrix: orthonormal rows within 1e-3, determinant +1; "
            "anything else is a ValueError). Flow vectors that are NaN, infinite or above 1e9 in magnitude are "
            "unknown flow (the marks of dis_flow(flow_check=…) and KITTI files) and left out, like vectors that "
-           "leave the image.");
+           "leave the image.")
+      .def("__repr__", &PyGeometricHead::repr);
 
   py::class_<PyInertialNetHead>(m, "_InertialNetHead")
       .def(py::init<const py::object&, const py::object&>(), py::arg("weights"), py::arg("device") = py::none())
       .def("rates", &PyInertialNetHead::rates, py::arg("flow"))
       .def_property_readonly("config", &PyInertialNetHead::config);
 
-  py::class_<PySequence>(m, "Sequence", "A EuRoC folder, an image folder or a video, frame by frame.")
-      .def(py::init<const std::filesystem::path&, double>(), py::arg("path"), py::arg("rate_hz") = 0.0)
+  // The Python class inertialnet.Sequence (a collections.abc.Sequence) wraps this one.
+  py::class_<PySequence>(m, "_Sequence", "A EuRoC folder, an image folder, a video or a ROS bag, frame by frame.")
+      .def(py::init<const std::filesystem::path&, double, const std::string&>(), py::arg("path"), py::arg("rate_hz") = 0.0,
+           py::arg("image_topic") = "")
+      .def_property_readonly("path", &PySequence::path)
+      .def_property_readonly("rate_hz", &PySequence::rate_hz)
+      .def_property_readonly("sequential", &PySequence::sequential)
       .def("__len__", &PySequence::size)
       .def("__getitem__", &PySequence::frame, py::arg("index"), "Frame `index` as uint8 RGB (H, W, 3).")
       .def_property_readonly("timestamps_ns", &PySequence::timestamps)
@@ -807,14 +1113,16 @@ PYBIND11_MODULE(_inertialnet, m) {
       .def_property_readonly("camera_to_body", &PySequence::camera_to_body)
       .def_property_readonly("description", &PySequence::description);
 
-  m.def("read_image", [](const std::filesystem::path& path) { return to_uint8_rgb(load_rgb_image(path)); },
+  m.def("read_image", [](const std::filesystem::path& path) { return to_uint8_rgb(load_rgb_image(existing(path, "the image"))); },
         py::arg("path"), "An image file as uint8 RGB (H, W, 3), gray replicated, as the CLI reads frames.");
 
   m.def("_predict",
         [](const std::filesystem::path& sequence, const std::vector<std::string>& weights, const std::string& model,
-           const std::string& flow, const std::string& head, const std::string& solver, double fx, double fy, double cx,
-           double cy, double rate_hz, const std::string& device, bool keep_flow, const py::object& max_pairs, int lanes,
-           int decode_threads, double flow_check, const py::object& progress) {
+           const std::string& flow, const std::string& head, const std::string& solver, const py::object& fx,
+           const py::object& fy, const py::object& cx, const py::object& cy, double rate_hz, const std::string& device,
+           bool keep_flow, const py::object& max_pairs, int lanes, int decode_threads, double flow_check,
+           const py::object& progress, const py::object& time_offset, double readout_time, const std::string& camera,
+           const std::string& calibration, const std::string& calibration_camera) {
           // The CLI's checks of --max-pairs, --rate, --fx, --fy: a value they refuse is a ValueError
           // here, not ignored (a negative rate or focal length was taken as "not given").
           const std::int64_t pairs = integer_of(max_pairs, "max_pairs");
@@ -822,23 +1130,47 @@ PYBIND11_MODULE(_inertialnet, m) {
             throw invalid_input("max_pairs must be a count of pairs (0 for all), got " + std::to_string(pairs));
           }
           rate_of(rate_hz);
-          zero_or_positive(fx, "fx", "pixels", "the calibration's focal length");
-          zero_or_positive(fy, "fy", "pixels", "fx");
+          // None: not given. fx, fy: 0 is "not given" too (never a focal length); cx, cy: any
+          // coordinate within 1e6 pixels, 0 included (a principal point at the corner), as
+          // --cx and --cy take it.
+          const auto focal = [](const py::object& value, const char* name, const char* zero_means) {
+            return value.is_none() ? std::optional<double>()
+                                   : std::optional<double>(zero_or_positive(value.cast<double>(), name, "pixels", zero_means));
+          };
+          const auto coordinate = [](const py::object& value, const char* name) {
+            if (value.is_none()) return std::optional<double>();
+            const double x = value.cast<double>();
+            if (!(std::abs(x) <= 1e6)) {
+              throw invalid_input(std::string(name) + " must be a finite pixel coordinate within 1e+06 of the origin, got " +
+                                  got(x));
+            }
+            return std::optional<double>(x);
+          };
+          const auto given_fx = focal(fx, "fx", "the calibration's focal length");
+          const auto given_fy = focal(fy, "fy", "fx");
+          const auto given_cx = coordinate(cx, "cx"), given_cy = coordinate(cy, "cy");
           if (!progress.is_none() && !PyCallable_Check(progress.ptr())) {
             throw py::type_error("progress must be a callable taking (done, total), or None, not " +
                                  type_name(progress));
           }
           PredictSettings s;
-          s.sequence = sequence;
+          s.sequence = existing_sequence(sequence);
+          // Stated in the rates' metadata for evaluate(), as predict --time-offset/--readout-time
+          // state them in the CSV; the Prediction checks their ranges.
+          if (!time_offset.is_none()) s.time_offset_s = time_offset.cast<double>();
+          s.readout_time_s = readout_time;
+          s.camera = camera;
           s.weights = weights;
           s.model = model;
           s.flow = flow;
           s.head = head;
           s.solver = solver;
-          s.fx = fx;
-          s.fy = fy;
-          s.cx = cx;
-          s.cy = cy;
+          s.fx = given_fx;
+          s.fy = given_fy;
+          s.cx = given_cx;
+          s.cy = given_cy;
+          s.calibration = calibration.empty() ? std::filesystem::path() : existing(calibration, "the calibration file");
+          s.calibration_camera = calibration_camera;
           s.rate_hz = rate_hz;
           s.device = device;
           s.keep_flow = keep_flow;
@@ -850,51 +1182,42 @@ PYBIND11_MODULE(_inertialnet, m) {
   m.def("_write_rates_csv",
         [](const std::filesystem::path& path, const std::vector<std::string>& columns, const py::array& t,
            const py::array& values, const std::vector<std::string>& status_names,
-           const std::vector<std::vector<std::string>>& statuses) {
-          const auto ta = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(t);
-          const auto va = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(values);
-          const auto rows = static_cast<std::size_t>(ta.size());
-          const std::size_t k = columns.size();
-          if (k < 3 || static_cast<std::size_t>(va.size()) != rows * k) {
-            throw invalid_input("a rates table needs wx, wy, wz and one value per row and column.");
-          }
-          RatesTable table;
-          table.t_ns.assign(ta.data(), ta.data() + rows);
-          table.extra_names.assign(columns.begin() + 3, columns.end());
-          table.extra.assign(k - 3, std::vector<double>(rows));
-          for (std::size_t r = 0; r < rows; ++r) {
-            const double* row = va.data() + r * k;
-            table.w.push_back({row[0], row[1], row[2]});
-            for (std::size_t c = 3; c < k; ++c) table.extra[c - 3][r] = row[c];
-          }
-          table.status_names = status_names;
-          table.statuses = statuses;
-          write_rates_csv(path, table);
+           const std::vector<std::vector<std::string>>& statuses,
+           const std::vector<std::pair<std::string, std::string>>& metadata) {
+          write_rates_csv(path, rates_table(columns, t, values, status_names, statuses, metadata));
         });
+  m.def("_read_rates_csv", &read_rates);
 
-  m.def("read_flo", [](const std::filesystem::path& path) { return flow_to_array(read_flo(path)); }, py::arg("path"),
-        "A Middlebury .flo file as float32 (H, W, 2).");
+  m.def("read_flo", [](const std::filesystem::path& path) { return flow_to_array(read_flo(existing(path, "the flow file"))); }, py::arg("path"),
+        "A Middlebury .flo file as float32 (H, W, 2); unknown flow (above 1e9 in the file) is NaN.");
   m.def("write_flo", [](const std::filesystem::path& path, const py::array& flow) { write_flo(path, flow_from_array(flow)); },
-        py::arg("path"), py::arg("flow"), "Writes (H, W, 2) flow as Middlebury .flo (atomically).");
-  m.def("read_kitti_flow", [](const std::filesystem::path& path) { return flow_to_array(read_kitti_flow_png(path)); },
-        py::arg("path"), "A KITTI 16-bit flow PNG as float32 (H, W, 2); invalid pixels are 1e10 (unknown flow).");
+        py::arg("path"), py::arg("flow"), "Writes (H, W, 2) flow as Middlebury .flo (atomically); NaN vectors as 1e10, Middlebury's unknown flow.");
+  m.def("read_kitti_flow", [](const std::filesystem::path& path) { return flow_to_array(read_kitti_flow_png(existing(path, "the flow file"))); },
+        py::arg("path"), "A KITTI 16-bit flow PNG as float32 (H, W, 2); invalid pixels are NaN (unknown flow).");
   m.def("write_kitti_flow",
         [](const std::filesystem::path& path, const py::array& flow) { write_kitti_flow_png(path, flow_from_array(flow)); },
-        py::arg("path"), py::arg("flow"), "Writes (H, W, 2) flow as a KITTI 16-bit flow PNG (1/64 px steps).");
-  m.def("read_flow", [](const std::filesystem::path& path) { return flow_to_array(read_flow_file(path)); },
-        py::arg("path"), "A .flo or KITTI flow PNG file, recognised by its content, as float32 (H, W, 2).");
+        py::arg("path"), py::arg("flow"), "Writes (H, W, 2) flow as a KITTI 16-bit flow PNG (1/64 px steps); NaN vectors as invalid pixels.");
+  m.def("read_flow", [](const std::filesystem::path& path) { return flow_to_array(read_flow_file(existing(path, "the flow file"))); },
+        py::arg("path"), "A .flo or KITTI flow PNG file, recognised by its content, as float32 (H, W, 2); unknown flow is NaN.");
   m.def("flow_to_color",
-        [](const py::array& flow, float max_magnitude, bool legend) {
+        [](const py::array& flow, float max_magnitude, bool legend, const std::string& order) {
+          const ChannelOrder channels = parse_order(order);
           ColorImage image = flow_to_color(flow_from_array(flow), max_magnitude);
           if (legend && std::min(image.width, image.height) / 4 >= 8) {
             paste_legend(image, color_wheel_legend(std::min(image.width, image.height) / 4));
           }
           py::array_t<std::uint8_t> out({image.height, image.width, 3});
-          std::copy(image.rgb.begin(), image.rgb.end(), out.mutable_data());
+          std::uint8_t* p = out.mutable_data();
+          std::copy(image.rgb.begin(), image.rgb.end(), p);
+          // BGR for OpenCV's imshow and imwrite, as the image arguments take order="bgr".
+          if (channels == ChannelOrder::BGR) {
+            for (std::size_t i = 0; i < image.rgb.size(); i += 3) std::swap(p[i], p[i + 2]);
+          }
           return out;
         },
-        py::arg("flow"), py::arg("max_magnitude") = 0.0f, py::arg("legend") = false,
-        "Middlebury colour coding of (H, W, 2) flow as uint8 RGB (H, W, 3); max_magnitude 0: the field's maximum.");
+        py::arg("flow"), py::arg("max_magnitude") = 0.0f, py::arg("legend") = false, py::arg("order") = "rgb",
+        "Middlebury colour coding of (H, W, 2) flow as uint8 (H, W, 3), RGB or with order=\"bgr\" BGR; "
+        "max_magnitude 0: the field's maximum; unknown (NaN) flow is black.");
   m.def("write_flow_png",
         [](const std::filesystem::path& path, const py::array& flow, float max_magnitude) {
           write_flow_png(path, flow_from_array(flow), max_magnitude);

@@ -39,8 +39,22 @@ def sequence(tmp_path_factory):
     return out
 
 
+@pytest.fixture(scope="session")
+def video(tmp_path_factory):
+    """clip.avi of tests/cli/make_test_video: 40 MJPEG frames of 188x120 at 20 Hz.
+
+    The maker is $INERTIALNET_MAKE_TEST_VIDEO (set by ctest), else build/tests/cli/make_test_video;
+    the tests that need it are skipped, saying so, when neither exists."""
+    maker = os.environ.get("INERTIALNET_MAKE_TEST_VIDEO") or str(REPO / "build" / "tests" / "cli" / "make_test_video")
+    if not os.access(maker, os.X_OK):
+        pytest.skip(f"no make_test_video at {maker} (set INERTIALNET_MAKE_TEST_VIDEO)")
+    folder = tmp_path_factory.mktemp("video")
+    subprocess.run([maker, str(folder)], check=True, capture_output=True)
+    return folder / "clip.avi"
+
+
 def read_rates_csv(path):
-    """The header and the rows of a rates CSV (schema inertialnet.rates/2): timestamps as int, the
+    """The header and the rows of a rates CSV (schema inertialnet.rates/3, or 2): timestamps as int, the
     status columns as their words, rates as float (NaN where a pair has no answer: empty cells)."""
     with open(path) as f:
         rows = [r for r in csv.reader(f) if r and not r[0].startswith("#")]  # `# key: value` lines aside

@@ -89,7 +89,7 @@ def test_sequence_takes_python_indices(sequence):
     for index in (len(seq), -len(seq) - 1):
         with pytest.raises(IndexError, match=f"frame {index} is out of range: the sequence has {len(seq)} frames"):
             seq[index]
-    with pytest.raises(TypeError, match="frame index must be an integer, not float"):
+    with pytest.raises(TypeError, match="Sequence indices must be integers or slices, not float"):
         seq[1.5]
 
 

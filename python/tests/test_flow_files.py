@@ -89,12 +89,31 @@ def test_viz_writes_the_same_colours(cli, tmp_path):
 def test_flo_round_trip_is_bit_exact(tmp_path):
     rng = np.random.default_rng(1)
     flow = rng.normal(0, 20, size=(37, 53, 2)).astype(np.float32)
-    flow[3, 4] = [1e10, 0]  # unknown flow survives bit for bit
     inertialnet.write_flo(tmp_path / "f.flo", flow)
     back = inertialnet.read_flo(tmp_path / "f.flo")
     assert back.dtype == np.float32 and back.shape == flow.shape
     np.testing.assert_array_equal(back.view(np.uint32), flow.view(np.uint32))
     np.testing.assert_array_equal(inertialnet.read_flow(tmp_path / "f.flo"), flow)
+
+
+def test_unknown_flow_is_nan_in_python_and_1e10_in_flo_files(tmp_path):
+    """Python sees NaN where a file marks unknown flow (1e10 made flow.mean() about 2.6e8); the
+    .flo writer keeps Middlebury's 1e10 mark, so other readers still see it."""
+    flow = np.ones((6, 8, 2), np.float32)
+    flow[3, 4] = [1e10, 0]
+    flow[1, 2] = [np.nan, 5]
+    inertialnet.write_flo(tmp_path / "f.flo", flow)
+    raw = np.fromfile(tmp_path / "f.flo", dtype="<f4", offset=12).reshape(6, 8, 2)
+    assert list(raw[3, 4]) == [1e10, 1e10] and list(raw[1, 2]) == [1e10, 1e10]
+    back = inertialnet.read_flo(tmp_path / "f.flo")
+    assert np.isnan(back[3, 4]).all() and np.isnan(back[1, 2]).all()
+    assert np.isnan(back).sum() == 4 and np.nanmean(back) == 1.0
+    # The flow_check marks of dis_flow are NaN too.
+    rng = np.random.default_rng(3)
+    frame = (rng.random((48, 64)) * 255).astype(np.uint8)
+    checked = inertialnet.dis_flow(frame, np.roll(frame, 9, axis=1), flow_check=0.01)
+    assert np.isnan(checked).any() and not (np.abs(checked) > 1e9).any()
+    assert np.array_equal(np.isnan(checked[..., 0]), np.isnan(checked[..., 1]))
 
 
 def test_kitti_round_trip_is_exact_to_one_64th_pixel(tmp_path):
@@ -106,15 +125,17 @@ def test_kitti_round_trip_is_exact_to_one_64th_pixel(tmp_path):
     inertialnet.write_kitti_flow(tmp_path / "any.png", flow)
     back = inertialnet.read_flow(tmp_path / "any.png")
     assert np.abs(back - flow).max() <= 1 / 128 + 1e-6
-    # Unknown flow becomes KITTI's invalid pixel and reads back as unknown (1e10).
-    flow[0, 0] = [1e10, 1e10]
+    # Unknown flow (NaN) becomes KITTI's invalid pixel and reads back as unknown (NaN).
+    flow[0, 0] = [np.nan, np.nan]
     inertialnet.write_kitti_flow(tmp_path / "invalid.png", flow)
-    assert inertialnet.read_kitti_flow(tmp_path / "invalid.png")[0, 0, 0] > 1e9
+    back = inertialnet.read_kitti_flow(tmp_path / "invalid.png")
+    assert np.isnan(back[0, 0]).all() and np.isfinite(back[0, 1]).all()
 
 
 def test_flow_file_errors_are_value_errors_with_the_library_message(tmp_path):
-    with pytest.raises(ValueError, match="does not exist"):
+    with pytest.raises(FileNotFoundError, match="does not exist") as missing:
         inertialnet.read_flo(tmp_path / "missing.flo")
+    assert missing.value.filename == str(tmp_path / "missing.flo")
     (tmp_path / "text.flo").write_text("hello")
     with pytest.raises(ValueError, match="neither a Middlebury"):
         inertialnet.read_flow(tmp_path / "text.flo")

@@ -56,7 +56,15 @@ def test_inertialnet_head_matches_the_cli(cli, sequence, tmp_path):
     cli("predict", sequence, "-w", head_weights, "--flow", "dis", "--head", "both", "-o", tmp_path / "rates.csv")
     header, expected = read_rates_csv(tmp_path / "rates.csv")
     rates = inertialnet.predict(sequence, head_weights, flow="dis", head="both")
-    assert list(rates.dtype.names) == header
+    assert rates.columns == header
+    # Each estimator keeps what the CSV states of it: the network's rates and the geometric head's.
+    assert rates.heads == ["", "geometric"] and (rates.estimator, rates.frame) == ("network", "body")
+    geometric = rates.head("geometric")
+    assert (geometric.estimator, geometric.frame) == ("inter_frame", "body")
+    np.testing.assert_array_equal(geometric.w[:, 0], rates["wx_geometric"])
+    with pytest.raises(ValueError, match="no estimator 'nosuch'"):
+        rates.head("nosuch")
+    assert repr(inertialnet.InertialNetHead.load(head_weights)) == "<inertialnet.InertialNetHead 128x96>"
     for i, name in enumerate(header[1:], start=1):
         assert [csv_text(v) for v in rates[name]] == [csv_text(v) for v in expected[:, i]]
     head = inertialnet.InertialNetHead.load(head_weights)

@@ -21,7 +21,7 @@ def cli_rates(cli, sequence, tmp_path, *args):
 def test_predict_matches_the_cli(cli, sequence, tmp_path):
     header, expected = cli_rates(cli, sequence, tmp_path)
     rates = inertialnet.predict(sequence)
-    assert list(rates.dtype.names) == header == ["timestamp_ns", "wx", "wy", "wz", "status"]
+    assert rates.columns == header == ["timestamp_ns", "wx", "wy", "wz", "status"]
     assert len(rates) == len(expected) == 4
     np.testing.assert_array_equal(rates["timestamp_ns"], expected[:, 0].astype(np.int64))
     assert list(rates["status"]) == ["ok"] * 4
@@ -74,8 +74,9 @@ def test_evaluate_matches_cli_eval_json(cli, sequence, tmp_path):
     assert report == from_cli
     # From predict()'s array, through the same CSV writer: the same metrics.
     # An array states no estimator, so the target is named: the one the CLI chose from the CSV.
-    chosen = report["estimators"][0]["target"]
-    from_array = inertialnet.evaluate(inertialnet.predict(sequence), sequence, target=chosen)
+    # The rates state their estimator, as the CSV does: the same target is chosen.
+    from_array = inertialnet.evaluate(inertialnet.predict(sequence), sequence)
+    assert from_array["estimators"][0]["target"] == report["estimators"][0]["target"]
     assert from_array["estimators"][0]["bias_corrected"] == report["estimators"][0]["bias_corrected"]
 
 
@@ -83,13 +84,18 @@ def test_errors_map_to_python_exceptions_with_the_cli_messages(cli, sequence, tm
     message = cli("predict", sequence, "--head", "inertialnet", expect=2)
     with pytest.raises(ValueError) as error:
         inertialnet.predict(sequence, head="inertialnet")
-    assert str(error.value) in message
+    # The CLI's message, with the keyword arguments where it names its options.
+    assert "--flow flownet2 and --head inertialnet need weights: --weights FILE" in message
+    assert 'flow="flownet2" and head="inertialnet" need weights: weights=FILE' in str(error.value)
+    assert "--" not in str(error.value).split("`")[0]
     with pytest.raises(ValueError, match="nosuch"):
         inertialnet.Device("nosuch")
-    with pytest.raises(ValueError, match="No such file"):
+    with pytest.raises(FileNotFoundError, match="weights file does not exist"):
         inertialnet.FlowNet2.load(tmp_path / "missing.safetensors")
+    with pytest.raises(FileNotFoundError, match="sequence does not exist"):
+        inertialnet.predict(tmp_path / "missing")
     with pytest.raises(ValueError, match="uint8"):
-        inertialnet.dis_flow(np.zeros((32, 32), np.float32), np.zeros((32, 32), np.float32))
+        inertialnet.dis_flow(np.zeros((32, 32), np.int32), np.zeros((32, 32), np.int32))
     with pytest.raises(ValueError, match="at least 16x16"):
         inertialnet.dis_flow(np.zeros((8, 8), np.uint8), np.zeros((8, 8), np.uint8))
 

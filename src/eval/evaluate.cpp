@@ -64,7 +64,7 @@ EvalReport evaluate(const RatesTable& all_rates, const EurocSequence& seq, const
   r.estimator = options.head_suffix.empty() ? std::string() : options.head_suffix.substr(1);
   r.columns = {"wx" + options.head_suffix, "wy" + options.head_suffix, "wz" + options.head_suffix};
   SyncOptions sync = options.sync;
-  std::vector<std::string> notes;
+  std::vector<std::string> notes = all_rates.notes;  // what reading the file assumed (no sidecar)
 
   const std::string estimator_key = "estimator" + options.head_suffix;
   if (const auto estimator = rates.meta(estimator_key); options.choose_target && estimator) {

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "inertialnet/io/bag.hpp"
+#include "inertialnet/io/bag_source.hpp"
 #include "inertialnet/io/kitti_timestamps.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "io/image_mat.hpp"
@@ -123,11 +125,22 @@ class VideoFrames : public FrameSource {
 }  // namespace
 
 std::unique_ptr<FrameSource> open_frame_source(const std::filesystem::path& path, std::optional<double> rate_hz,
-                                               const std::string& camera) {
+                                               const std::string& camera, const BagTopics& bag) {
   std::error_code error;
   if (!std::filesystem::exists(path, error)) throw invalid_input("sequence '" + path.string() + "' does not exist");
   std::unique_ptr<FrameSource> source;
-  if (is_euroc_folder(path)) {
+  const bool bag_file = is_bag(path);
+  if (bag.any() && !bag_file) {
+    throw invalid_input(std::string(!bag.image.empty() ? "--image-topic" : !bag.imu.empty() ? "--imu-topic" : "--camera-info-topic") +
+                        " names a topic of a ROS bag; " + path.string() + " is not one (a ROS 1 .bag, a ROS 2 .db3 or .mcap, "
+                        "or a rosbag2 folder).");
+  }
+  if (bag_file) {
+    // A bag's frames carry their header stamps and it has one camera per topic.
+    if (rate_hz) throw invalid_input("--rate is for image folders and videos; the bag " + path.string() + " stamps every frame.");
+    if (camera != "cam0") throw invalid_input("--camera picks a EuRoC camera; for the bag " + path.string() + " give --image-topic.");
+    source = open_bag_frame_source(path, bag);
+  } else if (is_euroc_folder(path)) {
     EurocReadOptions options;
     options.camera = camera;
     options.read_imu = false;  // predicting needs the frames only

@@ -15,6 +15,7 @@
 
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/runtime/log.hpp"
+#include "io/crc32.hpp"
 #include "io/input_file.hpp"
 #include "io/image_mat.hpp"
 #include "io/third_party_log.hpp"
@@ -25,6 +26,7 @@ namespace inertialnet {
 
 namespace {
 
+using io_detail::crc32_of;
 using io_detail::quoted;
 
 using Bytes = std::vector<unsigned char>;
@@ -88,22 +90,6 @@ std::string jpeg_truncation(const Bytes& bytes) {
   return "it ends after " + std::to_string(bytes.size()) + " bytes without the end-of-image marker";
 }
 
-// CRC-32 as PNG (and zlib) compute it.
-std::uint32_t crc32_of(const unsigned char* data, std::size_t size) {
-  static const auto table = [] {
-    std::array<std::uint32_t, 256> t{};
-    for (std::uint32_t n = 0; n < 256; ++n) {
-      std::uint32_t c = n;
-      for (int k = 0; k < 8; ++k) c = (c & 1) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
-      t[n] = c;
-    }
-    return t;
-  }();
-  std::uint32_t c = 0xFFFFFFFFu;
-  for (std::size_t i = 0; i < size; ++i) c = table[(c ^ data[i]) & 0xFF] ^ (c >> 8);
-  return c ^ 0xFFFFFFFFu;
-}
-
 // PNG chunks carry a CRC-32 of their type and data. libpng checks it too, but prints its
 // complaint ("libpng error: IDAT: CRC error") on stderr itself; checked here, a damaged file is
 // named in our message and libpng never sees it. Empty for a file whose every chunk matches.
@@ -152,7 +138,7 @@ std::pair<std::uint64_t, std::uint64_t> header_size(const Bytes& bytes) {
 // OpenCV refuses to decode an image beyond its size limits (a "decompression bomb": a small file
 // whose header announces billions of pixels) with an assertion text; this says it in our words.
 // The limits are OpenCV's defaults unless its environment variables set them.
-std::string size_limit_message(const fs::path& path, const Bytes& bytes) {
+std::string size_limit_message(const std::string& what, const Bytes& bytes) {
   auto limit = [](const char* variable, const char* fallback) {
     const char* set = std::getenv(variable);
     return set && *set ? std::string(set) + " (" + variable + ")" : std::string(fallback);
@@ -161,7 +147,7 @@ std::string size_limit_message(const fs::path& path, const Bytes& bytes) {
   const std::string size = width > 0 && height > 0 ? " is " + std::to_string(width) + " × " + std::to_string(height) +
                                                          " pixels (" + std::to_string(width * height) + " in all),"
                                                    : " is";
-  return "The image " + quoted(path) + size + " larger than OpenCV decodes: at most " +
+  return "The image " + what + size + " larger than OpenCV decodes: at most " +
          limit("OPENCV_IO_MAX_IMAGE_PIXELS", "1073741824 (2^30)") + " pixels in all and " +
          limit("OPENCV_IO_MAX_IMAGE_WIDTH", "1048576 (2^20)") + " wide, " +
          limit("OPENCV_IO_MAX_IMAGE_HEIGHT", "1048576 (2^20)") +
@@ -214,13 +200,14 @@ void to_planar_rgb(const cv::Mat& image, float divisor, HostImage& out) {
 
 }  // namespace
 
-HostImage load_rgb_image(const fs::path& path) {
-  const Bytes bytes = read_whole_file(path);
+HostImage load_rgb_image(const fs::path& path) { return decode_image_bytes(read_whole_file(path), quoted(path)); }
+
+HostImage decode_image_bytes(const std::vector<unsigned char>& bytes, const std::string& what) {
   const std::string missing = truncation(bytes);
-  if (!missing.empty()) throw invalid_input("The image " + quoted(path) + " is truncated: " + missing + ".");
+  if (!missing.empty()) throw invalid_input("The image " + what + " is truncated: " + missing + ".");
   if (is_png(bytes)) {
     const std::string damage = png_corruption(bytes);
-    if (!damage.empty()) throw invalid_input("The image " + quoted(path) + " is corrupt: " + damage + ".");
+    if (!damage.empty()) throw invalid_input("The image " + what + " is corrupt: " + damage + ".");
   }
 
   io_detail::route_third_party_logs();
@@ -231,16 +218,16 @@ HostImage load_rgb_image(const fs::path& path) {
                          cv::IMREAD_UNCHANGED);
   } catch (const cv::Exception& e) {
     // OpenCV's text is an assertion with its source path: for -v only, our words for the user.
-    log_message(LogLevel::Debug, "OpenCV on " + quoted(path) + ": " + e.what());
-    if (e.err.find("CV_IO_MAX_IMAGE") != std::string::npos) throw invalid_input(size_limit_message(path, bytes));
-    throw invalid_input("The image " + quoted(path) +
+    log_message(LogLevel::Debug, "OpenCV on " + what + ": " + e.what());
+    if (e.err.find("CV_IO_MAX_IMAGE") != std::string::npos) throw invalid_input(size_limit_message(what, bytes));
+    throw invalid_input("The image " + what +
                         " cannot be decoded: OpenCV's decoder refuses it (its own words are in the debug log, -v).");
   }
   if (image.empty()) {
-    throw invalid_input("The image " + quoted(path) +
+    throw invalid_input("The image " + what +
                         " cannot be decoded: it is not in a format OpenCV reads, or it is corrupt.");
   }
-  return host_image_from_mat(image, quoted(path));
+  return host_image_from_mat(image, what);
 }
 
 HostImage host_image_from_mat(const cv::Mat& image, const std::string& what) {

@@ -4,6 +4,7 @@
 
 #include <opencv2/core.hpp>
 #include <string>
+#include <vector>
 
 #include "inertialnet/io/image_io.hpp"
 
@@ -11,5 +12,9 @@ namespace inertialnet {
 
 // BGR(A) or gray(+alpha), 8 or 16 bit → planar RGB 0..255. `what` names the image in errors.
 HostImage host_image_from_mat(const cv::Mat& image, const std::string& what);
+
+// An encoded image in memory (a file's bytes, a ROS CompressedImage's data), checked and decoded
+// as load_rgb_image() does a file; `what` names it in errors ("'frame.png'", "message 3 of …").
+HostImage decode_image_bytes(const std::vector<unsigned char>& bytes, const std::string& what);
 
 }  // namespace inertialnet

@@ -2,6 +2,8 @@
 
 #include <system_error>
 
+#include "inertialnet/io/bag.hpp"
+#include "inertialnet/io/bag_source.hpp"
 #include "inertialnet/io/frame_source.hpp"
 #include "inertialnet/runtime/error.hpp"
 
@@ -69,11 +71,18 @@ EurocSequence read_sequence_with_imu(const fs::path& path, const ImuSequenceOpti
       options.imu_csv.empty()) {
     throw invalid_input("--imu-columns and --imu-units describe the file given with --imu, and none is given.");
   }
-  if (is_euroc_folder(path)) return read_euroc_with_imu(path, options);
+  const bool bag = is_bag(path);
+  if (!bag && is_euroc_folder(path)) {
+    if (options.bag.any()) open_frame_source(path, options.rate_hz, options.camera, options.bag);  // refuses the topics, named
+    return read_euroc_with_imu(path, options);
+  }
 
-  const bool folder = fs::is_directory(path, error);
+  const bool folder = !bag && fs::is_directory(path, error);
   const std::string kind = folder ? "an image folder" : "a video";
-  if (options.imu_csv.empty()) {
+  if (bag && !options.imu_csv.empty() && !options.bag.imu.empty()) {
+    throw invalid_input("--imu and --imu-topic both give the IMU of " + path.string() + "; give one.");
+  }
+  if (!bag && options.imu_csv.empty()) {
     throw invalid_input(path.string() + " is not a EuRoC sequence (no mav0/cam0/data.csv); as " + kind +
                         " it holds no gyro: give the IMU with --imu FILE (a "
                         "CSV of time, gx, gy, gz [rad/s] with or without the accelerometer after them, as EuRoC's "
@@ -82,11 +91,18 @@ EurocSequence read_sequence_with_imu(const fs::path& path, const ImuSequenceOpti
   }
   EurocSequence seq;
   seq.name = name_of(path);
-  const auto source = open_frame_source(path, options.rate_hz, options.camera);
+  const auto source = open_frame_source(path, options.rate_hz, options.camera, options.bag);
   seq.frames.resize(source->size());
   for (std::size_t i = 0; i < source->size(); ++i) seq.frames[i] = {source->timestamp_ns(i), std::string(), path};
   seq.notes = source->notes();
-  const GyroLog log = read_imu_file(options, seq);
+  if (bag) seq.camera = source->calibration();  // CameraInfo: calibrate-time predicts with it
+  GyroLog log;
+  if (bag && options.imu_csv.empty()) {
+    seq.imu = read_bag_imu(path, options.bag, seq.notes);
+  } else {
+    log = read_imu_file(options, seq);
+  }
+  const std::string imu_name = bag && options.imu_csv.empty() ? "the IMU topic of " + seq.name : options.imu_csv.string();
   if (options.camera_imu) {
     seq.imu_to_camera = options.camera_imu->rotation_cam_imu();
     seq.notes.push_back("IMU to camera rotation from " + options.camera_imu->source + ".");
@@ -100,11 +116,12 @@ EurocSequence read_sequence_with_imu(const fs::path& path, const ImuSequenceOpti
   }
   const std::int64_t f0 = seq.frames.front().t_ns, f1 = seq.frames.back().t_ns;
   if (seq.imu.back().t_ns < f0 || seq.imu.front().t_ns > f1) {
-    seq.warnings.push_back("The IMU samples of " + options.imu_csv.string() + " (t = " +
+    seq.warnings.push_back("The IMU samples of " + imu_name + " (t = " +
                            std::to_string(seq.imu.front().t_ns) + " to " + std::to_string(seq.imu.back().t_ns) +
                            " ns) do not overlap the frames of " + seq.name + " (t = " + std::to_string(f0) + " to " +
                            std::to_string(f1) + " ns): the IMU file must be stamped on the frames' clock (" +
-                           (folder ? "the file names' nanoseconds, or i/rate" : "the video's frame times, from its start") +
+                           (bag ? "the image messages' header stamps"
+                                : folder ? "the file names' nanoseconds, or i/rate" : "the video's frame times, from its start") +
                            "), up to the camera-IMU time offset.");
   }
   return seq;

@@ -9,12 +9,16 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <set>
 #include <utility>
+
+#include <nlohmann/json.hpp>
 
 #include "inertialnet/runtime/error.hpp"
 #include "io/csv_util.hpp"
 #include "runtime/atomic_file.hpp"
+#include "runtime/hash.hpp"
 
 namespace fs = std::filesystem;
 
@@ -62,7 +66,7 @@ int schema_version(const std::string& value, const fs::path& path) {
   const std::string prefix = "inertialnet.rates/";
   if (value.rfind(prefix, 0) == 0) {
     const std::string number = value.substr(prefix.size());
-    if (number == "1" || number == "2") return number[0] - '0';
+    if (number == "1" || number == "2" || number == "3") return number[0] - '0';
     if (!number.empty() && number.size() < 6 && number.find_first_not_of("0123456789") == std::string::npos) {
       throw invalid_input(path.string() + " is a rates file of schema " + value + ", newer than this version reads (" +
                           kRatesSchema + "); update inertialnet.");
@@ -202,6 +206,97 @@ RatesTable RatesTable::ok_rows(const std::string& suffix) const {
   return out;
 }
 
+fs::path rates_sidecar_path(const fs::path& path) {
+  fs::path sidecar = path;
+  sidecar += ".json";
+  return sidecar;
+}
+
+namespace {
+
+std::string hex64(std::uint64_t v) {
+  char buf[24];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(v));
+  return buf;
+}
+
+std::uint64_t file_fnv1a64(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::uint64_t hash = detail::kFnv1a64Offset;
+  char buf[1 << 16];
+  while (in.read(buf, sizeof buf) || in.gcount() > 0) {
+    hash = detail::fnv1a64(std::string_view(buf, static_cast<std::size_t>(in.gcount())), hash);
+  }
+  if (in.bad()) throw runtime_error("Cannot read " + path.string() + " to check it against its sidecar.");
+  return hash;
+}
+
+// The metadata of `path`'s sidecar into `table` (schema first); a note when there is none.
+void read_sidecar(const fs::path& path, RatesTable& table) {
+  std::error_code ec;
+  // A symbolic link's sidecar is its target's: the writer replaces a link's target and puts the
+  // sidecar beside it.
+  const fs::path target = fs::is_symlink(fs::symlink_status(path, ec)) ? fs::weakly_canonical(path, ec) : path;
+  const fs::path sidecar = rates_sidecar_path(target);
+  if (!fs::exists(sidecar, ec)) {
+    table.notes.push_back(path.string() + " states no metadata (no sidecar " + sidecar.filename().string() +
+                          " beside it, no '# key: value' lines): its frame, estimator, time offset and readout time "
+                          "are not known");
+    return;
+  }
+  std::ifstream in(sidecar, std::ios::binary);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  nlohmann::ordered_json doc;
+  try {
+    doc = nlohmann::ordered_json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw invalid_input(sidecar.string() + " (the sidecar of " + path.string() +
+                        ") is not valid JSON (at byte " + std::to_string(e.byte) + ").");
+  }
+  const auto wrong = [&](const std::string& what) {
+    return invalid_input(sidecar.string() + " (the sidecar of " + path.string() + "): " + what);
+  };
+  if (!doc.is_object() || !doc.contains("schema") || !doc["schema"].is_string()) {
+    throw wrong("expected a JSON object whose \"schema\" is \"" + std::string(kRatesSchema) + "\".");
+  }
+  const std::string schema = doc["schema"].get<std::string>();
+  if (schema_version(schema, sidecar) != 3) throw wrong("a sidecar is of schema " + std::string(kRatesSchema) + ", not " + schema + ".");
+  // rows and fnv1a64 tie the sidecar to its CSV (a journal's sidecar has neither: its CSV grows).
+  const bool has_rows = doc.contains("rows"), has_hash = doc.contains("fnv1a64");
+  if (has_rows != has_hash || (has_rows && (!doc["rows"].is_number_unsigned() || !doc["fnv1a64"].is_string()))) {
+    throw wrong("\"rows\" (a count) and \"fnv1a64\" (16 hex digits) come together.");
+  }
+  if (has_rows) {
+    const auto rows = doc["rows"].get<std::size_t>();
+    const std::string hash = doc["fnv1a64"].get<std::string>();
+    const std::string actual = hex64(file_fnv1a64(path));
+    if (rows != table.size() || hash != actual) {
+      throw wrong("it describes another CSV (" + std::to_string(rows) + " rows, fnv1a64 " + hash.substr(0, 16) + ") than " +
+                  path.string() + " (" + std::to_string(table.size()) + " rows, fnv1a64 " + actual +
+                  "): a run was stopped between writing the two, or the CSV was edited since. Rerun predict (its rows "
+                  "may be in " + partial_rates_path(target).filename().string() + "), or delete " +
+                  sidecar.filename().string() + " to read the CSV without metadata.");
+    }
+  }
+  table.metadata.emplace_back("schema", schema);
+  if (doc.contains("metadata")) {
+    if (!doc["metadata"].is_object()) throw wrong("\"metadata\" is not an object of key: value.");
+    for (const auto& item : doc["metadata"].items()) {
+      if (item.key() == "schema") continue;
+      const auto& value = item.value();
+      if (value.is_string()) {
+        table.metadata.emplace_back(item.key(), value.get<std::string>());
+      } else if (value.is_number()) {
+        table.metadata.emplace_back(item.key(), value.dump());
+      } else {
+        throw wrong("metadata \"" + item.key().substr(0, 64) + "\" is neither a string nor a number.");
+      }
+    }
+  }
+}
+
+}  // namespace
+
 RatesTable read_rates_csv(const fs::path& path) {
   csv::LineReader reader(path, "Rates file");
   RatesTable table;
@@ -329,6 +424,9 @@ RatesTable read_rates_csv(const fs::path& path) {
   if (!have_header) throw invalid_input("Rates file " + path.string() + " is empty: expected the header timestamp_ns,wx,wy,wz.");
   if (table.t_ns.empty()) throw invalid_input("Rates file " + path.string() + " has a header but no rows.");
   csv::check_timestamps(path, table.t_ns, lines, nullptr);
+  // "# key: value" lines make the file self-describing (schema 1 or 2); otherwise the metadata
+  // are in the sidecar, if there is one.
+  if (table.metadata.empty()) read_sidecar(path, table);
   return table;
 }
 
@@ -399,14 +497,17 @@ fs::path regular_rates_target(const fs::path& path) {
 }  // namespace
 
 // The rows go to `<target>.partial` (or, for a FIFO or character device the user named, to the
-// target itself), one write() each; close() renames the journal over the target.
+// target itself), one write() each; close() puts the sidecar in place, then renames the journal
+// over the target.
 struct RatesCsvWriter::Stream {
   int fd = -1;
   fs::path target;   // what close() puts in place
   fs::path journal;  // where the rows are written; == target when streaming in place
   bool in_place = false;
+  std::uint64_t hash = detail::kFnv1a64Offset;  // of every byte written, for the sidecar
 
   void write(const std::string& text) {
+    hash = detail::fnv1a64(text, hash);
     const char* p = text.data();
     std::size_t left = text.size();
     while (left > 0) {
@@ -417,32 +518,44 @@ struct RatesCsvWriter::Stream {
       left -= static_cast<std::size_t>(n);
     }
   }
-  void close() {
+  void close(const std::string& sidecar) {
     if (fd < 0) return;
     if (!in_place && ::fsync(fd) != 0) throw_write_error("flush", journal, errno);
     const int closing = std::exchange(fd, -1);
     if (::close(closing) != 0) throw_write_error("close", journal, errno);
     if (in_place) return;
+    // The sidecar first: the new CSV appears only beside its own sidecar.
+    write_file_atomically(rates_sidecar_path(target), sidecar.data(), sidecar.size());
     if (::rename(journal.c_str(), target.c_str()) != 0) throw_write_error("rename " + journal.string() + " to", target, errno);
     sync_folder(target);
+    ::unlink(rates_sidecar_path(journal).c_str());  // the journal's sidecar, now that the journal is gone
   }
   ~Stream() {
     if (fd >= 0) ::close(fd);  // not closed: the journal stays, with every row written so far
   }
 };
 
-std::string rates_csv_header(const RatesLayout& layout, const std::vector<std::pair<std::string, std::string>>& metadata) {
-  std::string s = std::string("# schema: ") + kRatesSchema + "\n";
+std::string rates_csv_header(const RatesLayout& layout) {
+  std::string s = "timestamp_ns";
+  for (const auto& name : layout.columns()) s += "," + name;
+  return s + "\n";
+}
+
+std::string rates_sidecar_text(const std::vector<std::pair<std::string, std::string>>& metadata,
+                               std::optional<std::size_t> rows, std::optional<std::uint64_t> fnv1a64) {
+  nlohmann::ordered_json doc;
+  doc["schema"] = kRatesSchema;
+  if (rows) doc["rows"] = *rows;
+  if (fnv1a64) doc["fnv1a64"] = hex64(*fnv1a64);
+  doc["metadata"] = nlohmann::ordered_json::object();
   for (const auto& [key, value] : metadata) {
     if (key.empty() || key.find_first_of(" \t:\n\r") != std::string::npos || value.find_first_of("\n\r") != std::string::npos) {
       throw invalid_input("Rates file metadata \"" + key + "\": keys are single words, values single lines.");
     }
-    if (key == "schema") continue;  // written above, for this layout
-    s += "# " + key + ": " + value + "\n";
+    if (key == "schema") continue;  // stated above, for this layout
+    doc["metadata"][key] = value;
   }
-  s += "timestamp_ns";
-  for (const auto& name : layout.columns()) s += "," + name;
-  return s + "\n";
+  return doc.dump(2) + "\n";
 }
 
 std::string format_rates_row(const RatesLayout& layout, const RatesRow& row) {
@@ -501,8 +614,8 @@ std::string format_rates_row(const RatesLayout& layout, const RatesRow& row) {
 
 RatesCsvWriter::RatesCsvWriter(const fs::path& path, const RatesLayout& layout,
                                const std::vector<std::pair<std::string, std::string>>& metadata)
-    : path_(path), layout_(layout), out_(std::make_unique<Stream>()) {
-  const std::string header = rates_csv_header(layout_, metadata);  // bad metadata before any file is made
+    : path_(path), layout_(layout), out_(std::make_unique<Stream>()), metadata_(metadata) {
+  const std::string journal_sidecar = rates_sidecar_text(metadata_);  // bad metadata before any file is made
   std::error_code error;
   const fs::file_status status = fs::status(path, error);
   if (!error && (fs::is_fifo(status) || fs::is_character_file(status))) {
@@ -524,7 +637,18 @@ RatesCsvWriter::RatesCsvWriter(const fs::path& path, const RatesLayout& layout,
       throw invalid_input("Cannot open " + out_->journal.string() + " for writing: " + std::strerror(err) + ".");
     }
   }
-  out_->write(header);
+  out_->write(rates_csv_header(layout_));
+  // The journal's sidecar after the journal is truncated and before its first row: a stale
+  // sidecar never describes new rows (a header alone is no rates file).
+  if (!out_->in_place) {
+    try {
+      write_file_atomically(rates_sidecar_path(out_->journal), journal_sidecar.data(), journal_sidecar.size());
+    } catch (const Error&) {
+      ::close(std::exchange(out_->fd, -1));
+      ::unlink(out_->journal.c_str());  // no destructor runs after a throwing constructor
+      throw;
+    }
+  }
 }
 
 RatesCsvWriter::~RatesCsvWriter() {
@@ -533,13 +657,16 @@ RatesCsvWriter::~RatesCsvWriter() {
   if (out_ && out_->fd >= 0 && !out_->in_place && rows_ == 0) {
     ::close(std::exchange(out_->fd, -1));
     ::unlink(out_->journal.c_str());
+    ::unlink(rates_sidecar_path(out_->journal).c_str());
   }
 }
 
 const fs::path& RatesCsvWriter::journal() const { return out_->journal; }
 
+bool RatesCsvWriter::has_sidecar() const { return !out_->in_place; }
+
 void RatesCsvWriter::close() {
-  if (out_) out_->close();
+  if (out_) out_->close(rates_sidecar_text(metadata_, rows_, out_->hash));
 }
 
 void RatesCsvWriter::write(const RatesRow& row) {

@@ -133,10 +133,10 @@ Quaternion normalised(const Quaternion& q) {
 }  // namespace
 
 RatesExportFormat rates_export_format_from_string(const std::string& name) {
-  if (name == "gyroflow") return RatesExportFormat::Gyroflow;
+  if (name == "gcsv" || name == "gyroflow") return RatesExportFormat::Gyroflow;  // the file format's name, or the tool's
   if (name == "euroc-imu") return RatesExportFormat::EurocImu;
   if (name == "tum") return RatesExportFormat::Tum;
-  throw invalid_input("unknown export format '" + name + "'; expected one of gyroflow, euroc-imu, tum");
+  throw invalid_input("unknown export format '" + name + "'; expected one of gcsv, gyroflow, euroc-imu, tum");
 }
 
 const char* to_string(RatesExportFormat format) {
@@ -173,7 +173,7 @@ std::string rates_to_euroc_imu(const RatesTable& table, const RatesExportOptions
                                const std::string& source, RatesExportSummary& summary) {
   const Group g = read_group(table, options, source, summary);
   if (g.frame != "body") {
-    const std::string stated = g.frame ? "'# frame" + options.head_suffix + ": " + *g.frame + "'" : "no '# frame:' line";
+    const std::string stated = g.frame ? "frame" + options.head_suffix + ": " + *g.frame : "no frame stated";
     if (!options.allow_camera_frame) {
       throw invalid_input(source + ": the rates are not stated to be in the body (IMU) frame (" + stated +
                           "), and EuRoC's w_RS_S is; predict with the sequence's cam0 T_BS to get body rates, or "
@@ -226,18 +226,28 @@ std::string rates_to_tum(const RatesTable& table, const RatesExportOptions& opti
   return out;
 }
 
-RatesExportSummary export_rates(const std::filesystem::path& rates, const std::filesystem::path& output,
-                                RatesExportFormat format, const RatesExportOptions& options) {
-  const RatesTable table = read_rates_csv(rates);
-  RatesExportSummary summary;
-  std::string text;
+std::string rates_export_text(const RatesTable& table, RatesExportFormat format, const RatesExportOptions& options,
+                              const std::string& source, RatesExportSummary& summary) {
+  summary.notes.insert(summary.notes.end(), table.notes.begin(), table.notes.end());
   switch (format) {
-    case RatesExportFormat::Gyroflow: text = rates_to_gcsv(table, options, rates.string(), summary); break;
-    case RatesExportFormat::EurocImu: text = rates_to_euroc_imu(table, options, rates.string(), summary); break;
-    case RatesExportFormat::Tum: text = rates_to_tum(table, options, rates.string(), summary); break;
+    case RatesExportFormat::Gyroflow: return rates_to_gcsv(table, options, source, summary);
+    case RatesExportFormat::EurocImu: return rates_to_euroc_imu(table, options, source, summary);
+    case RatesExportFormat::Tum: return rates_to_tum(table, options, source, summary);
   }
+  throw runtime_error("Unknown rates export format.");
+}
+
+RatesExportSummary export_rates(const RatesTable& table, const std::string& source, const std::filesystem::path& output,
+                                RatesExportFormat format, const RatesExportOptions& options) {
+  RatesExportSummary summary;
+  const std::string text = rates_export_text(table, format, options, source, summary);
   write_file_atomically(output, text.data(), text.size());
   return summary;
+}
+
+RatesExportSummary export_rates(const std::filesystem::path& rates, const std::filesystem::path& output,
+                                RatesExportFormat format, const RatesExportOptions& options) {
+  return export_rates(read_rates_csv(rates), rates.string(), output, format, options);
 }
 
 }  // namespace inertialnet

@@ -1,12 +1,15 @@
 #include "inertialnet/pipeline/predict.hpp"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cmath>
 #include <optional>
 
+#include "inertialnet/io/bag.hpp"
+#include "inertialnet/io/calibration_file.hpp"
 #include "inertialnet/io/camera.hpp"
 #include "inertialnet/models/flow_consistency.hpp"
 #include "inertialnet/runtime/device_selection.hpp"
@@ -35,7 +38,7 @@ const char* kNoWeightsHelp =
 // because a video decodes in order from its start and the pipeline starts at frame 0 again.
 std::pair<Frame, Frame> first_decodable_pair(const PredictSettings& s) {
   auto source =
-      open_frame_source(s.sequence, s.rate_hz > 0 ? std::optional<double>(s.rate_hz) : std::nullopt, s.camera);
+      open_frame_source(s.sequence, s.rate_hz > 0 ? std::optional<double>(s.rate_hz) : std::nullopt, s.camera, s.bag);
   std::optional<Frame> previous;
   std::optional<Error> first_error;
   for (std::size_t i = 0; i < source->size(); ++i) {
@@ -51,6 +54,117 @@ std::pair<Frame, Frame> first_decodable_pair(const PredictSettings& s) {
   }
   if (first_error) throw *first_error;
   throw invalid_input(source->description() + " has no two consecutive frames that decode");
+}
+
+// The camera of the geometric head and the rotation into the body frame, from the settings'
+// sources in their order of precedence: --calibration (each --fx … replacing one of its values),
+// else --fx … alone (an ideal pinhole, what is not given assumed), else the sequence's own
+// sensor.yaml. Every value assumed or replaced is a note.
+struct CameraChoice {
+  CameraIntrinsics camera;
+  std::optional<Mat3> camera_to_body;
+};
+
+std::string pixels_text(double v) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%.10g", v);
+  return text;
+}
+
+CameraChoice choose_camera(const PredictSettings& s, const FrameSource& source, std::vector<std::string>& notes) {
+  // An fx or fy of 0 is never a focal length: "not given" (the Python binding's default).
+  const std::optional<double> fx = s.fx && *s.fx != 0 ? s.fx : std::nullopt;
+  const std::optional<double> fy = s.fy && *s.fy != 0 ? s.fy : std::nullopt;
+  const std::optional<CameraCalibration> own = source.calibration();
+  const bool bag = is_bag(s.sequence);
+  const std::string own_name = bag ? "CameraInfo" : s.camera + "/sensor.yaml";
+  // A calibration without extrinsics (a bag's CameraInfo: T_BS all zero) leaves the rates in the
+  // camera frame, as for an image folder with --fx.
+  const bool own_extrinsic = own && own->T_BS != std::array<double, 16>{};
+  CameraChoice choice;
+  if (!s.calibration.empty()) {
+    CalibrationFile file = read_calibration_file(s.calibration, s.calibration_camera);
+    notes.insert(notes.end(), file.notes.begin(), file.notes.end());
+    const std::string name = s.calibration.string();
+    if (own) notes.push_back("--calibration " + name + " replaces " + source.description() + "'s " + own_name + ".");
+    const HostImage first = first_decodable_pair(s).first.image;
+    choice.camera = fit_to_frames(file.camera, first.width, first.height, "--calibration " + name, notes);
+    // Values given one by one replace the file's: a focal length refined since, say.
+    const auto replace = [&notes, &name](double& value, const std::optional<double>& given, const char* flag) {
+      if (!given) return;
+      notes.push_back(std::string(flag) + " " + pixels_text(*given) + " replaces " + name + "'s " + (flag + 2) + " " +
+                      pixels_text(value) + ".");
+      value = *given;
+    };
+    replace(choice.camera.fx, fx, "--fx");
+    replace(choice.camera.fy, fy, "--fy");
+    replace(choice.camera.cx, s.cx, "--cx");
+    replace(choice.camera.cy, s.cy, "--cy");
+    choice.camera.validate();
+    // A EuRoC sequence's body frame is its sensor.yaml's T_BS, for eval as for predict (eval refuses
+    // another extrinsic for it); an image folder or a video takes the file's.
+    if (own_extrinsic) {
+      choice.camera_to_body = own->rotation_BS();
+      if (file.camera_imu) {
+        notes.push_back("the rates are turned into the body frame with " + source.description() + "'s " + own_name +
+                        " T_BS, not with " + file.camera_imu->source + ".");
+      }
+    } else if (file.camera_imu) {
+      const Mat3 r = file.camera_imu->rotation_cam_imu();  // IMU → camera; its transpose turns back
+      choice.camera_to_body = Mat3{r[0], r[3], r[6], r[1], r[4], r[7], r[2], r[5], r[8]};
+    }
+    return choice;
+  }
+  if (fx || fy) {
+    const HostImage first = first_decodable_pair(s).first.image;
+    CameraIntrinsics& camera = choice.camera;
+    camera.width = first.width;
+    camera.height = first.height;
+    camera.fx = fx ? *fx : *fy;
+    camera.fy = fy ? *fy : *fx;
+    camera.cx = s.cx ? *s.cx : (first.width - 1) / 2.0;
+    camera.cy = s.cy ? *s.cy : (first.height - 1) / 2.0;
+    // Each guess changes the rates: say it, so that a wrong one is found (fy = fx alone cost a
+    // test video ten times its error).
+    if (!fy) notes.push_back("--fy not given: assumed fy = fx = " + pixels_text(camera.fy) + " px.");
+    if (!fx) notes.push_back("--fx not given: assumed fx = fy = " + pixels_text(camera.fx) + " px.");
+    if (!s.cx) notes.push_back("--cx not given: assumed the image centre, cx = " + pixels_text(camera.cx) + " px.");
+    if (!s.cy) notes.push_back("--cy not given: assumed the image centre, cy = " + pixels_text(camera.cy) + " px.");
+    if (own) {
+      notes.push_back("--fx/--fy describe an ideal pinhole camera that replaces " + source.description() + "'s " +
+                      own_name + " (its distortion and T_BS are not used; --calibration " + own_name +
+                      " --fx … would replace only the values given).");
+    }
+    camera.validate();
+    return choice;
+  }
+  if (s.cx || s.cy) {
+    throw invalid_input("--cx and --cy need a focal length: give --fx (and --fy), or --calibration FILE.");
+  }
+  if (!own) {
+    throw invalid_input("the geometric head needs the camera: " + source.description() + " has no " +
+                        (bag ? "CameraInfo topic beside its images (--camera-info-topic)" : own_name) +
+                        "; give --calibration FILE (EuRoC sensor.yaml, Kalibr camchain, OpenCV YAML/XML) or --fx "
+                        "(and --fy --cx --cy)");
+  }
+  try {
+    choice.camera = CameraIntrinsics::from_calibration(*own);
+  } catch (const Error& e) {
+    // The library's message names the model or the coefficients; say which file holds them.
+    if (e.kind() != ErrorKind::InvalidInput) throw;
+    throw invalid_input(source.description() + ": " + own_name + ": " + e.what());
+  }
+  // The geometric head allocates per pixel of the calibrated size: compare it with the images
+  // before, so that a wrong resolution is a clear message, not gigabytes asked for.
+  const HostImage first = first_decodable_pair(s).first.image;
+  if (first.width != choice.camera.width || first.height != choice.camera.height) {
+    throw invalid_input(source.description() + ": " + own_name + " gives the resolution " +
+                        std::to_string(choice.camera.width) + "x" + std::to_string(choice.camera.height) +
+                        ", which does not match the images (" + std::to_string(first.width) + "x" +
+                        std::to_string(first.height) + ").");
+  }
+  if (own_extrinsic) choice.camera_to_body = own->rotation_BS();
+  return choice;
 }
 
 }  // namespace
@@ -84,43 +198,14 @@ Prediction::Prediction(const PredictSettings& s) : settings_(s) {
   processor_.geometric.readout_time_s = s.readout_time_s;
   require_flow_check_setting(s.flow_check_px);
   processor_.flow_check_px = s.flow_check_px;
-  source_ = open_frame_source(s.sequence, s.rate_hz > 0 ? std::optional<double>(s.rate_hz) : std::nullopt, s.camera);
+  source_ = open_frame_source(s.sequence, s.rate_hz > 0 ? std::optional<double>(s.rate_hz) : std::nullopt, s.camera, s.bag);
   notes_ = source_->notes();
+  // Where the source's calibration comes from, for the messages below.
+  const std::string calibration_file = is_bag(s.sequence) ? "its CameraInfo" : s.camera + "/sensor.yaml";
   if (processor_.geometric_head) {
-    const bool given = s.fx > 0 || s.fy > 0;
-    if (given) {
-      CameraIntrinsics camera;
-      const HostImage first = first_decodable_pair(s).first.image;
-      camera.width = first.width;
-      camera.height = first.height;
-      camera.fx = s.fx;
-      camera.fy = s.fy > 0 ? s.fy : s.fx;
-      camera.cx = s.cx > 0 ? s.cx : (first.width - 1) / 2.0;
-      camera.cy = s.cy > 0 ? s.cy : (first.height - 1) / 2.0;
-      camera.validate();
-      processor_.camera = camera;
-    } else if (const auto calibration = source_->calibration()) {
-      try {
-        processor_.camera = CameraIntrinsics::from_calibration(*calibration);
-      } catch (const Error& e) {
-        // The library's message names the model or the coefficients; say which file holds them.
-        if (e.kind() != ErrorKind::InvalidInput) throw;
-        throw invalid_input(source_->description() + ": " + s.camera + "/sensor.yaml: " + e.what());
-      }
-      // The geometric head allocates per pixel of the calibrated size: compare it with the
-      // images before, so that a wrong resolution is a clear message, not gigabytes asked for.
-      const HostImage first = first_decodable_pair(s).first.image;
-      if (first.width != processor_.camera->width || first.height != processor_.camera->height) {
-        throw invalid_input(source_->description() + ": " + s.camera + "/sensor.yaml gives the resolution " +
-                            std::to_string(processor_.camera->width) + "x" + std::to_string(processor_.camera->height) +
-                            ", which does not match the images (" + std::to_string(first.width) + "x" +
-                            std::to_string(first.height) + ").");
-      }
-      processor_.camera_to_body = calibration->rotation_BS();
-    } else {
-      throw invalid_input("the geometric head needs the camera: " + source_->description() +
-                          " has no " + s.camera + "/sensor.yaml; give --fx (and --fy --cx --cy)");
-    }
+    const CameraChoice choice = choose_camera(s, *source_, notes_);
+    processor_.camera = choice.camera;
+    processor_.camera_to_body = choice.camera_to_body;
   }
   processor_.keep_flow = s.keep_flow;
 

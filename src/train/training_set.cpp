@@ -11,7 +11,9 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/float16.hpp"
+#include "inertialnet/io/bag.hpp"
 #include "inertialnet/io/euroc.hpp"
+#include "inertialnet/io/frame_source.hpp"
 #include "inertialnet/io/image_io.hpp"
 #include "inertialnet/models/dis_flow.hpp"
 #include "inertialnet/models/flownet.hpp"
@@ -58,7 +60,7 @@ std::string cache_key(const std::filesystem::path& root, const EurocSequence& se
     key << ":medium";  // DisFlow's preset
   }
   key << '|' << o.weights_id << "|resize:area-or-bilinear|" << o.width << 'x' << o.height << '|'
-      << sequence.frames.size();
+      << sequence.frames.size() << '|' << o.bag_input.bag.image;  // a bag's frames: its file and topic
   for (const auto& frame : sequence.frames) {
     std::error_code size_error, time_error;
     const auto size = std::filesystem::file_size(frame.path, size_error);
@@ -170,9 +172,13 @@ std::vector<std::uint16_t> TrainingSet::pair_flows(const EurocSequence& sequence
                                         *options_.flownet_weights);
     queue = options_.device->create_queue();
   }
-  HostImage previous = load_rgb_image(sequence.frames[0].path);
+  // A bag's frames are decoded in order through its frame source; a folder's are files.
+  std::unique_ptr<FrameSource> bag;
+  if (is_bag(root)) bag = open_frame_source(root, std::nullopt, "cam0", options_.bag_input.bag);
+  auto load = [&](std::size_t k) { return bag ? bag->decode(k) : load_rgb_image(sequence.frames[k].path); };
+  HostImage previous = load(0);
   for (std::size_t k = 1; k <= pairs; ++k) {
-    HostImage current = load_rgb_image(sequence.frames[k].path);
+    HostImage current = load(k);
     if (current.width != previous.width || current.height != previous.height) {
       throw invalid_input(sequence.frames[k].path.string() + " is " + std::to_string(current.width) + "x" +
                           std::to_string(current.height) + " but the frame before it is " +
@@ -225,11 +231,18 @@ std::vector<std::uint16_t> TrainingSet::pair_flows(const EurocSequence& sequence
 }
 
 std::size_t TrainingSet::add_sequence(const std::filesystem::path& root, const FlowProgress& progress) {
-  if (!is_euroc_folder(root)) {
-    throw invalid_input(root.string() + " is not a EuRoC sequence (no mav0/ with cam0/ and imu0/); training needs "
-                        "the IMU for its targets");
+  const bool bag = is_bag(root);
+  if (!bag && !is_euroc_folder(root)) {
+    throw invalid_input(root.string() + " is not a EuRoC sequence (no mav0/ with cam0/ and imu0/) or a ROS bag; "
+                        "training needs the IMU for its targets");
   }
-  const EurocSequence sequence = read_euroc(root);
+  if (!bag && (options_.bag_input.bag.any() || options_.bag_input.camera_imu)) {
+    // A EuRoC sequence's topics and rotation are its folders and sensor.yaml: said, not ignored.
+    throw invalid_input("--image-topic, --imu-topic, --camera-info-topic and --T-cam-imu are for ROS bags; " + root.string() +
+                        " is a EuRoC sequence (its camera rotation is cam0/sensor.yaml's T_BS).");
+  }
+  const EurocSequence sequence = bag ? read_sequence_with_imu(root, options_.bag_input) : read_euroc(root);
+  for (const auto& note : sequence.notes) notes_.push_back(sequence.name + ": " + note);
   if (sequence.frames.size() < 2) throw invalid_input(root.string() + " has fewer than two frames");
   SyncOptions sync;
   sync.target = options_.target;
@@ -240,7 +253,7 @@ std::size_t TrainingSet::add_sequence(const std::filesystem::path& root, const F
   for (const auto& note : truth.notes) notes_.push_back(sequence.name + ": " + note);
   notes_.push_back(sequence.name + ": targets bias-corrected from " + to_string(truth.bias_source));
   Mat3 camera_to_body{1, 0, 0, 0, 1, 0, 0, 0, 1};
-  if (sequence.camera) {
+  if (sequence.camera || sequence.imu_to_camera) {
     const Mat3 r = imu_to_camera_rotation(sequence);  // R_CS: IMU → camera; its transpose back
     camera_to_body = {r[0], r[3], r[6], r[1], r[4], r[7], r[2], r[5], r[8]};
   }

@@ -348,7 +348,7 @@ expect_match("--T-cam-imu excludes --camchain")
 run(2 ${CLI} eval rates.csv seq ${imu} --T-cam-imu "1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1")
 expect_match("seq is a EuRoC sequence, whose camera rotation comes from mav0/cam0/sensor.yaml's T_BS")
 run(2 ${CLI} calibrate-time ${folder} ${imu})
-expect_match("calibrate-time: seq/mav0/cam0/data has no camera calibration to predict with; give --fx")
+expect_match("calibrate-time: seq/mav0/cam0/data has no camera calibration to predict with; give --calibration FILE or --fx")
 # train's camera-IMU offset: a number of seconds, finite, within an hour.
 run(2 ${CLI} train --train seq --val seq -o head.safetensors --time-offset nan)
 expect_match("--time-offset should be a number of seconds")

@@ -1,5 +1,5 @@
-// The rates CSV (schema inertialnet.rates/2: timestamp_ns,wx,wy,wz,status[,…]): round trip,
-// statuses, schema-1 files, the journal a run writes, and errors.
+// The rates CSV (schema inertialnet.rates/3: timestamp_ns,wx,wy,wz,status[,…] and its sidecar):
+// round trip, statuses, schema-1 and -2 files, the sidecar, the journal a run writes, and errors.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -62,9 +62,7 @@ TEST(RatesCsv, RoundTripIsExactForFloats) {
 
   std::ifstream in(path);
   std::string header;
-  std::getline(in, header);
-  EXPECT_EQ(header, "# schema: inertialnet.rates/2");
-  std::getline(in, header);
+  std::getline(in, header);  // the first line is the header (schema 3: metadata in the sidecar)
   EXPECT_EQ(header, "timestamp_ns,wx,wy,wz,status,wx_geometric,wy_geometric,wz_geometric");
 }
 
@@ -157,14 +155,17 @@ TEST(RatesCsv, MetadataRoundTripAndOldFiles) {
   write_rates_csv(path, t);
   const RatesTable back = read_rates_csv(path);
   auto expected = t.metadata;
-  expected.insert(expected.begin(), {"schema", "inertialnet.rates/2"});
+  expected.insert(expected.begin(), {"schema", "inertialnet.rates/3"});
   EXPECT_EQ(back.metadata, expected);
   EXPECT_EQ(back.meta("frame").value_or(""), "body");
   EXPECT_FALSE(back.meta("readout_time_s").has_value());
   EXPECT_NEAR(back.meta_number("time_offset_s").value_or(0), 0.04, 1e-15);
-  EXPECT_EQ(rates_csv_header(rates_layout({"", "_g"}), {{"frame", "camera"}}),
-            "# schema: inertialnet.rates/2\n# frame: camera\ntimestamp_ns,wx,wy,wz,status,wx_g,wy_g,wz_g,status_g\n");
-  EXPECT_THROW(rates_csv_header({}, {{"two words", "x"}}), Error);
+  EXPECT_EQ(rates_csv_header(rates_layout({"", "_g"})), "timestamp_ns,wx,wy,wz,status,wx_g,wy_g,wz_g,status_g\n");
+  EXPECT_THROW(rates_sidecar_text({{"two words", "x"}}), Error);
+  // Schema 2 (today's files before the sidecar): the metadata in comment lines, read as before.
+  const auto two = write_text(dir, "# schema: inertialnet.rates/2\n# frame: camera\ntimestamp_ns,wx,wy,wz,status\n5,1,2,3,ok\n");
+  EXPECT_EQ(read_rates_csv(two).metadata,
+            (std::vector<std::pair<std::string, std::string>>{{"schema", "inertialnet.rates/2"}, {"frame", "camera"}}));
 
   const auto old = write_text(dir, "# written by an older predict\ntimestamp_ns,wx,wy,wz\n5,1,2,3\n");
   const RatesTable o = read_rates_csv(old);
@@ -218,10 +219,10 @@ TEST(RatesCsv, StatusErrorsNameTheLine) {
   EXPECT_TRUE(contains(m, "line 2: status is \"\"")) << m;
   m = msg("timestamp_ns,wx,wy,wz\n1,,0,0\n");  // schema 1: no status to explain an empty rate
   EXPECT_TRUE(contains(m, "line 2")) << m;
-  m = msg("# schema: inertialnet.rates/3\ntimestamp_ns,wx,wy,wz,status\n1,0,0,0,ok\n");
+  m = msg("# schema: inertialnet.rates/4\ntimestamp_ns,wx,wy,wz,status\n1,0,0,0,ok\n");
   EXPECT_TRUE(contains(m, "newer than this version reads")) << m;
   m = msg("# schema: something/else\ntimestamp_ns,wx,wy,wz,status\n1,0,0,0,ok\n");
-  EXPECT_TRUE(contains(m, "expected inertialnet.rates/2")) << m;
+  EXPECT_TRUE(contains(m, "expected inertialnet.rates/3")) << m;
 }
 
 // A run's rows go to <name>.partial, one write each, and replace <name> only when the run
@@ -249,8 +250,105 @@ TEST(RatesCsv, WriterJournalLeavesGoodOutputUntilClosed) {
   }
   EXPECT_EQ(read_rates_csv(path).t_ns, std::vector<std::int64_t>{30});
   EXPECT_FALSE(std::filesystem::exists(partial_rates_path(path)));
-  // Nothing else is left beside it.
+  // Nothing else is left beside it but its sidecar.
   std::size_t files = 0;
   for (const auto& entry : std::filesystem::directory_iterator(dir.path())) files += entry.is_regular_file();
-  EXPECT_EQ(files, 1u);
+  EXPECT_EQ(files, 2u);
+  EXPECT_TRUE(std::filesystem::exists(rates_sidecar_path(path)));
+}
+
+namespace {
+std::string file_text(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+}  // namespace
+
+// Schema 3: the CSV's first line is its header (pandas' and numpy's defaults read it), the
+// metadata are in the sidecar <file>.json, which states the CSV's row count and hash (issue 21:
+// the "# key: value" lines stood before the header).
+TEST(RatesCsv, SidecarHoldsTheMetadata) {
+  te::TempDir dir("rates_sidecar");
+  const auto path = dir.path() / "rates.csv";
+  {
+    RatesCsvWriter writer(path, {}, {{"frame", "body"}, {"time_offset_s", "0.04"}});
+    EXPECT_TRUE(writer.has_sidecar());
+    writer.write({10, {0.1, 0.2, 0.3}, "ok", {}, {}});
+    // The journal has its own sidecar from its first row on: eval reads a stopped run's rows
+    // with their frame.
+    const RatesTable journal = read_rates_csv(writer.journal());
+    EXPECT_EQ(journal.meta("frame").value_or(""), "body");
+    EXPECT_TRUE(journal.notes.empty());
+    writer.write({20, {0.4, 0.5, 0.6}, "ok", {}, {}});
+    writer.close();
+  }
+  const std::string csv = file_text(path);
+  EXPECT_EQ(csv.substr(0, csv.find('\n')), "timestamp_ns,wx,wy,wz,status");
+  const std::string sidecar = file_text(rates_sidecar_path(path));
+  EXPECT_TRUE(contains(sidecar, "\"schema\": \"inertialnet.rates/3\"")) << sidecar;
+  EXPECT_TRUE(contains(sidecar, "\"rows\": 2")) << sidecar;
+  EXPECT_TRUE(contains(sidecar, "\"time_offset_s\": \"0.04\"")) << sidecar;
+  EXPECT_FALSE(std::filesystem::exists(rates_sidecar_path(partial_rates_path(path))));
+  const RatesTable r = read_rates_csv(path);
+  EXPECT_EQ(r.metadata, (std::vector<std::pair<std::string, std::string>>{
+                            {"schema", "inertialnet.rates/3"}, {"frame", "body"}, {"time_offset_s", "0.04"}}));
+  EXPECT_TRUE(r.notes.empty());
+
+  // A run killed between the sidecar's rename and the CSV's: the new sidecar beside the old CSV
+  // is refused by its row count and hash, naming both files.
+  const std::string good_sidecar = sidecar;
+  std::ofstream(rates_sidecar_path(path)) << rates_sidecar_text({{"frame", "camera"}}, 2, 12345);
+  std::string m = invalid_input_message([&] { read_rates_csv(path); });
+  EXPECT_TRUE(contains(m, "rates.csv.json (the sidecar of")) << m;
+  EXPECT_TRUE(contains(m, "describes another CSV")) << m;
+  // An edit of the CSV (same rows, other bytes) is caught by the hash.
+  std::ofstream(rates_sidecar_path(path)) << good_sidecar;
+  std::ofstream(path) << "timestamp_ns,wx,wy,wz,status\n10,0.1,0.2,0.3,ok\n20,0.4,0.5,0.7,ok\n";
+  m = invalid_input_message([&] { read_rates_csv(path); });
+  EXPECT_TRUE(contains(m, "describes another CSV (2 rows")) << m;
+  // Newer sidecars, other documents and broken JSON: refused with the sidecar's name.
+  std::ofstream(rates_sidecar_path(path)) << "{\"schema\": \"inertialnet.rates/4\"}";
+  EXPECT_TRUE(contains(invalid_input_message([&] { read_rates_csv(path); }), "newer than this version reads"));
+  std::ofstream(rates_sidecar_path(path)) << "{\"schema\": \"inertialnet.rates/3\", \"metadata\": {\"frame\": [1]}}";
+  EXPECT_TRUE(contains(invalid_input_message([&] { read_rates_csv(path); }), "neither a string nor a number"));
+  std::ofstream(rates_sidecar_path(path)) << "{\"schema\": ";
+  EXPECT_TRUE(contains(invalid_input_message([&] { read_rates_csv(path); }), "is not valid JSON"));
+  // Without a sidecar: no metadata, and a note saying so.
+  std::filesystem::remove(rates_sidecar_path(path));
+  const RatesTable bare = read_rates_csv(path);
+  EXPECT_TRUE(bare.metadata.empty());
+  ASSERT_EQ(bare.notes.size(), 1u);
+  EXPECT_TRUE(contains(bare.notes[0], "states no metadata (no sidecar rates.csv.json")) << bare.notes[0];
+  // A file that states its metadata itself (schema 2) does not read a sidecar beside it.
+  std::ofstream(rates_sidecar_path(path)) << "{\"schema\": \"inertialnet.rates/4\"}";
+  const RatesTable two = read_rates_csv(write_text(dir, "# schema: inertialnet.rates/2\n# frame: camera\ntimestamp_ns,wx,wy,wz\n5,1,2,3\n"));
+  EXPECT_EQ(two.meta("frame").value_or(""), "camera");
+}
+
+// A run that fails keeps the previous CSV and its sidecar as they were (issue 21: the pair must
+// never be mixed).
+TEST(RatesCsv, FailedRunKeepsThePreviousPair) {
+  te::TempDir dir("rates_sidecar_keep");
+  const auto path = dir.path() / "rates.csv";
+  {
+    RatesCsvWriter writer(path, {}, {{"frame", "body"}});
+    writer.write({10, {0.1, 0.2, 0.3}, "ok", {}, {}});
+    writer.close();
+  }
+  const std::string csv = file_text(path), sidecar = file_text(rates_sidecar_path(path));
+  {
+    RatesCsvWriter writer(path, {}, {{"frame", "camera"}});
+    writer.write({10, {0.7, 0.8, 0.9}, "ok", {}, {}});
+    // Destroyed without close().
+  }
+  EXPECT_EQ(file_text(path), csv);
+  EXPECT_EQ(file_text(rates_sidecar_path(path)), sidecar);
+  EXPECT_EQ(read_rates_csv(path).meta("frame").value_or(""), "body");
+  EXPECT_EQ(read_rates_csv(partial_rates_path(path)).meta("frame").value_or(""), "camera");
+  {
+    RatesCsvWriter writer(path, {}, {{"frame", "camera"}});  // fails before its first row
+  }
+  EXPECT_FALSE(std::filesystem::exists(partial_rates_path(path)));
+  EXPECT_FALSE(std::filesystem::exists(rates_sidecar_path(partial_rates_path(path))));
+  EXPECT_EQ(file_text(rates_sidecar_path(path)), sidecar);
 }

@@ -28,10 +28,10 @@ struct CalibrateTimeOptions {
 // Weight-free rates of every frame pair, set up as `inertialnet predict SEQ` sets them up (the
 // library's Prediction: DIS flow + geometric head, in the body frame when cam0 gives T_BS).
 RatesTable predict_weight_free(const CalibrateTimeOptions& o, const EurocSequence& seq, const GlobalOptions& global) {
-  const bool given = o.camera.fx > 0 || o.camera.fy > 0;
+  const bool given = o.camera.fx || o.camera.fy || !o.camera.calibration.file.empty();
   if (!seq.camera && !given) {
     throw invalid_input("calibrate-time: " + o.sequence + (seq.mav0.empty() ? " has no camera calibration" : " has no " + o.input.camera + "/sensor.yaml") +
-                        " to predict with; give --fx (and --fy --cx --cy), or a rates file.");
+                        " to predict with; give --calibration FILE or --fx (and --fy --cx --cy), or a rates file.");
   }
   PredictSettings settings;
   settings.sequence = o.sequence;
@@ -39,11 +39,15 @@ RatesTable predict_weight_free(const CalibrateTimeOptions& o, const EurocSequenc
   settings.fy = o.camera.fy;
   settings.cx = o.camera.cx;
   settings.cy = o.camera.cy;
+  settings.calibration = o.camera.calibration.file;
+  settings.calibration_camera = o.camera.calibration.camera;
   settings.rate_hz = o.input.rate_hz;
   settings.camera = o.input.camera;
+  settings.bag = o.input.bag;
   settings.device = global.device;
   settings.no_cache = global.no_cache;
   Prediction prediction(settings);
+  for (const auto& note : prediction.notes()) info("note: " + note);
   RatesTable table;
   table.metadata = prediction.csv_metadata();
   table.status_names = {"status"};
@@ -66,7 +70,7 @@ RatesTable predict_weight_free(const CalibrateTimeOptions& o, const EurocSequenc
 
 Command register_calibrate_time(CLI::App& app, const GlobalOptions& global) {
   auto o = std::make_shared<CalibrateTimeOptions>();
-  app.add_option("sequence", o->sequence, "EuRoC-layout sequence with mav0/imu0, or an image folder or video with --imu")
+  app.add_option("sequence", o->sequence, "EuRoC-layout sequence with mav0/imu0, an image folder or video with --imu, or a ROS bag")
       ->required()
       ->check(CLI::ExistingPath);
   app.add_option("rates", o->rates, "rates CSV written by predict (default: predict weight-free now)")
@@ -81,6 +85,7 @@ Command register_calibrate_time(CLI::App& app, const GlobalOptions& global) {
     options.estimate_time_offset = true;
     options.time_offset_search.range_s = o->range;
     if (!o->head.empty()) options.head_suffix = "_" + o->head;
+    o->input.calibration = o->camera.calibration;  // one --calibration: the camera and its extrinsic
     options.input = imu_sequence_options(o->input);
     const EurocSequence seq = read_sequence_with_imu(o->sequence, options.input);
     for (const auto& note : seq.notes) info(note);
@@ -109,6 +114,11 @@ Command register_calibrate_time(CLI::App& app, const GlobalOptions& global) {
     if (!o->input.imu_units.empty()) input += " --imu-units " + o->input.imu_units;
     if (!o->input.T_cam_imu.empty()) input += " --T-cam-imu '" + o->input.T_cam_imu + "'";
     if (!o->input.camchain.empty()) input += " --camchain " + o->input.camchain;
+    if (!o->input.calibration.file.empty()) input += " --calibration " + o->input.calibration.file;
+    if (!o->input.calibration.camera.empty()) input += " --calibration-camera " + o->input.calibration.camera;
+    if (!o->input.bag.image.empty()) input += " --image-topic " + o->input.bag.image;
+    if (!o->input.bag.imu.empty()) input += " --imu-topic " + o->input.bag.imu;
+    if (!o->input.bag.camera_info.empty()) input += " --camera-info-topic " + o->input.bag.camera_info;
     std::cout << "apply it with: inertialnet eval RATES.csv " << o->sequence << input << " --time-offset " << e.offset_s
               << "\n";
     for (const auto& w : report.warnings) warning(w);

@@ -25,7 +25,7 @@ struct EvalCliOptions {
 Command register_eval(CLI::App& app, const GlobalOptions&) {
   auto o = std::make_shared<EvalCliOptions>();
   app.add_option("rates", o->rates, "rates CSV written by predict")->required()->check(CLI::ExistingFile);
-  app.add_option("sequence", o->sequence, "EuRoC sequence with mav0/imu0, or an image folder or video with --imu")
+  app.add_option("sequence", o->sequence, "EuRoC sequence with mav0/imu0, an image folder or video with --imu, or a ROS bag")
       ->required()
       ->check(CLI::ExistingPath);
   app.add_option("--plot", o->plot,
@@ -47,6 +47,7 @@ Command register_eval(CLI::App& app, const GlobalOptions&) {
   app.add_flag("--camera-frame", o->camera_frame,
                "rotate the gyro into the camera frame with cam0's T_BS (or --T-cam-imu / --camchain)");
   add_imu_options(app, o->input);
+  add_calibration_options(app, o->input.calibration);
   app.add_option("--head", o->head, "compare columns wx<_HEAD>…, e.g. --head geometric");
   auto* json = app.add_flag("--json", o->json, "machine-readable report (schema inertialnet.eval/1, docs/cli.md)");
   app.add_flag("--series", o->series, "include the per-frame values in the --json report")->needs(json);
@@ -74,7 +75,7 @@ Command register_eval(CLI::App& app, const GlobalOptions&) {
       // The plot and its histogram beside it never replace what eval reads.
       const std::string hist = histogram_path(o->plot).string();
       std::vector<std::string> inputs = {o->rates, o->sequence};
-      for (const std::string& file : {o->input.imu, o->input.camchain}) {
+      for (const std::string& file : {o->input.imu, o->input.camchain, o->input.calibration.file}) {
         if (!file.empty()) inputs.push_back(file);
       }
       check_distinct_outputs({{o->plot, "--plot"}, {hist, "--plot's histogram"}}, inputs);

@@ -21,10 +21,10 @@ Command register_export(CLI::App& app, const GlobalOptions&) {
   auto o = std::make_shared<ExportCliOptions>();
   app.add_option("rates", o->rates, "rates CSV written by predict")->required()->check(CLI::ExistingFile);
   app.add_option("--format", o->format,
-                 "gyroflow (.gcsv gyro log), euroc-imu (imu0/data.csv layout, gyro only) or tum (orientation "
+                 "gcsv or gyroflow (Gyroflow's .gcsv gyro log), euroc-imu (imu0/data.csv layout, gyro only) or tum (orientation "
                  "trajectory integrated from the rates, for evo)")
       ->required()
-      ->transform(choice("format", {"gyroflow", "euroc-imu", "tum"}));
+      ->transform(choice("format", {"gcsv", "gyroflow", "euroc-imu", "tum"}));
   app.add_option("-o,--output", o->output, "file to write (replaced whole or left as it was; folders created as needed)")
       ->required();
   app.add_option("--head", o->head, "export columns wx<_HEAD>…, e.g. --head geometric");

@@ -1,8 +1,10 @@
 // `inertialnet predict SEQ`: angular rates for every frame pair of a sequence, through the
-// pipelined scheduler, as a rates CSV (timestamp_ns,wx,wy,wz; rad/s; stamped with t_k).
+// pipelined scheduler, as a rates CSV (timestamp_ns,wx,wy,wz; rad/s; stamped with t_k) and its
+// sidecar, or with --format in the formats of `export` (io/rates_export.hpp).
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -19,6 +21,7 @@
 #include "inertialnet/pipeline/pipeline.hpp"
 #include "inertialnet/pipeline/predict.hpp"
 #include "inertialnet/io/rates_csv.hpp"
+#include "inertialnet/io/rates_export.hpp"
 #include "inertialnet/eval/time_offset.hpp"
 #include "profile.hpp"
 #include "progress.hpp"
@@ -59,10 +62,12 @@ struct PredictOptions {
   std::string solver = "motion-field";
   IntrinsicsCliOptions camera;
   std::string output;
+  std::string format = "csv";  // csv, or an export format (gcsv, euroc-imu, tum)
   std::string save_flow;
   std::string flow_format = "flo";
   double rate_hz = 0;
   std::string camera_name = "cam0";  // --camera (o.camera holds --fx …)
+  BagTopics bag;                     // --image-topic, --camera-info-topic
   std::string time_offset, readout_time;
   double flow_check_px = 0.5;  // PredictSettings' default
   int lanes = 0;  // 0: default_lanes_per_device()
@@ -95,6 +100,11 @@ void check_predict_outputs(const PredictOptions& o) {
       !fs::is_character_file(status)) {
     throw invalid_input("-o " + o.output + ": it exists and is not a file; give the path of a rates CSV.");
   }
+  // The export formats are written whole at the end of the run, atomically: a regular file only.
+  if (!o.output.empty() && o.format != "csv" && fs::exists(status) && !fs::is_regular_file(status)) {
+    throw invalid_input("-o " + o.output + ": it exists and is not a regular file; --format " + o.format +
+                        " is written whole when the run ends, to a regular file or (without -o) standard output.");
+  }
   const std::vector<OutputPath> outputs = {{o.output, "-o"}, {o.save_flow, "--save-flow"}};
   check_outputs_outside_sequence(outputs, o.sequence);
   std::vector<std::string> inputs = o.weights;
@@ -104,11 +114,40 @@ void check_predict_outputs(const PredictOptions& o) {
   if (!o.output.empty()) prepare_output_file(o.output, "-o");
 }
 
+// A value as the CSV holds it (%.9g, format_rates_row), so that `predict --format F` writes what
+// `export --format F` makes of predict's CSV, to the byte.
+double as_written(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.9g", v);
+  return std::strtod(text, nullptr);
+}
+
+// --format other than csv: the rows are kept as a rates table (what the CSV would hold: a rate
+// without an answer is NaN, as an empty cell reads) and converted when the run ends.
+void append_row(RatesTable& table, const RatesLayout& layout, const RatesRow& row) {
+  const double nan = std::nan("");
+  table.t_ns.push_back(row.t_ns);
+  table.w.push_back(row.status == "ok" ? Vec3{as_written(row.w[0]), as_written(row.w[1]), as_written(row.w[2])}
+                                       : Vec3{nan, nan, nan});
+  table.statuses[0].push_back(row.status);
+  for (std::size_t c = 0; c < row.statuses.size(); ++c) table.statuses[c + 1].push_back(row.statuses[c]);
+  for (std::size_t c = 0; c < row.extra.size(); ++c) {
+    // wx<suffix> belongs to status<suffix>; a column of no group is kept as it is.
+    const std::string& name = layout.extra_names[c];
+    const std::string status = name.size() > 2 && name[0] == 'w' ? "status" + name.substr(2) : "";
+    bool ok = true;
+    for (std::size_t g = 0; g < layout.status_names.size(); ++g) {
+      if (layout.status_names[g] == status) ok = row.statuses[g] == "ok";
+    }
+    table.extra[c].push_back(ok ? as_written(row.extra[c]) : nan);
+  }
+}
+
 }  // namespace
 
 Command register_predict(CLI::App& app, const GlobalOptions& global) {
   auto o = std::make_shared<PredictOptions>();
-  app.add_option("sequence", o->sequence, "EuRoC folder, image folder or video")->required();
+  app.add_option("sequence", o->sequence, "EuRoC folder, image folder, video or ROS bag")->required();
   app.add_option("-w,--weights", o->weights,
                  "weights (safetensors) holding FlowNet2 and/or the InertialNet head; repeat for several files");
   app.add_option("--model", o->model, "flow network (default FlowNet2)")->transform(choice("model", flow_model_names()));
@@ -121,6 +160,11 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
       ->transform(choice("solver", {"motion-field", "opengv"}));
   add_intrinsics_options(app, o->camera);
   app.add_option("-o,--output", o->output, "rates CSV to write, folders created as needed (default: standard output)");
+  app.add_option("--format", o->format,
+                 "csv (rates CSV and its sidecar <file>.json), gcsv or gyroflow (Gyroflow's gyro log), euroc-imu (imu0/data.csv "
+                 "layout, gyro only) or tum (orientation trajectory integrated from the rates, for evo); as `export`")
+      ->capture_default_str()
+      ->transform(choice("format", {"csv", "gcsv", "gyroflow", "euroc-imu", "tum"}));
   auto* save_flow_option = app.add_option(
       "--save-flow", o->save_flow, "write each pair's flow as <timestamp>.flo (or .png) into this folder (created as needed)");
   app.add_option("--flow-format", o->flow_format,
@@ -131,6 +175,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
   app.add_option("--rate", o->rate_hz, "frame rate for image folders and videos without timestamps (Hz)")
       ->check(finite_positive_up_to(1e6, "Hz"));
   add_camera_option(app, o->camera_name);
+  add_bag_topic_options(app, o->bag, false);
   app.add_option("--time-offset", o->time_offset,
                  "camera-IMU time offset in seconds (t_imu = t_cam + offset), stated in the CSV for eval");
   app.add_option("--readout-time", o->readout_time,
@@ -170,8 +215,11 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
     settings.fy = o->camera.fy;
     settings.cx = o->camera.cx;
     settings.cy = o->camera.cy;
+    settings.calibration = o->camera.calibration.file;
+    settings.calibration_camera = o->camera.calibration.camera;
     settings.rate_hz = o->rate_hz;
     settings.camera = o->camera_name;
+    settings.bag = o->bag;
     settings.flow_check_px = o->flow_check_px;
     if (!o->readout_time.empty()) settings.readout_time_s = parse_seconds(o->readout_time, "--readout-time");
     if (!o->time_offset.empty()) settings.time_offset_s = parse_seconds(o->time_offset, "--time-offset");
@@ -211,15 +259,41 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
     const RatesLayout layout = prediction.layout();
     std::unique_ptr<RatesCsvWriter> file_writer;
     const auto metadata = prediction.csv_metadata();
-    if (!o->output.empty()) file_writer = std::make_unique<RatesCsvWriter>(o->output, layout, metadata);
-    if (!file_writer) std::cout << rates_csv_header(layout, metadata);
+    const bool csv = o->format == "csv";
+    // --format gcsv|euroc-imu|tum: the rows as the CSV would hold them, converted at the end by
+    // the code `export` runs.
+    RatesTable collected;
+    collected.metadata = metadata;
+    collected.extra_names = layout.extra_names;
+    collected.extra.resize(layout.extra_names.size());
+    collected.status_names = {"status"};
+    collected.status_names.insert(collected.status_names.end(), layout.status_names.begin(), layout.status_names.end());
+    collected.statuses.resize(collected.status_names.size());
+    if (o->format == "euroc-imu" && collected.meta("frame").value_or("") != "body") {
+      // Said before any pair is computed: EuRoC's columns are the IMU frame (`export` would refuse).
+      throw invalid_input("--format euroc-imu: the rates of " + prediction.source().description() + " are in the " +
+                          collected.meta("frame").value_or("camera") + " frame (no camera-IMU rotation known), and "
+                          "EuRoC's columns are the IMU frame; give the calibration, or write the CSV (--format csv) and "
+                          "use `inertialnet export --format euroc-imu --allow-camera-frame`.");
+    }
+    if (csv && !o->output.empty()) file_writer = std::make_unique<RatesCsvWriter>(o->output, layout, metadata);
+    if (csv && (!file_writer || !file_writer->has_sidecar())) {
+      // A stream has no sidecar: its metadata go to the standard error, in words.
+      std::string stated;
+      for (const auto& [key, value] : metadata) stated += (stated.empty() ? "" : ", ") + key + ": " + value;
+      info(std::string("note: the rates' metadata (a stream has no sidecar): schema: ") + kRatesSchema +
+           (stated.empty() ? "" : ", " + stated));
+    }
+    if (csv && !file_writer) std::cout << rates_csv_header(layout);
 
     Progress progress("predict", pairs);
     std::size_t done = 0;
     UnansweredTally tally;
     auto sink = [&](const PairResult& r) {
       const RatesRow row = rates_row(r);
-      if (file_writer) {
+      if (!csv) {
+        append_row(collected, layout, row);
+      } else if (file_writer) {
         file_writer->write(row);
       } else {
         std::cout << format_rates_row(layout, row);
@@ -279,7 +353,8 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
       std::cerr << "inertialnet: interrupted after " << stats.pairs << " of " << pairs << " pairs; "
                 << (file_writer ? "the rows so far are in " + file_writer->journal().string() + " (" + o->output +
                                       " is untouched)"
-                                : std::string("the rates written so far are complete rows"))
+                    : csv       ? std::string("the rates written so far are complete rows")
+                                : "nothing written (--format " + o->format + " is written when the run ends)")
                 << "\n";
       return 1;
     }
@@ -292,6 +367,20 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
                           ".");
     }
     if (file_writer) file_writer->close();  // a failed write or rename is exit 1, not a silent loss
+    if (!csv) {
+      // Pairs without an answer: left out of gcsv and euroc-imu, held over in tum (notes say so).
+      RatesExportSummary written;
+      if (o->output.empty()) {
+        std::cout << rates_export_text(collected, rates_export_format_from_string(o->format), {}, o->sequence, written);
+        flush_standard_output();
+      } else {
+        written = export_rates(collected, o->sequence, o->output, rates_export_format_from_string(o->format));
+      }
+      for (const std::string& note : written.notes) info("note: " + note);
+      if (!o->output.empty()) {
+        info("wrote " + std::to_string(written.rows_written) + " rows (" + o->format + ") to " + o->output);
+      }
+    }
     if (!tally.summary().empty()) {
       warning(tally.summary() + "; their rows say why (status column) and eval leaves them out");
     }

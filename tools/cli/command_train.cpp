@@ -21,7 +21,9 @@
 #include "interrupt.hpp"
 #include "common.hpp"
 #include "progress.hpp"
+#include "input_options.hpp"
 #include "inertialnet/eval/plots.hpp"
+#include "inertialnet/io/camera_imu.hpp"
 #include "inertialnet/eval/time_offset.hpp"
 #include "inertialnet/models/weights.hpp"
 #include "inertialnet/runtime/error.hpp"
@@ -39,6 +41,8 @@ struct TrainCliOptions {
   std::vector<std::string> train, val, weights;
   std::string flow = "dis", optimizer = "sgd", schedule = "constant", head_size = "752x480", target = "spline";
   std::string out, log, plot, cache, time_offset;
+  BagTopics bag;          // --image-topic, --imu-topic, --camera-info-topic: every ROS bag's
+  std::string T_cam_imu;  // --T-cam-imu: a ROS bag's IMU-camera rotation
   int epochs = 20, batch = 10;
   float lr = 1e-6f, momentum = 0.0f, weight_decay = 0.0f;
   std::string seed = "1";
@@ -107,8 +111,12 @@ void check_outputs(const std::vector<Output>& outputs, const std::vector<std::st
 
 Command register_train(CLI::App& app, const GlobalOptions& global) {
   auto o = std::make_shared<TrainCliOptions>();
-  app.add_option("--train", o->train, "training sequences (EuRoC folders)")->required();
-  app.add_option("--val", o->val, "validation sequences (EuRoC folders)")->required();
+  app.add_option("--train", o->train, "training sequences (EuRoC folders or ROS bags)")->required();
+  app.add_option("--val", o->val, "validation sequences (EuRoC folders or ROS bags)")->required();
+  add_bag_topic_options(app, o->bag, true);
+  app.add_option("--T-cam-imu", o->T_cam_imu,
+                 "for ROS bags: IMU-to-camera transform, 16 numbers (4x4 row-major, Kalibr's T_cam_imu) or a YAML file "
+                 "with T_cam_imu (or T_BS as cam0/sensor.yaml writes it); default: identity");
   app.add_option("--flow", o->flow, "dis (weight-free) or flownet2 (needs --weights)")->capture_default_str();
   app.add_option("--weights", o->weights, "FlowNet2 weights, for --flow flownet2");
   app.add_option("--epochs", o->epochs, "epochs")->capture_default_str()->check(CLI::Range(1, 100000));
@@ -157,6 +165,8 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
     set_options.flow = parse_flow_method(o->flow);
     set_options.target = parse_sync_target(o->target);
     if (!o->time_offset.empty()) set_options.time_offset_s = parse_seconds(o->time_offset, "--time-offset");
+    set_options.bag_input.bag = o->bag;
+    if (!o->T_cam_imu.empty()) set_options.bag_input.camera_imu = parse_camera_imu(o->T_cam_imu, "--T-cam-imu");
     if (set_options.flow == FlowMethod::FlowNet && o->weights.empty()) {
       throw invalid_input("--flow flownet2 needs FlowNet2 weights (--weights FILE)");
     }

@@ -23,7 +23,8 @@ std::string help_examples(const std::string& subcommand) {
        "  inertialnet predict data/seq -o out/rates.csv                        # DIS + geometric head\n"
        "  inertialnet predict data/seq -w flownet2.safetensors -w head.safetensors --head both -o rates.csv\n"
        "  inertialnet predict video.mp4 --fx 458 --rate 20 --stats\n"
-       "  inertialnet predict data/seq --flow DIS --save-flow out/flows -q\n"},
+       "  inertialnet predict data/seq --flow DIS --save-flow out/flows -q\n"
+       "  inertialnet predict clip.mp4 --fx 900 --format gcsv -o clip.gcsv     # Gyroflow gyro log\n"},
       {"eval",
        "  inertialnet eval rates.csv data/seq\n"
        "  inertialnet eval rates.csv data/seq --plot out/rates.png --target mean\n"

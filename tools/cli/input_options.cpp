@@ -6,6 +6,7 @@
 #include <regex>
 #include <sstream>
 
+#include "inertialnet/io/calibration_file.hpp"
 #include "inertialnet/io/camera_imu.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/runtime/excerpt.hpp"
@@ -56,12 +57,29 @@ CLI::Validator finite_pixel_coordinate() {
       "NUMBER");
 }
 
+void add_calibration_options(CLI::App& app, CalibrationCliOptions& o) {
+  auto* file = app.add_option("--calibration", o.file,
+                              "camera calibration file: EuRoC sensor.yaml, Kalibr camchain (camchain.yaml, "
+                              "camchain-imucam.yaml), or OpenCV calibrateCamera YAML/XML (camera_matrix, "
+                              "distortion_coefficients, image_width, image_height); pinhole with radtan or "
+                              "equidistant (fisheye) distortion")
+                   ->check(CLI::ExistingFile);
+  app.add_option("--calibration-camera", o.camera, "with --calibration: the camchain's camera (cam0, cam1, ...; "
+                                                   "default cam0)")
+      ->needs(file);
+}
+
 void add_intrinsics_options(CLI::App& app, IntrinsicsCliOptions& o) {
   const CLI::Validator focal = finite_positive_up_to(1e6, "pixels");
-  app.add_option("--fx", o.fx, "focal length x (px), when the sequence has no sensor.yaml")->check(focal);
+  app.add_option("--fx", o.fx,
+                 "focal length x (px) when the sequence has no sensor.yaml (fy, cx, cy are then assumed with a note "
+                 "unless given); with --calibration it replaces the file's fx")
+      ->check(focal);
   app.add_option("--fy", o.fy, "focal length y (px)")->check(focal);
-  app.add_option("--cx", o.cx, "principal point x (px)")->check(finite_pixel_coordinate());
+  app.add_option("--cx", o.cx, "principal point x (px; 0 is a value, the left pixel's centre)")
+      ->check(finite_pixel_coordinate());
   app.add_option("--cy", o.cy, "principal point y (px)")->check(finite_pixel_coordinate());
+  add_calibration_options(app, o.calibration);
 }
 
 void add_camera_option(CLI::App& app, std::string& camera) {
@@ -71,8 +89,17 @@ void add_camera_option(CLI::App& app, std::string& camera) {
       ->transform(choice("camera", {"cam0", "cam1"}));
 }
 
+void add_bag_topic_options(CLI::App& app, BagTopics& topics, bool imu) {
+  app.add_option("--image-topic", topics.image,
+                 "a ROS bag's sensor_msgs/Image or CompressedImage topic (default: its only one)");
+  if (imu) app.add_option("--imu-topic", topics.imu, "a ROS bag's sensor_msgs/Imu topic (default: its only one)");
+  app.add_option("--camera-info-topic", topics.camera_info,
+                 "a ROS bag's sensor_msgs/CameraInfo topic (default: the one beside the image topic)");
+}
+
 void add_imu_options(CLI::App& app, ImuCliOptions& o) {
   add_camera_option(app, o.camera);
+  add_bag_topic_options(app, o.bag, true);
   app.add_option("--imu", o.imu,
                  "gyro log on the frames' clock, for an image folder or a video (for a EuRoC folder it replaces "
                  "mav0/imu0/data.csv): a CSV of time, gx, gy, gz [rad/s] with or without accel x y z after them "
@@ -119,6 +146,7 @@ ImuSequenceOptions imu_sequence_options(const ImuCliOptions& o) {
   options.imu_csv = o.imu;
   if (o.rate_hz > 0) options.rate_hz = o.rate_hz;
   options.camera = o.camera;
+  options.bag = o.bag;
   if (!o.imu_time_unit.empty()) options.imu_time_unit = parse_time_unit(o.imu_time_unit);
   if (!o.imu_units.empty()) {
     const std::size_t comma = o.imu_units.find(',');
@@ -133,6 +161,18 @@ ImuSequenceOptions imu_sequence_options(const ImuCliOptions& o) {
   }
   if (!o.T_cam_imu.empty()) options.camera_imu = parse_camera_imu(o.T_cam_imu, "--T-cam-imu");
   if (!o.camchain.empty()) options.camera_imu = read_kalibr_camchain(o.camchain);
+  if (!o.calibration.file.empty()) {
+    // One path for the extrinsic: the file's T_cam_imu (or sensor.yaml's T_BS) is what --camchain
+    // (or --T-cam-imu FILE) would read from it; a file without one leaves the others in charge.
+    const CalibrationFile file = read_calibration_file(o.calibration.file, o.calibration.camera);
+    if (file.camera_imu) {
+      if (options.camera_imu) {
+        throw invalid_input("--calibration " + o.calibration.file + " holds a camera-IMU extrinsic, and " +
+                            (o.camchain.empty() ? "--T-cam-imu" : "--camchain") + " gives one too; give one of them.");
+      }
+      options.camera_imu = file.camera_imu;
+    }
+  }
   return options;
 }
 

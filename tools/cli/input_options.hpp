@@ -4,6 +4,7 @@
 // --camchain, --rate; include/inertialnet/io/imu_sequence.hpp).
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -22,22 +23,38 @@ inline constexpr double kMinimumPositive = 1e-6;
 CLI::Validator finite_positive_up_to(double limit, const char* unit);  // "must be a finite positive number, got …"
 CLI::Validator finite_pixel_coordinate();                              // within 1e6 pixels of the origin
 
-// --fx --fy --cx --cy (0: not given).
+// --calibration FILE [--calibration-camera camN]: a calibration file (calibration_file.hpp).
+// Added by add_intrinsics_options; eval, which needs only its extrinsic, adds it alone.
+struct CalibrationCliOptions {
+  std::string file, camera;
+};
+void add_calibration_options(CLI::App& app, CalibrationCliOptions& o);
+
+// --fx --fy --cx --cy (each optional: --cx 0 is a principal point) and --calibration.
 struct IntrinsicsCliOptions {
-  double fx = 0, fy = 0, cx = 0, cy = 0;
+  std::optional<double> fx, fy, cx, cy;
+  CalibrationCliOptions calibration;
 };
 void add_intrinsics_options(CLI::App& app, IntrinsicsCliOptions& o);
 
 // --camera cam0|cam1: which camera of a EuRoC sequence (predict, eval, calibrate-time).
 void add_camera_option(CLI::App& app, std::string& camera);
 
+// --image-topic, --camera-info-topic and (with `imu`) --imu-topic: a ROS bag's topics
+// (bag_topics.hpp); predict has no IMU to read.
+void add_bag_topic_options(CLI::App& app, BagTopics& topics, bool imu);
+
 // --imu FILE, --imu-time-unit s|ms|us|ns, --imu-columns T,GX,GY,GZ, --imu-units TIME,GYRO,
-// --T-cam-imu M|FILE, --camchain FILE, --rate HZ.
+// --T-cam-imu M|FILE, --camchain FILE, --rate HZ, and a bag's topics.
 struct ImuCliOptions {
   std::string imu, imu_time_unit, T_cam_imu, camchain;
   std::string imu_columns, imu_units;  // as given; split in imu_sequence_options
   std::string camera = "cam0";  // --camera, added with the IMU options
   double rate_hz = 0;
+  // --calibration, added by add_calibration_options (or add_intrinsics_options): its camera-IMU
+  // extrinsic, when the file has one, stands for --camchain.
+  CalibrationCliOptions calibration;
+  BagTopics bag;                // --image-topic, --imu-topic, --camera-info-topic
 };
 void add_imu_options(CLI::App& app, ImuCliOptions& o);
 // Reads the calibration given (invalid_input naming the option or file when it is bad).

@@ -55,8 +55,9 @@ class BagReader {
   virtual std::string description() const = 0;
 };
 
-// True when `path` is a bag by its content (ROS 1's "#ROSBAG V2.0" line, MCAP's magic, an
-// SQLite database with rosbag2's tables) or a folder holding a rosbag2 metadata.yaml.
+// True when `path` is a bag by its content (ROS 1's "#ROSBAG V" line: open_bag names a version
+// other than 2.0 when it refuses it; MCAP's magic; SQLite's header: open_bag names the rosbag2
+// tables an SQLite file lacks) or a folder holding a rosbag2 metadata.yaml.
 bool is_bag(const std::filesystem::path& path);
 // Opens a bag (any of the three); invalid_input naming the file when it is none of them, is
 // damaged, or uses a format version or compression we do not read.

@@ -1,4 +1,5 @@
-// Where frames come from: a EuRoC sequence (mav0/cam0), a folder of images, or a video file.
+// Where frames come from: a EuRoC sequence (mav0/cam0), a folder of images, a video file, or a ROS
+// bag's image topic (bag_source.hpp).
 // Frames carry int64 nanosecond timestamps; decoding yields planar RGB (grayscale replicated).
 #pragma once
 
@@ -10,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "inertialnet/io/bag_topics.hpp"
 #include "inertialnet/io/euroc.hpp"
 #include "inertialnet/io/image_io.hpp"
 
@@ -46,8 +48,11 @@ class FrameSource {
 // before the frame count its header announces. Fewer than two frames, an empty or unreadable
 // source are invalid_input. `camera` picks a EuRoC folder's camera (mav0/cam0 or mav0/cam1, as
 // --camera); any other than cam0 is refused for a folder of images or a video.
+// A ROS bag (bag.hpp: a .bag, .db3 or .mcap file, or a rosbag2 folder, told by content) is read
+// from the topics `bag` names (bag_source.hpp: header stamps; --rate and --camera are refused);
+// topics given for any other input are refused.
 std::unique_ptr<FrameSource> open_frame_source(const std::filesystem::path& path,
                                                std::optional<double> rate_hz = std::nullopt,
-                                               const std::string& camera = "cam0");
+                                               const std::string& camera = "cam0", const BagTopics& bag = {});
 
 }  // namespace inertialnet

@@ -14,11 +14,16 @@
 // file replaces mav0/imu0/data.csv (a note says so) and is taken to be in imu0's frame: the
 // camera's (`camera`: cam0 or cam1) T_BS keeps giving the rotation (a calibration given is refused, invalid_input), and the ground
 // truth's gyro bias, which belongs to imu0, is not used.
+//
+// A ROS bag (bag_source.hpp) is read like a folder with its IMU file: the frames of its image
+// topic, the samples of its Imu topic (or of the --imu file, which then replaces them), the
+// rotation given or the identity; its CameraInfo, when found, is the sequence's camera.
 #pragma once
 
 #include <filesystem>
 #include <optional>
 
+#include "inertialnet/io/bag_topics.hpp"
 #include "inertialnet/io/camera_imu.hpp"
 #include "inertialnet/io/euroc.hpp"
 #include "inertialnet/io/gyro_log.hpp"
@@ -32,6 +37,7 @@ struct ImuSequenceOptions {
   std::optional<TimeUnit> imu_time_unit;           // the time unit of imu_csv's CSV (--imu-time-unit)
   GyroLogOptions imu_format;                       // --imu-columns, --imu-units (imu_time_unit, when set, wins)
   std::string camera = "cam0";                     // a EuRoC folder's camera (--camera); cam0 for others
+  BagTopics bag;                                   // a ROS bag's topics (--image-topic, --imu-topic, …)
 };
 
 // Frames (timestamps only; images are not decoded, a video is read once for its frame times),

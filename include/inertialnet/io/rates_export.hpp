@@ -20,8 +20,8 @@
 //      1403715273312143104,0.0123,-0.0456,0.0789,,,
 //    The accelerometer cells are empty: there is no measurement, and 0 would read as free fall
 //    to a program that integrates it; an empty cell makes such a program fail instead of drift.
-//    EuRoC's w_RS_S is in the IMU (body) frame: a file whose frame is camera is refused unless
-//    allow_camera_frame.
+//    EuRoC's w_RS_S is in the IMU (body) frame: a file whose frame is camera (or states none) is
+//    refused unless allow_camera_frame.
 //  * tum: an orientation trajectory for evo, `timestamp tx ty tz qx qy qz qw` (seconds, exact to
 //    the nanosecond; translation 0), the frame's orientation relative to its orientation at the
 //    first row, from integrating the rates: each ok row k holds the mean rate over [t_{k-1}, t_k]
@@ -49,7 +49,7 @@ namespace inertialnet {
 
 enum class RatesExportFormat { Gyroflow, EurocImu, Tum };
 
-// "gyroflow", "euroc-imu", "tum"; invalid_input listing them for another word.
+// "gcsv" (or "gyroflow"), "euroc-imu", "tum"; invalid_input listing them for another word.
 RatesExportFormat rates_export_format_from_string(const std::string& name);
 const char* to_string(RatesExportFormat format);
 
@@ -75,6 +75,16 @@ std::string rates_to_euroc_imu(const RatesTable& table, const RatesExportOptions
                                const std::string& source, RatesExportSummary& summary);
 std::string rates_to_tum(const RatesTable& table, const RatesExportOptions& options, const std::string& source,
                          RatesExportSummary& summary);
+
+// The file's text in `format` (one of the three above), with the notes of reading `table` first.
+// `predict --format` and `export` both come here.
+std::string rates_export_text(const RatesTable& table, RatesExportFormat format, const RatesExportOptions& options,
+                              const std::string& source, RatesExportSummary& summary);
+
+// Converts `table` and writes `output` atomically (runtime/atomic_file.hpp): the output names a
+// complete file or is untouched.
+RatesExportSummary export_rates(const RatesTable& table, const std::string& source, const std::filesystem::path& output,
+                                RatesExportFormat format, const RatesExportOptions& options = {});
 
 // Reads `rates`, converts it and writes `output` atomically (runtime/atomic_file.hpp): the output
 // names a complete file or is untouched.

@@ -30,11 +30,20 @@ struct PredictSettings {
   std::string flow;                  // "flownet2" or "dis"; "": flownet2 with weights, dis without
   std::string head;                  // "inertialnet", "geometric" or "both"; "": by the weights
   std::string solver = "motion-field";  // geometric head: "motion-field" or "opengv"
-  // Intrinsics for sources without sensor.yaml (fx > 0 overrides the calibration); fy, cx, cy
-  // default to fx and the image centre.
-  double fx = 0, fy = 0, cx = 0, cy = 0;
+  // A calibration file (calibration_file.hpp: EuRoC sensor.yaml, Kalibr camchain, OpenCV YAML/XML)
+  // for the geometric head; it replaces a EuRoC sequence's own sensor.yaml (with a note), and its
+  // camera-IMU extrinsic, when it has one, puts the rates in the IMU (body) frame as T_BS does.
+  // calibration_camera picks a camchain's camera ("": cam0).
+  std::filesystem::path calibration;
+  std::string calibration_camera;
+  // Intrinsics given one by one (0 is a valid cx or cy; an fx or fy of 0, never a focal length,
+  // counts as not given). With `calibration` each replaces the file's value, with a note; without
+  // it fx or fy describes an ideal pinhole that replaces the sequence's sensor.yaml, and each
+  // value assumed (fy = fx, fx = fy, the image centre) is a note.
+  std::optional<double> fx, fy, cx, cy;
   double rate_hz = 0;                // frame rate of image folders and videos; 0: from the source
   std::string camera = "cam0";       // a EuRoC sequence's camera: "cam0" or "cam1" (mav0/<camera>)
+  BagTopics bag;                     // a ROS bag's topics (bag_topics.hpp); empty: the bag's only ones
   // Rolling shutter: seconds from the first row's exposure to the last's (0: global shutter). The
   // geometric head corrects each flow vector's interval; the CSV states it for eval.
   double readout_time_s = 0;

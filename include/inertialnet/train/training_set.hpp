@@ -1,7 +1,8 @@
 // A training (or validation) set for the InertialNet head: every consecutive frame pair of one or
 // more sequences, as a flow at the head's input size and the angular rate it should predict.
 //
-// Sequences are EuRoC folders (mav0/cam0 + imu0, `inertialnet synth` output included). The target
+// Sequences are EuRoC folders (mav0/cam0 + imu0, `inertialnet synth` output included) or ROS bags
+// (bag_source.hpp: an image topic and an Imu topic, the IMU-camera rotation given or the identity). The target
 // of pair (k−1, k) is the gyro synchronised onto frame k's time (eval/imu_sync.hpp: `spline`, the
 // paper's, or `mean` over the interval), bias-corrected when a bias is known (ground truth, else a
 // static start), in the body (IMU) frame — so a trained head predicts what the gyro measures, in
@@ -29,6 +30,7 @@
 
 #include "inertialnet/core/vec3.hpp"
 #include "inertialnet/eval/imu_sync.hpp"
+#include "inertialnet/io/imu_sequence.hpp"
 #include "inertialnet/models/weights.hpp"
 #include "inertialnet/pipeline/rates_processor.hpp"
 #include "inertialnet/runtime/device.hpp"
@@ -47,6 +49,9 @@ struct TrainingSetOptions {
   // Camera–IMU time offset of every sequence (t_imu = t_cam + offset, eval/time_offset.hpp): the
   // targets are the gyro at the shifted times, as eval --time-offset compares them.
   double time_offset_s = 0;
+  // How a ROS bag among the sequences is read: its topics (bag) and the IMU-camera rotation
+  // (camera_imu); read_sequence_with_imu() reads it.
+  ImuSequenceOptions bag_input;
   std::filesystem::path cache_dir;  // empty: no disk cache
   std::uint64_t cache_budget_bytes = std::numeric_limits<std::uint64_t>::max();
 };
