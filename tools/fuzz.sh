@@ -17,6 +17,7 @@ build="${FUZZ_BUILD_DIR:-build-asan}"
 all_targets=(safetensors camera_csv imu_csv gyro_log sensor_yaml rates_csv image device_spec flo)
 all_targets+=(mcap ros2_sqlite)  # ROS 2 bag containers
 all_targets+=(ros1_bag)  # the ROS 1 bag container and the sensor_msgs decoders
+all_targets+=(gpmf)  # GoPro MP4s' GPMF gyro
 targets=("$@")
 [ ${#targets[@]} -eq 0 ] && targets=("${all_targets[@]}")
 

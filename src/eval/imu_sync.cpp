@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "inertialnet/runtime/error.hpp"
+#include "inertialnet/eval/mocap_bias.hpp"
 #include "inertialnet/eval/spline.hpp"
 
 namespace inertialnet {
@@ -106,6 +107,7 @@ std::string to_string(BiasSource source) {
     case BiasSource::StaticStart: return "static_start";
     case BiasSource::Automatic: return "automatic";
     case BiasSource::LeastSquares: return "least_squares";
+    case BiasSource::Mocap: return "mocap";
   }
   return "unknown";
 }
@@ -146,7 +148,7 @@ std::vector<Vec3> GyroTruth::corrected() const {
 
 GyroTruth sync_gyro(const std::vector<std::int64_t>& camera_t_ns, const std::vector<ImuSample>& imu,
                     const SyncOptions& options, const std::vector<GroundTruthSample>* ground_truth,
-                    const Mat3* imu_to_camera) {
+                    const Mat3* imu_to_camera, const std::vector<MocapSample>* mocap) {
   // Everything below works on the camera times moved onto the IMU's clock; the output keeps the
   // camera's own stamps, which is what rates files carry.
   if (!std::isfinite(options.time_offset_s) || std::abs(options.time_offset_s) > 3600) {
@@ -283,13 +285,24 @@ GyroTruth sync_gyro(const std::vector<std::int64_t>& camera_t_ns, const std::vec
   BiasSource source = options.bias;
   const bool have_gt = ground_truth && !ground_truth->empty();
   StaticEstimate still;
+  MocapBias from_mocap;
   if (source == BiasSource::Automatic) {
     if (have_gt) {
       source = BiasSource::GroundTruth;
     } else {
       still = estimate_static_start(imu, options.static_start);
       source = still.ok ? BiasSource::StaticStart : BiasSource::None;
-      if (!still.ok) {
+      if (!still.ok && mocap && !mocap->empty()) {
+        from_mocap = estimate_mocap_bias(imu, *mocap);
+        if (from_mocap.ok) {
+          source = BiasSource::Mocap;
+        } else {
+          out.notes.push_back("The mocap poses (mocap0) overlap the IMU for " + fmt("%.2f", from_mocap.span_s) +
+                              " s in steps of at most " + fmt("%.3g", kMaxMocapStep) + " s, fewer than the " +
+                              fmt("%.2g", kMinMocapSpan) + " s a mocap gyro bias needs.");
+        }
+      }
+      if (source == BiasSource::None) {
         out.notes.push_back("No gyro bias: the sequence has no ground truth and its first " +
                             fmt("%.2f", options.static_start.window_s) +
                             " s of IMU data are not static (gyro std " + vec_str(still.std) + " rad/s, limit " +
@@ -358,6 +371,14 @@ GyroTruth sync_gyro(const std::vector<std::int64_t>& camera_t_ns, const std::vec
                           vec_str(still.std) + " rad/s): " + vec_str(still.mean) + " rad/s.");
       break;
     }
+    case BiasSource::Mocap:
+      bias.assign(n, from_mocap.mean);
+      out.bias_imu_frame = from_mocap.mean;
+      out.notes.push_back("Gyro bias from motion capture (mav0/mocap0, no static start): the mean of gyro minus the "
+                          "mocap orientation's rate over " + plural(from_mocap.intervals, "pose interval", "pose intervals") +
+                          " (" + fmt("%.2f", from_mocap.span_s) + " s): " + vec_str(from_mocap.mean) +
+                          " rad/s (IMU frame; mocap0 gives the IMU's own pose, on its clock).");
+      break;
   }
   out.bias_source = source == BiasSource::Automatic ? BiasSource::None : source;
 
@@ -399,7 +420,8 @@ GyroTruth sync_gyro(const EurocSequence& sequence, const SyncOptions& options) {
   if (options.camera_frame) rotation = imu_to_camera_rotation(sequence);
   const std::vector<GroundTruthSample>* gt =
       sequence.ground_truth ? &*sequence.ground_truth : nullptr;
-  return sync_gyro(cam, sequence.imu, options, gt, rotation ? &*rotation : nullptr);
+  return sync_gyro(cam, sequence.imu, options, gt, rotation ? &*rotation : nullptr,
+                   sequence.mocap ? &*sequence.mocap : nullptr);
 }
 
 }  // namespace inertialnet

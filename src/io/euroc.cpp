@@ -293,6 +293,8 @@ EurocSequence read_euroc(const fs::path& root, const EurocReadOptions& options) 
   if (options.read_ground_truth && fs::exists(gt)) {
     seq.ground_truth = read_ground_truth_csv(gt, &seq.warnings);
   }
+  const fs::path mocap = mav0 / "mocap0" / "data.csv";
+  if (options.read_ground_truth && fs::exists(mocap)) seq.mocap = read_mocap_csv(mocap, &seq.warnings);
   return seq;
 }
 

@@ -21,10 +21,13 @@ std::string name_of(const fs::path& path) {
 Mat3 rotation_of(const std::array<double, 16>& T) { return {T[0], T[1], T[2], T[4], T[5], T[6], T[8], T[9], T[10]}; }
 
 // The --imu file's samples into `seq`, its notes after the sequence's.
-void read_imu_file(const ImuSequenceOptions& options, EurocSequence& seq) {
-  GyroLog log = read_gyro_log(options.imu_csv, options.imu_time_unit, &seq.warnings);
+GyroLog read_imu_file(const ImuSequenceOptions& options, EurocSequence& seq) {
+  GyroLogOptions format = options.imu_format;
+  if (options.imu_time_unit) format.time_unit = options.imu_time_unit;
+  GyroLog log = read_gyro_log(options.imu_csv, format, &seq.warnings);
   seq.imu = std::move(log.samples);
   seq.notes.insert(seq.notes.end(), log.notes.begin(), log.notes.end());
+  return log;
 }
 
 EurocSequence read_euroc_with_imu(const fs::path& path, const ImuSequenceOptions& options) {
@@ -65,6 +68,10 @@ EurocSequence read_sequence_with_imu(const fs::path& path, const ImuSequenceOpti
   if (options.imu_time_unit && options.imu_csv.empty()) {
     throw invalid_input("--imu-time-unit describes the file given with --imu, and none is given.");
   }
+  if ((options.imu_format.time_unit || options.imu_format.gyro_unit || !options.imu_format.columns.empty()) &&
+      options.imu_csv.empty()) {
+    throw invalid_input("--imu-columns and --imu-units describe the file given with --imu, and none is given.");
+  }
   const bool bag = is_bag(path);
   if (!bag && is_euroc_folder(path)) {
     if (options.bag.any()) open_frame_source(path, options.rate_hz, options.camera, options.bag);  // refuses the topics, named
@@ -90,15 +97,19 @@ EurocSequence read_sequence_with_imu(const fs::path& path, const ImuSequenceOpti
   for (std::size_t i = 0; i < source->size(); ++i) seq.frames[i] = {source->timestamp_ns(i), std::string(), path};
   seq.notes = source->notes();
   if (bag) seq.camera = source->calibration();  // CameraInfo: calibrate-time predicts with it
+  GyroLog log;
   if (bag && options.imu_csv.empty()) {
     seq.imu = read_bag_imu(path, options.bag, seq.notes);
   } else {
-    read_imu_file(options, seq);
+    log = read_imu_file(options, seq);
   }
   const std::string imu_name = bag && options.imu_csv.empty() ? "the IMU topic of " + seq.name : options.imu_csv.string();
   if (options.camera_imu) {
     seq.imu_to_camera = options.camera_imu->rotation_cam_imu();
     seq.notes.push_back("IMU to camera rotation from " + options.camera_imu->source + ".");
+  } else if (log.imu_to_camera) {
+    seq.imu_to_camera = log.imu_to_camera;
+    seq.notes.push_back("IMU to camera rotation from " + log.imu_to_camera_source + ".");
   } else {
     seq.imu_to_camera = Mat3{1, 0, 0, 0, 1, 0, 0, 0, 1};
     seq.notes.push_back("No --T-cam-imu or --camchain: the IMU frame is taken to be the camera frame (x right, "

@@ -304,6 +304,21 @@ expect_match("gyro_bare.csv line 1: the timestamp \\[ns\\] is \"0.005\", a time 
 file(WRITE "${WORK}/no_scale.gcsv" "GYROFLOW IMU LOG\nversion,1.3\nid,x\norientation,XYZ\ngscale,1\nt,gx,gy,gz\n0,1,2,3\n")
 run(2 ${CLI} calibrate-time ${folder} --imu no_scale.gcsv --fx 100)
 expect_match("no_scale.gcsv \\(a Gyroflow .gcsv\\) has no tscale line")
+# --imu-columns / --imu-units: without --imu, with --imu-time-unit, a gyro value that is not a
+# number in a column chosen by name (file, line, column, value), an MP4 cut inside its first box.
+run(2 ${CLI} eval rates.csv seq --imu-columns 0,1,2,3)
+expect_match("--imu-columns and --imu-units describe the file given with --imu, and none is given")
+run(2 ${CLI} eval rates.csv ${folder} --imu gyro_s.csv --imu-units s,rad/s --imu-time-unit s)
+expect_match("--imu-time-unit excludes --imu-units")
+file(WRITE "${WORK}/gyro_named.csv" "temp,wz,stamp,wx,wy
+20,0.1,1.0,0.2,0.3
+20,0.1,1.005,0.2,oops
+")
+run(2 ${CLI} eval rates.csv ${folder} --imu gyro_named.csv --imu-columns stamp,wx,wy,wz --imu-units s,rad/s)
+expect_match("gyro_named.csv line 3: wy should be a number, found \"oops\"")
+file(WRITE "${WORK}/short.mp4" "AAAAftypmp42")  # an ftyp box whose size (0x41414141) overruns the file
+run(2 ${CLI} eval rates.csv ${folder} --imu short.mp4)
+expect_match("short.mp4: damaged MP4 at byte offset 0: box 'ftyp' claims 1094795585 bytes, beyond the file's end \\(12 bytes\\)")
 run(2 ${CLI} eval rates.csv ${folder} ${imu} --T-cam-imu "1 0 0 0 0 1 0 0 0 0 1 0")
 expect_match("--T-cam-imu should be 16 numbers \\(a 4×4 T_cam_imu, row-major\\), found 12")
 run(2 ${CLI} eval rates.csv ${folder} ${imu} --T-cam-imu "1 0.5 0 0 0 1 0 0 0 0 1 0 0 0 0 1")

@@ -160,3 +160,111 @@ if(CMAKE_MATCH_1 LESS 0.035 OR CMAKE_MATCH_1 GREATER 0.045)
   message(FATAL_ERROR "time_offset_s ${CMAKE_MATCH_1} from the log in seconds, expected 0.040 within 0.005")
 endif()
 expect_match("apply it with: inertialnet eval RATES.csv late/mav0/cam0/data --imu late_seconds.csv --imu-time-unit s --T-cam-imu")
+
+# A generic CSV in seconds and deg/s, its columns in another order among others, read with
+# --imu-columns and --imu-units: the same gyro (to the 17 digits written), so the same RMSE.
+set(generic "temperature,wz_dps,stamp,wx_dps,pressure,wy_dps\n")
+set(to_deg 57.295779513082320876798)
+foreach(row IN LISTS imu_rows)
+  string(REGEX MATCH "^([0-9]+)([0-9][0-9][0-9][0-9][0-9][0-9][0-9][0-9][0-9]),([^,]+),([^,]+),([^,]+)," _ "${row}")
+  set(seconds "${CMAKE_MATCH_1}.${CMAKE_MATCH_2}")
+  set(wx "${CMAKE_MATCH_3}")
+  set(wy "${CMAKE_MATCH_4}")
+  set(wz "${CMAKE_MATCH_5}")
+  list(APPEND generic_rows "20.5,${wz},${seconds},${wx},1013,${wy}")
+endforeach()
+if(PYTHON)
+  # CMake has no floating point: Python converts rad/s to deg/s (17 significant digits).
+  file(WRITE "${WORK}/rows.txt" "${generic_rows}")
+  execute_process(COMMAND ${PYTHON} -c "
+import math
+rows = open('${WORK}/rows.txt').read().split(';')
+out = ['temperature,wz_dps,stamp,wx_dps,pressure,wy_dps']
+for r in rows:
+    t, wz, s, wx, p, wy = r.split(',')
+    out.append(','.join([t, repr(math.degrees(float(wz))), s, repr(math.degrees(float(wx))), p, repr(math.degrees(float(wy)))]))
+open('${WORK}/gyro_generic.csv', 'w').write('\\n'.join(out) + '\\n')
+" RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "writing gyro_generic.csv failed")
+  endif()
+  run(0 ${CLI} eval folder.csv seq/mav0/cam0/data --imu gyro_generic.csv --imu-columns stamp,wx_dps,wy_dps,wz_dps
+      --imu-units s,deg/s --camchain camchain.yaml --json)
+  rmse_of(from_generic "${output}")
+  expect_same_rmse("${reference}" "${from_generic}" "--imu gyro_generic.csv --imu-columns --imu-units s,deg/s")
+  # The same by 0-based index; and a unit that contradicts the header is refused.
+  run(0 ${CLI} eval folder.csv seq/mav0/cam0/data --imu gyro_generic.csv --imu-columns 2,3,5,1
+      --imu-units s,deg/s --camchain camchain.yaml --json)
+  rmse_of(from_index "${output}")
+  expect_same_rmse("${reference}" "${from_index}" "--imu-columns 2,3,5,1")
+  run(2 ${CLI} eval folder.csv seq/mav0/cam0/data --imu gyro_generic.csv --imu-columns stamp,wx_dps,wy_dps,wz_dps
+      --imu-units s,rad/s)
+  expect_match("gyro_generic.csv line 1: the gyro column \"wx_dps\" is in deg/s, but --imu-units says rad/s")
+  run(2 ${CLI} eval folder.csv seq/mav0/cam0/data --imu gyro_generic.csv --imu-units s,degrees)
+  expect_match("--imu-units: expected TIME,GYRO with TIME one of s, ms, us, ns and GYRO rad/s or deg/s, got s,degrees")
+  run(2 ${CLI} eval folder.csv seq/mav0/cam0/data --imu gyro_generic.csv --imu-columns stamp,wx,wy,omega --imu-units s,deg/s)
+  expect_match("--imu-columns: gyro_generic.csv line 1: no column named \"omega\" among: temperature, wz_dps, stamp")
+
+  # A GoPro MP4 (tests/support/write_gopro_mp4.py: the PNG frames as a lossless 'png ' video track,
+  # the gyro as HERO5 GPMF, int16 / SCAL 10000): `predict` gives the folder's rates exactly (the
+  # same pixels), and `eval rec.mp4 --imu rec.mp4` reads the samples the writer says it stored
+  # (expected.csv, to every digit: the same RMSE). Against the EuRoC path the gyro differs by the
+  # int16 rounding, at most half of 1/SCAL rad/s per axis before rotation, so the camera-frame RMSE
+  # agrees within sqrt(3)·0.5e-4 rad/s = 0.005 deg/s.
+  run(0 ${PYTHON} ${CMAKE_CURRENT_LIST_DIR}/../support/write_gopro_mp4.py seq rec.mp4 --expected expected.csv)
+  run(0 ${CLI} predict rec.mp4 ${intrinsics} -o video.csv)
+  foreach(csv folder.csv video.csv)
+    file(STRINGS "${WORK}/${csv}" rows REGEX "^[0-9]")
+    list(TRANSFORM rows REPLACE "^[0-9]+," "")
+    set(rates_${csv} "${rows}")
+  endforeach()
+  if(NOT rates_folder.csv STREQUAL rates_video.csv)
+    message(FATAL_ERROR "predict on rec.mp4 gives other rates than on its frames as a folder:\n${rates_video.csv}\n${rates_folder.csv}")
+  endif()
+  run(0 ${CLI} eval euroc.csv seq --json --camera-frame)
+  rmse_of(euroc_camera "${output}")
+  run(0 ${CLI} eval video.csv rec.mp4 --imu expected.csv --json --camera-frame)
+  rmse_of(expected_camera "${output}")
+  run(0 ${CLI} eval video.csv rec.mp4 --imu rec.mp4 --json --camera-frame)
+  rmse_of(gopro_camera "${output}")
+  expect_same_rmse("${expected_camera}" "${gopro_camera}" "--imu rec.mp4 against the samples written")
+  foreach(k 0 1 2)
+    list(GET euroc_camera ${k} e)
+    list(GET gopro_camera ${k} g)
+    execute_process(COMMAND ${PYTHON} -c "import sys; sys.exit(abs(${e} - ${g}) > 0.005)" RESULT_VARIABLE far)
+    if(NOT far EQUAL 0)
+      message(FATAL_ERROR "--imu rec.mp4: camera-frame RMSE ${gopro_camera} deg/s, the EuRoC path ${euroc_camera}")
+    endif()
+  endforeach()
+  # The axis order an ORIN item states (lower case: negated), as HERO8 and later write it.
+  run(0 ${PYTHON} ${CMAKE_CURRENT_LIST_DIR}/../support/write_gopro_mp4.py seq rec_orin.mp4 --orin yZx --expected expected_orin.csv)
+  run(0 ${CLI} eval video.csv rec.mp4 --imu expected_orin.csv --json --camera-frame)
+  rmse_of(expected_orin "${output}")
+  run(0 ${CLI} eval video.csv rec.mp4 --imu rec_orin.mp4 --json --camera-frame)
+  rmse_of(gopro_orin "${output}")
+  expect_same_rmse("${expected_orin}" "${gopro_orin}" "--imu rec_orin.mp4 (ORIN yZx) against the samples written")
+  expect_no_match("no ORIN in its GPMF")
+  run(0 ${CLI} eval video.csv rec.mp4 --imu rec.mp4)
+  expect_match("note: rec.mp4: 191 gyro samples from its GoPro metadata \\(GPMF, axis order ZXY\\), timed by a fit to the payload times: 200 Hz from t = 0 ns")
+  expect_match("IMU to camera rotation from GoPro's IMU axis labels")
+  run(2 ${CLI} eval video.csv rec.mp4 --imu rec.mp4 --imu-units s,deg/s)
+  expect_match("rec.mp4 is an MP4, whose GoPro metadata \\(GPMF\\) states its own units")
+
+  # Damaged MP4s: the file and the byte offset named, exit 2. Cut short (the moov is lost and
+  # mdat overruns the end); a GYRO item whose repeat claims more than its payload; no gpmd track.
+  execute_process(COMMAND ${PYTHON} -c "
+d = open('${WORK}/rec.mp4', 'rb').read()
+open('${WORK}/cut.mp4', 'wb').write(d[:len(d) // 2])
+k = d.index(b'GYRO')
+open('${WORK}/klv.mp4', 'wb').write(d[:k + 6] + b'\\xff\\xff' + d[k + 8:])
+print(k)
+s = d.index(b'gpmd')
+open('${WORK}/nogpmd.mp4', 'wb').write(d[:s] + b'xxxx' + d[s + 4:])
+" OUTPUT_VARIABLE gyro_offset OUTPUT_STRIP_TRAILING_WHITESPACE)
+  run(2 ${CLI} eval video.csv rec.mp4 --imu cut.mp4)
+  expect_match("cut.mp4: damaged MP4 at byte offset 24: box 'mdat' claims [0-9]+ bytes, beyond the file's end")
+  run(2 ${CLI} eval video.csv rec.mp4 --imu klv.mp4)
+  expect_match("klv.mp4: damaged GPMF at byte offset ${gyro_offset}: GYRO claims 393210 bytes")
+  run(2 ${CLI} eval video.csv rec.mp4 --imu nogpmd.mp4)
+  expect_match("nogpmd.mp4 is an MP4 without GoPro metadata \\(a track whose sample description is 'gpmd'; tracks found, handler/format: vide/png , meta/xxxx\\)")
+endif()

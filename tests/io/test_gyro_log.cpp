@@ -113,8 +113,10 @@ TEST(GyroLog, BadNumbersNameFileLineAndValue) {
   const auto fields = write(dir, "fields.csv", "t_s,gx,gy,gz\n0,0,0,0\n0.005,0,0\n");
   EXPECT_TRUE(contains(invalid_input_message([&] { read_gyro_log(fields); }),
                        "fields.csv line 3: expected 4 comma-separated fields (as the header on line 1 names), found 3"));
-  const auto five = write(dir, "five.csv", "t_s,gx,gy,gz,temp\n0,0,0,0,20\n");
-  EXPECT_TRUE(contains(invalid_input_message([&] { read_gyro_log(five); }), "the header names 5 columns"));
+  // Five columns whose names say nothing of time or gyro: neither by name nor EuRoC's order.
+  const auto five = write(dir, "five.csv", "a,b,c,d,e\n0,0,0,0,20\n");
+  EXPECT_TRUE(contains(invalid_input_message([&] { read_gyro_log(five); }),
+                       "five.csv line 1: the header names 5 columns (a, b, c, d, e), and no time, gx, gy, gz among them"));
   const auto back = write(dir, "back.csv", "t_s,gx,gy,gz\n0.010,0,0,0\n0.005,0,0,0\n");
   EXPECT_TRUE(contains(invalid_input_message([&] { read_gyro_log(back); }), "goes back in time"));
   const auto empty = write(dir, "empty.csv", "t_s,gx,gy,gz\n");
@@ -163,4 +165,105 @@ TEST(GyroLog, GyroflowGcsvWithItsScales) {
   EXPECT_TRUE(contains(invalid_input_message([&] { read_gyro_log(not_gcsv); }), "g.gcsv line 1: a Gyroflow .gcsv starts with GYROFLOW IMU LOG"));
   const auto short_row = write(dir, "h.gcsv", head + "tscale,0.001\ngscale,1\nt,gx,gy,gz\n0,1,2\n");
   EXPECT_TRUE(contains(invalid_input_message([&] { read_gyro_log(short_row); }), "h.gcsv line 12: expected 4 comma-separated fields"));
+}
+
+// Other layouts by name: extra columns, another order, the unit in the name; the same samples.
+TEST(GyroLog, ColumnsFoundByName) {
+  te::TempDir dir("gyro_named");
+  const auto p = write(dir, "reordered.csv", "temp,gz,t_s,gx,accel,gy\n20,0.3,1.5,0.1,9.8,0.2\n21,0.6,1.505,0.4,9.8,0.5\n");
+  const GyroLog log = read_gyro_log(p);
+  ASSERT_EQ(log.samples.size(), 2u);
+  EXPECT_EQ(log.samples[1].t_ns, 1'505'000'000);
+  EXPECT_DOUBLE_EQ(log.samples[0].gyro[0], 0.1);
+  EXPECT_DOUBLE_EQ(log.samples[0].gyro[1], 0.2);
+  EXPECT_DOUBLE_EQ(log.samples[1].gyro[2], 0.6);
+  EXPECT_TRUE(has_note(log, "time from column \"t_s\", gyro x, y, z from \"gx\", \"gy\", \"gz\" (found by name"));
+
+  // Sensor Logger's Gyroscope.csv: nanoseconds named `time`, then seconds_elapsed, axes z, y, x.
+  const auto phone = write(dir, "Gyroscope.csv", "time,seconds_elapsed,z,y,x\n1700000000000000000,0,0.3,0.2,0.1\n"
+                                                 "1700000000010000000,0.01,0.3,0.2,0.1\n");
+  const GyroLog s = read_gyro_log(phone);
+  EXPECT_EQ(s.samples[1].t_ns, 1700000000010000000);
+  EXPECT_DOUBLE_EQ(s.samples[1].gyro[0], 0.1);
+  EXPECT_DOUBLE_EQ(s.samples[1].gyro[2], 0.3);
+
+  // phyphox: quoted names with units in parentheses.
+  const auto phyphox = write(dir, "phyphox.csv", "\"Time (s)\",\"Gyroscope x (rad/s)\",\"Gyroscope y (rad/s)\","
+                                                 "\"Gyroscope z (rad/s)\"\n0.5,0.1,0.2,0.3\n0.51,0.1,0.2,0.3\n");
+  EXPECT_EQ(read_gyro_log(phyphox).samples[1].t_ns, 510'000'000);
+
+  // Betaflight: blackbox_decode's `time (us)` and Blackbox Explorer's plain `time` are µs; gyroADC deg/s.
+  const auto decode = write(dir, "bf.csv", "loopIteration, time (us), axisP[0], gyroADC[0], gyroADC[1], gyroADC[2]\n"
+                                           "0, 1000, 5, 180, -90, 0\n1, 1125, 5, 180, -90, 0\n");
+  const GyroLog b = read_gyro_log(decode);
+  EXPECT_EQ(b.samples[1].t_ns, 1'125'000);
+  EXPECT_NEAR(b.samples[0].gyro[0], 3.14159265358979, 1e-12);
+  EXPECT_NEAR(b.samples[0].gyro[1], -1.5707963267949, 1e-12);
+  EXPECT_TRUE(has_note(b, "Betaflight's gyroADC, in degrees per second"));
+  const auto explorer = write(dir, "explorer.csv", "\"loopIteration\",\"time\",\"gyroADC[0]\",\"gyroADC[1]\",\"gyroADC[2]\"\n"
+                                                   "0,1000,1,2,3\n1,1125,1,2,3\n");
+  const GyroLog e = read_gyro_log(explorer);
+  EXPECT_EQ(e.samples[1].t_ns, 1'125'000);
+  EXPECT_TRUE(has_note(e, "is read as microseconds, as Betaflight logs it"));
+
+  // Two columns that could be one axis: refused, naming both.
+  const auto twice = write(dir, "twice.csv", "t,gx,gyro_x,gy,gz\n0,0,0,0,0\n");
+  EXPECT_TRUE(contains(invalid_input_message([&] { read_gyro_log(twice); }),
+                       "twice.csv line 1: two columns could be the gyro's x axis, \"gx\" and \"gyro_x\": choose with --imu-columns"));
+}
+
+// --imu-columns and --imu-units: any columns, by name or 0-based index, in seconds and deg/s.
+TEST(GyroLog, ColumnsAndUnitsGiven) {
+  te::TempDir dir("gyro_given");
+  GyroLogOptions o;
+  o.columns = {"stamp", "wx", "wy", "wz"};
+  o.time_unit = TimeUnit::s;
+  o.gyro_unit = GyroUnit::deg_s;
+  o.time_unit_option = "--imu-units";
+  const auto named = write(dir, "named.csv", "wz,stamp,wy,junk,wx\n90,2.25,-45,x,180\n90,2.255,-45,y,180\n");
+  const GyroLog log = read_gyro_log(named, o);
+  ASSERT_EQ(log.samples.size(), 2u);
+  EXPECT_EQ(log.samples[1].t_ns, 2'255'000'000);
+  EXPECT_NEAR(log.samples[0].gyro[0], 3.14159265358979, 1e-12);
+  EXPECT_NEAR(log.samples[0].gyro[1], -0.785398163397448, 1e-12);
+  EXPECT_NEAR(log.samples[0].gyro[2], 1.5707963267949, 1e-12);
+
+  GyroLogOptions by_index = o;
+  by_index.columns = {"1", "4", " 2", "0"};
+  const auto bare = write(dir, "bare.csv", "90,2.25,-45,7,180\n90,2.255,-45,7,180\n");
+  const GyroLog b = read_gyro_log(bare, by_index);
+  EXPECT_EQ(b.samples[0].t_ns, 2'250'000'000);
+  EXPECT_NEAR(b.samples[0].gyro[2], 1.5707963267949, 1e-12);
+
+  GyroLogOptions missing = o;
+  missing.columns = {"stamp", "wx", "wy", "omega"};
+  EXPECT_TRUE(contains(invalid_input_message([&] { read_gyro_log(named, missing); }),
+                       "--imu-columns: " + named.string() + " line 1: no column named \"omega\" among: wz, stamp, wy, junk, wx"));
+  EXPECT_TRUE(contains(invalid_input_message([&] { read_gyro_log(bare, o); }),
+                       "--imu-columns names the column \"stamp\", but " + bare.string() + " has no header line"));
+  GyroLogOptions beyond = by_index;
+  beyond.columns = {"1", "4", "2", "9"};
+  EXPECT_TRUE(contains(invalid_input_message([&] { read_gyro_log(bare, beyond); }),
+                       "bare.csv line 1: --imu-columns reads column 9 (0-based), but the row has 5 fields"));
+  GyroLogOptions three = o;
+  three.columns = {"stamp", "wx", "wy"};
+  EXPECT_TRUE(contains(invalid_input_message([&] { read_gyro_log(named, three); }), "--imu-columns takes four columns"));
+  // A value that is not a number: file, line, column and value.
+  const auto bad = write(dir, "bad.csv", "wz,stamp,wy,junk,wx\n90,2.25,-45,x,180\n90,2.255,1e,y,180\n");
+  const std::string not_number = invalid_input_message([&] { read_gyro_log(bad, o); });
+  EXPECT_TRUE(contains(not_number, "bad.csv line 3: wy should be a number, found \"1e\"")) << not_number;
+  // Units that contradict the names.
+  const auto deg = write(dir, "deg.csv", "t_ms,gx_deg,gy_deg,gz_deg\n1,0,0,0\n");
+  GyroLogOptions rad;
+  rad.gyro_unit = GyroUnit::rad_s;
+  EXPECT_TRUE(contains(invalid_input_message([&] { read_gyro_log(deg, rad); }),
+                       "deg.csv line 1: the gyro column \"gx_deg\" is in deg/s, but --imu-units says rad/s"));
+  GyroLogOptions seconds = o;
+  seconds.columns.clear();
+  seconds.gyro_unit.reset();
+  EXPECT_TRUE(contains(invalid_input_message([&] { read_gyro_log(deg, seconds); }),
+                       "deg.csv line 1: the time column \"t_ms\" is in ms, but --imu-units says s"));
+  // A .gcsv states its own layout.
+  const auto gcsv = write(dir, "g.gcsv", "GYROFLOW IMU LOG\ntscale,1\ngscale,1\nt,gx,gy,gz\n0,0,0,0\n");
+  EXPECT_TRUE(contains(invalid_input_message([&] { read_gyro_log(gcsv, o); }), "do not apply to"));
 }

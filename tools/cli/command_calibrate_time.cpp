@@ -110,6 +110,8 @@ Command register_calibrate_time(CLI::App& app, const GlobalOptions& global) {
     if (o->input.camera != "cam0") input += " --camera " + o->input.camera;
     if (!o->input.imu.empty()) input += " --imu " + o->input.imu;
     if (!o->input.imu_time_unit.empty()) input += " --imu-time-unit " + o->input.imu_time_unit;
+    if (!o->input.imu_columns.empty()) input += " --imu-columns '" + o->input.imu_columns + "'";
+    if (!o->input.imu_units.empty()) input += " --imu-units " + o->input.imu_units;
     if (!o->input.T_cam_imu.empty()) input += " --T-cam-imu '" + o->input.T_cam_imu + "'";
     if (!o->input.camchain.empty()) input += " --camchain " + o->input.camchain;
     if (!o->input.bag.image.empty()) input += " --image-topic " + o->input.bag.image;

@@ -104,11 +104,30 @@ void add_imu_options(CLI::App& app, ImuCliOptions& o) {
                  "gyro log on the frames' clock, for an image folder or a video (for a EuRoC folder it replaces "
                  "mav0/imu0/data.csv): a CSV of time, gx, gy, gz [rad/s] with or without accel x y z after them "
                  "(EuRoC's imu0/data.csv), times in ns unless the header (t_s, timestamp [ns], ...) or "
-                 "--imu-time-unit says otherwise; or Gyroflow's .gcsv")
+                 "--imu-time-unit says otherwise; a CSV with other columns found by name (time, gx/gyro_x/"
+                 "gyroADC[0]/x, ...) or chosen with --imu-columns; Gyroflow's .gcsv; or a GoPro MP4's embedded "
+                 "gyro (GPMF)")
       ->check(CLI::ExistingFile);
-  app.add_option("--imu-time-unit", o.imu_time_unit,
-                 "unit of the --imu CSV's time column when its header does not name it: s, ms, us or ns")
-      ->transform(choice("time unit", {"s", "ms", "us", "ns"}));
+  auto* time_unit = app.add_option("--imu-time-unit", o.imu_time_unit,
+                                   "unit of the --imu CSV's time column when its header does not name it: s, ms, us or ns")
+                        ->transform(choice("time unit", {"s", "ms", "us", "ns"}));
+  app.add_option("--imu-columns", o.imu_columns,
+                 "the --imu CSV's time, gx, gy, gz columns: four header names or 0-based indices, comma-separated "
+                 "(e.g. 'time,x,y,z' or 0,3,2,1); other columns are ignored");
+  app.add_option("--imu-units", o.imu_units,
+                 "units of the --imu CSV's time and gyro columns: TIME,GYRO with TIME s, ms, us or ns and GYRO "
+                 "rad/s or deg/s (e.g. s,deg/s)")
+      ->excludes(time_unit)
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            const std::size_t comma = text.find(',');
+            if (comma == std::string::npos || !parse_time_unit(text.substr(0, comma)) ||
+                !parse_gyro_unit(text.substr(comma + 1))) {
+              return "expected TIME,GYRO with TIME one of s, ms, us, ns and GYRO rad/s or deg/s, got " + excerpt(text);
+            }
+            return std::string();
+          },
+          "TIME,GYRO"));
   auto* t = app.add_option("--T-cam-imu", o.T_cam_imu,
                            "with --imu: IMU-to-camera transform, 16 numbers (4x4 row-major, Kalibr's T_cam_imu) or a "
                            "YAML file with T_cam_imu (or T_BS as cam0/sensor.yaml writes it); default: identity");
@@ -129,6 +148,17 @@ ImuSequenceOptions imu_sequence_options(const ImuCliOptions& o) {
   options.camera = o.camera;
   options.bag = o.bag;
   if (!o.imu_time_unit.empty()) options.imu_time_unit = parse_time_unit(o.imu_time_unit);
+  if (!o.imu_units.empty()) {
+    const std::size_t comma = o.imu_units.find(',');
+    options.imu_format.time_unit = parse_time_unit(o.imu_units.substr(0, comma));
+    options.imu_format.gyro_unit = parse_gyro_unit(o.imu_units.substr(comma + 1));
+    options.imu_format.time_unit_option = "--imu-units";
+  }
+  if (!o.imu_columns.empty()) {
+    std::stringstream columns(o.imu_columns);
+    for (std::string c; std::getline(columns, c, ',');) options.imu_format.columns.push_back(c);
+    if (o.imu_columns.back() == ',') options.imu_format.columns.emplace_back();
+  }
   if (!o.T_cam_imu.empty()) options.camera_imu = parse_camera_imu(o.T_cam_imu, "--T-cam-imu");
   if (!o.camchain.empty()) options.camera_imu = read_kalibr_camchain(o.camchain);
   if (!o.calibration.file.empty()) {

@@ -44,10 +44,11 @@ void add_camera_option(CLI::App& app, std::string& camera);
 // (bag_topics.hpp); predict has no IMU to read.
 void add_bag_topic_options(CLI::App& app, BagTopics& topics, bool imu);
 
-// --imu FILE, --imu-time-unit s|ms|us|ns, --T-cam-imu M|FILE, --camchain FILE, --rate HZ, and a
-// bag's topics.
+// --imu FILE, --imu-time-unit s|ms|us|ns, --imu-columns T,GX,GY,GZ, --imu-units TIME,GYRO,
+// --T-cam-imu M|FILE, --camchain FILE, --rate HZ, and a bag's topics.
 struct ImuCliOptions {
   std::string imu, imu_time_unit, T_cam_imu, camchain;
+  std::string imu_columns, imu_units;  // as given; split in imu_sequence_options
   std::string camera = "cam0";  // --camera, added with the IMU options
   double rate_hz = 0;
   BagTopics bag;                // --image-topic, --imu-topic, --camera-info-topic

@@ -41,10 +41,10 @@
 namespace inertialnet {
 
 enum class SyncTarget { Spline, Mean };
-enum class BiasSource { None, Given, GroundTruth, StaticStart, Automatic, LeastSquares };
+enum class BiasSource { None, Given, GroundTruth, StaticStart, Automatic, LeastSquares, Mocap };
 
 std::string to_string(SyncTarget target);   // "spline", "mean"
-// "none", "given", "ground_truth", "static_start", "automatic", "least_squares"
+// "none", "given", "ground_truth", "static_start", "automatic", "least_squares", "mocap"
 std::string to_string(BiasSource source);
 SyncTarget parse_sync_target(const std::string& text);   // throws invalid_input listing the choices
 // "x,y,z" (whitespace allowed) → Vec3; throws invalid_input naming `what`.
@@ -102,11 +102,12 @@ struct GyroTruth {
 // Low level: `imu_to_camera` is R_CS = R_BS,camᵀ · R_BS,imu (required with camera_frame).
 // Throws invalid_input when the camera timestamps are not strictly increasing, when the IMU
 // has fewer than 2 samples, when no camera frame falls inside the IMU's span, or when a bias
-// source that was asked for explicitly is unavailable.
+// source that was asked for explicitly is unavailable. Automatic bias: the ground truth's, else a
+// static start's, else the mocap's (`mocap`, TUM-VI's mocap0: mocap_bias.hpp), else none.
 GyroTruth sync_gyro(const std::vector<std::int64_t>& camera_t_ns, const std::vector<ImuSample>& imu,
                     const SyncOptions& options,
                     const std::vector<GroundTruthSample>* ground_truth = nullptr,
-                    const Mat3* imu_to_camera = nullptr);
+                    const Mat3* imu_to_camera = nullptr, const std::vector<MocapSample>* mocap = nullptr);
 
 // A EuRoC sequence's camera frames, IMU, ground truth and calibration.
 GyroTruth sync_gyro(const EurocSequence& sequence, const SyncOptions& options);

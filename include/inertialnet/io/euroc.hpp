@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "inertialnet/core/vec3.hpp"
+#include "inertialnet/io/mocap.hpp"
 
 namespace inertialnet {
 
@@ -62,7 +63,7 @@ struct EurocReadOptions {
   std::string camera = "cam0";     // which camera folder under mav0/
   bool check_images = true;        // every listed image must exist (not decoded)
   bool read_imu = true;            // mav0/imu0/data.csv is then required
-  bool read_ground_truth = true;   // mav0/state_groundtruth_estimate0/data.csv, read when present
+  bool read_ground_truth = true;   // mav0/state_groundtruth_estimate0/data.csv (and mocap0/data.csv), read when present
 };
 
 struct EurocSequence {
@@ -73,6 +74,9 @@ struct EurocSequence {
   std::vector<ImuSample> imu;
   std::optional<Mat3> imu_rotation_BS;                // imu0/sensor.yaml's R_BS when present (identity in EuRoC)
   std::optional<std::vector<GroundTruthSample>> ground_truth;
+  // TUM-VI's mav0/mocap0/data.csv (IMU poses, no bias), read with the ground truth when present:
+  // the gyro bias of a sequence without a ground-truth bias or a static start (mocap_bias.hpp).
+  std::optional<std::vector<MocapSample>> mocap;
   std::vector<std::string> warnings;                  // timestamp gaps and the like, one sentence each
   // For an input with an IMU file (imu_sequence.hpp): R_cam_imu, IMU → camera, which then stands
   // for the sensor.yaml pair in imu_to_camera_rotation(); the body frame is the IMU frame.

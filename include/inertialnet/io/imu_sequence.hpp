@@ -8,7 +8,8 @@
 // frame, usually 0) — a constant difference is the camera–IMU time offset.
 //
 // The IMU frame is the body frame. For a folder or a video, the rotation to the camera is the
-// calibration given (camera_imu.hpp) or, without one, the identity (a note says so); frame times
+// calibration given (camera_imu.hpp), else the one the log's format implies (a GoPro MP4's axis
+// labels, gpmf.hpp), else the identity (a note says either); frame times
 // are the ones predict stamps (open_frame_source with the same rate). For a EuRoC folder the IMU
 // file replaces mav0/imu0/data.csv (a note says so) and is taken to be in imu0's frame: the
 // camera's (`camera`: cam0 or cam1) T_BS keeps giving the rotation (a calibration given is refused, invalid_input), and the ground
@@ -34,6 +35,7 @@ struct ImuSequenceOptions {
   std::optional<CameraImuCalibration> camera_imu;  // IMU → camera for a folder or a video
   std::optional<double> rate_hz;                   // as predict's --rate, for a folder or a video
   std::optional<TimeUnit> imu_time_unit;           // the time unit of imu_csv's CSV (--imu-time-unit)
+  GyroLogOptions imu_format;                       // --imu-columns, --imu-units (imu_time_unit, when set, wins)
   std::string camera = "cam0";                     // a EuRoC folder's camera (--camera); cam0 for others
   BagTopics bag;                                   // a ROS bag's topics (--image-topic, --imu-topic, …)
 };
