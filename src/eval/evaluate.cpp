@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "inertialnet/eval/rotation_fit.hpp"
 #include "inertialnet/runtime/error.hpp"
 
 namespace inertialnet {
@@ -95,6 +96,17 @@ EvalReport evaluate(const RatesTable& all_rates, const EurocSequence& seq, const
   } else {
     notes.push_back(std::string("The rates file does not state its frame; its rates are taken to be in the ") +
                     (compare_in_camera ? "camera" : "body (IMU)") + " frame of the comparison.");
+  }
+
+  if (options.rotation_correction_deg) {
+    // R_BS,true = R · R_BS: the IMU-frame prediction p becomes R·p; a camera-frame one, R_cs·R·R_csᵀ·p.
+    const Mat3 correction = rotation_from_vector_deg(*options.rotation_correction_deg);
+    std::optional<Mat3> r_cs;
+    if (compare_in_camera) r_cs = imu_to_camera_rotation(seq);
+    for (auto& w : predicted) w = r_cs ? mul(*r_cs, mul(correction, mul_transposed(*r_cs, w))) : mul(correction, w);
+    r.rotation_correction_deg = options.rotation_correction_deg;
+    notes.push_back("Predictions rotated by the camera-IMU rotation correction " +
+                    fmt3(*options.rotation_correction_deg, "%+.3f") + " deg (rotation vector, IMU frame).");
   }
 
   const auto& calibration = options.input.camera_imu;
@@ -323,6 +335,10 @@ std::string EvalReport::table() const {
     s += buf;
     if (time_offset_estimate) s += "  " + time_offset_estimate->summary() + "\n";
   }
+  if (rotation_correction_deg) {
+    s += "  camera-IMU rotation correction applied: " + fmt3(*rotation_correction_deg, "%+.3f") +
+         " deg (rotation vector, IMU frame)\n";
+  }
   s += "\n";
 
   std::vector<RmseRow> rows;
@@ -371,6 +387,7 @@ std::string EvalReport::json(bool include_series) const {
                                  {"determined", e.determined}};
     if (!e.determined) j["time_offset_estimate"]["undetermined_reason"] = e.undetermined_reason;
   }
+  if (rotation_correction_deg) j["rotation_correction_deg"] = vec_json(*rotation_correction_deg);
   j["bias"] = {{"source", to_string(bias_source)}};
   if (bias_source != BiasSource::None) j["bias"]["imu_frame_rad_s"] = vec_json(bias_imu_frame);
   j["raw"] = stats_json(raw);

@@ -26,14 +26,22 @@
 // data cannot say when the camera's frames were taken. The estimate then says so
 // (`determined` false, `undetermined_reason` in words, offset_s 0, std_error_s infinite) rather
 // than offering a range edge or an infinitely uncertain value to apply (issue 20, item 9).
+//
+// With `fit_rotation` (calibrate-time) the camera–IMU rotation correction (rotation_fit.hpp) is
+// fitted with the offset, alternately: the offset on the predictions as given, the rotation at
+// that offset, the offset again on the rotated predictions, twice; then the rotation once more at
+// the final offset. A rotation error leaks rate from one axis into the others, which the offset
+// search alone would partly absorb; the alternation lowers one cost over both unknowns.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "inertialnet/core/vec3.hpp"
+#include "inertialnet/eval/rotation_fit.hpp"
 #include "inertialnet/io/euroc.hpp"
 
 namespace inertialnet {
@@ -41,6 +49,7 @@ namespace inertialnet {
 struct TimeOffsetOptions {
   double range_s = 0.2;    // candidates over [−range_s, range_s]
   double step_s = 0.001;   // grid step before the parabolic refinement
+  bool fit_rotation = false;  // also fit the camera–IMU rotation correction (see above)
 };
 
 struct TimeOffsetEstimate {
@@ -51,8 +60,11 @@ struct TimeOffsetEstimate {
   std::size_t pairs = 0;       // frame pairs used
   double rmse_deg_s = 0;       // per-axis-mean-removed RMS residual at the estimate (over 3 axes)
   double rmse_at_zero_deg_s = 0;  // the same with no offset
+  double excitation_deg_s = 0;    // the gyro's per-axis-mean-removed RMS over the pairs, at the estimate
+  double explained = 0;           // 1 − residual² / excitation²: the share of the gyro's motion predicted
   bool determined = true;         // false: the data fix no offset; nothing to apply
   std::string undetermined_reason;  // why not, in words ("the gyro shows no rotation …")
+  std::optional<RotationFit> rotation;  // with fit_rotation (unset when the offset search ended on the edge)
   std::string summary() const; // one line for reports
   // A rough verdict: "none" (not determined), "high" (σ < 2 ms and contrast < 0.5), "low" (flat),
   // else "medium".
