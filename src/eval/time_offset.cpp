@@ -49,9 +49,36 @@ double centred_rms(const std::vector<Vec3>& values) {
 
 std::string TimeOffsetEstimate::confidence() const {
   if (!determined) return "none";
-  if (at_range_edge || !std::isfinite(std_error_s) || contrast > 0.9) return "low";
-  if (std_error_s < 0.002 && contrast < 0.5) return "high";
+  // The curvature's σ assumes the residual is noise around a true alignment; when the predictions
+  // explain little of a gyro that barely moves, the minimum is noise fitted to noise and its σ
+  // is as small as any (a near-still clip gave a spurious +6 ms rated high, issue 22).
+  if (at_range_edge || !std::isfinite(std_error_s) || contrast > 0.9 || explained < kLowExplained ||
+      excitation_deg_s < kLowExcitationDegS) {
+    return "low";
+  }
+  if (std_error_s < 0.002 && contrast < 0.5 && explained >= kHighExplained && excitation_deg_s >= kHighExcitationDegS) {
+    return "high";
+  }
   return "medium";
+}
+
+std::string TimeOffsetEstimate::unreliable_reason() const {
+  char buf[200];
+  if (!determined) return undetermined_reason;
+  if (at_range_edge) return "the best alignment lies on the edge of the search range";
+  if (!std::isfinite(std_error_s)) return "the alignment cost has no distinct minimum";
+  if (excitation_deg_s < kLowExcitationDegS) {
+    std::snprintf(buf, sizeof buf, "the gyro moves only %.2f deg/s RMS over these frames (below %.2g): too still to time",
+                  excitation_deg_s, kLowExcitationDegS);
+    return buf;
+  }
+  if (explained < kLowExplained) {
+    std::snprintf(buf, sizeof buf, "the aligned predictions explain only %.0f %% of the gyro's motion (below %.0f %%)",
+                  100 * explained, 100 * kLowExplained);
+    return buf;
+  }
+  if (contrast > 0.9) return "the alignment cost is nearly flat";
+  return "";
 }
 
 std::string TimeOffsetEstimate::summary() const {
@@ -59,12 +86,14 @@ std::string TimeOffsetEstimate::summary() const {
     return "camera-IMU time offset not determined: " + undetermined_reason + " (" + std::to_string(pairs) +
            " frame pairs)";
   }
-  char buf[320];
+  char buf[400];
   std::snprintf(buf, sizeof buf,
                 "camera-IMU time offset %+.2f ms (t_imu = t_cam + offset) +- %.2f ms (1 sigma), confidence %s "
-                "(cost contrast %.3f, %zu frame pairs; residual %.3f deg/s, %.3f deg/s without the offset)%s",
-                offset_s * 1e3, std_error_s * 1e3, confidence().c_str(), contrast, pairs, rmse_deg_s,
-                rmse_at_zero_deg_s, at_range_edge ? "; the minimum lies at the edge of the search range" : "");
+                "(cost contrast %.3f, %zu frame pairs, gyro %.2f deg/s RMS, %.0f %% explained; residual %.3f deg/s, "
+                "%.3f deg/s without the offset)%s",
+                offset_s * 1e3, std_error_s * 1e3, confidence().c_str(), contrast, pairs, excitation_deg_s,
+                100 * explained, rmse_deg_s, rmse_at_zero_deg_s,
+                at_range_edge ? "; the minimum lies at the edge of the search range" : "");
   return buf;
 }
 

@@ -122,3 +122,22 @@ run(2 ${CLI} eval rates.csv rig --rotation-correction 1,2)
 expect_match("--rotation-correction should be three comma-separated numbers")
 run(2 ${CLI} eval rates.csv rig --rotation-correction 200,0,0)
 expect_match("--rotation-correction should be a rotation vector of at most 180 degrees, found \"200,0,0\"")
+
+# Issue 22: ratings that do not lie and an `auto` that refuses. A near-still clip (0.05 deg/s):
+# the offset found is noise fitted to noise, rated low with the reason; eval --time-offset auto
+# refuses it (exit 2, what to do), and calibrate-time suggests nothing to apply.
+run(0 ${CLI} synth still --frames 60 --size 188x120 --seed 1 --max-rate 0.05)
+run(0 ${CLI} calibrate-time still)
+expect_match("confidence low")
+expect_match("the gyro moves only 0\\.0[0-9] deg/s RMS")
+expect_no_match("apply it with")
+run(0 ${CLI} predict still -o still.csv)
+run(2 ${CLI} eval still.csv still --time-offset auto)
+expect_match("--time-offset auto: the camera-IMU time offset estimated \\([-+0-9.]+ ms, confidence low\\) is not reliable: the gyro moves only")
+expect_match("Give the offset instead \\(--time-offset 0")
+run(0 ${CLI} eval still.csv still --time-offset 0)
+# The true offset (40 ms) beyond the range searched: the minimum on the edge is no estimate.
+run(2 ${CLI} eval rates.csv rig --time-offset auto --time-offset-range 0.01)
+expect_match("--time-offset auto: the camera-IMU time offset is not determined: the best alignment lies on the edge of the \\+-0.01 s search range")
+run(0 ${CLI} eval rates.csv rig --time-offset auto)
+expect_match("confidence high")

@@ -19,7 +19,7 @@ bool rotation_determined(const TimeOffsetEstimate& e) { return e.determined && e
 }  // namespace
 
 std::string calibrate_time_eval_options(const TimeOffsetEstimate& e) {
-  if (!e.determined) return "";
+  if (!e.determined || e.confidence() == "low") return "";
   char buf[160];
   std::snprintf(buf, sizeof buf, "--time-offset %.6f", e.offset_s);
   std::string s = buf;

@@ -19,7 +19,8 @@
 //         "rotation_vector_deg": xyz, "std_error_deg": xyz, "angle_deg", "angle_std_error_deg",
 //         "min_excitation_deg_s", "pairs", "rmse_deg_s", "rmse_before_deg_s",
 //         "undetermined_reason" (when not determined)},
-//     "apply": string (the eval options that apply the estimate; "" when nothing to apply),
+//     "apply": string (the eval options that apply the estimate; "" when nothing to apply:
+//         not determined, or confidence low),
 //     "warnings": [string] }
 #pragma once
 
@@ -33,7 +34,7 @@ namespace inertialnet::cli {
 inline constexpr const char* kCalibrateTimeJsonSchema = "inertialnet.calibrate-time/1";
 
 // The eval options applying `e` ("--time-offset 0.0399 --rotation-correction 1.01,1.99,2.00"),
-// or "" when the offset is not determined.
+// or "" when the offset is not determined or its confidence is low (eval's auto refuses it).
 std::string calibrate_time_eval_options(const TimeOffsetEstimate& e);
 
 // The `key value` lines above (after the summary lines).

@@ -119,8 +119,13 @@ Command register_calibrate_time(CLI::App& app, const GlobalOptions& global) {
       if (!o->input.imu_time_unit.empty()) input += " --imu-time-unit " + o->input.imu_time_unit;
       if (!o->input.T_cam_imu.empty()) input += " --T-cam-imu '" + o->input.T_cam_imu + "'";
       if (!o->input.camchain.empty()) input += " --camchain " + o->input.camchain;
-      std::cout << "apply it with: inertialnet eval RATES.csv " << o->sequence << input << " "
-                << calibrate_time_eval_options(e) << "\n";
+      if (e.confidence() == "low") {
+        // eval --time-offset auto refuses such an estimate; suggesting it here would undo that.
+        warning("the time offset is not reliable (" + e.unreliable_reason() + "): nothing suggested to apply");
+      } else {
+        std::cout << "apply it with: inertialnet eval RATES.csv " << o->sequence << input << " "
+                  << calibrate_time_eval_options(e) << "\n";
+      }
     }
     for (const auto& w : report.warnings) warning(w);
     return 0;

@@ -1,6 +1,7 @@
 // `inertialnet eval RATES.csv SEQ`: the paper's metrics — per-axis RMSE (deg/s, its Table 1),
 // RMS(t) (its Eq. 1), error histograms and time-series plots (its Figs. 5–10).
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -115,6 +116,19 @@ Command register_eval(CLI::App& app, const GlobalOptions&) {
         options.plot = plot.parent_path() / (plot.stem().string() + suffixes[i] + plot.extension().string());
       }
       const EvalReport report = evaluate(o->rates, o->sequence, options);
+      if (const auto& e = report.time_offset_estimate; e && (e->confidence() == "low" || e->confidence() == "none")) {
+        // An offset applied silently would be read as measured; metrics without it would not be
+        // what `auto` asked for. Refuse, say why and what to do instead.
+        char estimate[64];
+        std::snprintf(estimate, sizeof estimate, "%+.2f ms, confidence low", e->offset_s * 1e3);
+        throw invalid_input(std::string("--time-offset auto: the camera-IMU time offset") +
+                            (report.estimator.empty() ? "" : " of " + report.estimator) +
+                            (e->determined ? std::string(" estimated (") + estimate + ") is not reliable: "
+                                           : std::string(" is not determined: ")) +
+                            e->unreliable_reason() +
+                            "; not applying it. Give the offset instead (--time-offset 0, or a calibration's), or a "
+                            "wider --time-offset-range when the best alignment lies on its edge.");
+      }
       if (!o->json) {
         info("target " + to_string(report.target) +
              (o->target.empty() ? " (chosen for the estimator; --target spline|mean to change it)" : ""));

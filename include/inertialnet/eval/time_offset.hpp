@@ -18,7 +18,10 @@
 // cost_min / (3N − 3)), the cost's curvature c at the minimum gives the offset's standard error
 // sqrt(2σ² / c). `contrast` is cost_min over the median cost of the grid: near 0 for a sharp,
 // well-defined minimum, near 1 for a flat curve (a still camera carries no timing information).
-// An estimate at the edge of the range is flagged.
+// An estimate at the edge of the range is flagged. The curvature's σ holds only when there is
+// motion to align: `excitation_deg_s` is the gyro's RMS over the pairs and `explained` the share
+// of its motion (variance) the aligned predictions account for. On a near-still clip both sides
+// are noise, the minimum is noise fitted to noise, and its curvature-σ is as small as a real one.
 //
 // Not determined: when the predictions show no rotation (constant or textureless frames), the
 // gyro shows none (a still platform or a zero gyro), the cost has no interior minimum (it lies on
@@ -66,10 +69,22 @@ struct TimeOffsetEstimate {
   std::string undetermined_reason;  // why not, in words ("the gyro shows no rotation …")
   std::optional<RotationFit> rotation;  // with fit_rotation (unset when the offset search ended on the edge)
   std::string summary() const; // one line for reports
-  // A rough verdict: "none" (not determined), "high" (σ < 2 ms and contrast < 0.5), "low" (flat),
-  // else "medium".
+  // The verdict: "none" (not determined); "low" (on the range edge, no curvature, contrast > 0.9,
+  // under kLowExplained explained or under kLowExcitationDegS of gyro motion); "high" (σ < 2 ms,
+  // contrast < 0.5, at least kHighExplained explained and kHighExcitationDegS of motion); else
+  // "medium". eval --time-offset auto refuses "low" and "none" (docs/cli.md).
   std::string confidence() const;
+  // Why the estimate is "low" or "none", in words; "" otherwise.
+  std::string unreliable_reason() const;
 };
+
+// Thresholds of the verdict. Below 0.5 deg/s RMS a real gyro's noise and vibration are of the
+// size of the motion; under half the gyro's variance explained, the predictions and the gyro do
+// not describe the same motion (a still platform, a wrong extrinsic, a failing estimator).
+inline constexpr double kLowExcitationDegS = 0.5;
+inline constexpr double kLowExplained = 0.5;
+inline constexpr double kHighExcitationDegS = 2.0;
+inline constexpr double kHighExplained = 0.8;
 
 // `pairs_from[i]`, `pairs_to[i]`: frame pair i's times on the camera clock (t_{k−1}, t_k);
 // `predicted[i]`: its predicted rate, in the IMU frame (rad/s); `imu`: the gyro. Throws
