@@ -178,21 +178,28 @@ EvalReport evaluate(const RatesTable& all_rates, const EurocSequence& seq, const
              !seq.imu.empty()) {
     const StaticStartCheck still = check_static_start(seq.imu, sync.static_start);
     const std::int64_t end = seq.imu.front().t_ns + std::llround(sync.static_start.window_s * 1e9);
+    // Whether the images show rotation is asked of the file's first estimator (wx,wy,wz) whichever
+    // is evaluated: a rule that looked at each estimator's own predictions could compare two
+    // estimators of one file with two different truths (issue 22). |ω| needs no frame rotation.
+    const RatesTable first = all_rates.ok_rows("");
+    const std::vector<Vec3> first_predicted = first.rates("");
     double sum2 = 0;
     std::size_t rows_in_window = 0;
-    for (std::size_t i = 0; i < rates.size() && rates.t_ns[i] <= end; ++i) {
-      if (rates.t_ns[i] < seq.imu.front().t_ns) continue;
-      sum2 += predicted[i][0] * predicted[i][0] + predicted[i][1] * predicted[i][1] + predicted[i][2] * predicted[i][2];
+    for (std::size_t i = 0; i < first.size() && first.t_ns[i] <= end; ++i) {
+      if (first.t_ns[i] < seq.imu.front().t_ns) continue;
+      const Vec3& w = first_predicted[i];
+      sum2 += w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
       ++rows_in_window;
     }
     const double image_rms = rows_in_window ? std::sqrt(sum2 / static_cast<double>(rows_in_window)) : 0;
     if (!still.is_static && rows_in_window >= 3 && image_rms < sync.static_start.max_image_rate_rad_s) {
       sync.bias = BiasSource::StaticStart;
       sync.static_start.max_std_rad_s = std::numeric_limits<double>::infinity();
-      char buf[320];
+      char buf[400];
       std::snprintf(buf, sizeof buf,
                     "The gyro moves over the first %.2f s (std %.4g, %.4g, %.4g rad/s, above the static limit %.3g) "
-                    "but the images show no rotation there (predicted |w| RMS %.4f rad/s over %zu frame pairs): "
+                    "but the images show no rotation there (the file's first estimator, wx,wy,wz, predicts |w| RMS %.4f rad/s "
+                    "over %zu frame pairs): "
                     "taken as vibration on a still platform, so the static-start bias is used.",
                     sync.static_start.window_s, still.std[0], still.std[1], still.std[2], options.sync.static_start.max_std_rad_s,
                     image_rms, rows_in_window);
