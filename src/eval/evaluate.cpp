@@ -392,6 +392,9 @@ std::string EvalReport::json(bool include_series) const {
                                  {"at_range_edge", e.at_range_edge}, {"pairs", e.pairs},
                                  {"rmse_deg_s", e.rmse_deg_s},   {"rmse_at_zero_deg_s", e.rmse_at_zero_deg_s},
                                  {"determined", e.determined}};
+    // What the verdict weighs besides the curvature (time_offset.hpp): added under eval/1.
+    j["time_offset_estimate"]["excitation_deg_s"] = e.excitation_deg_s;
+    j["time_offset_estimate"]["explained"] = e.explained;
     if (!e.determined) j["time_offset_estimate"]["undetermined_reason"] = e.undetermined_reason;
   }
   if (rotation_correction_deg) j["rotation_correction_deg"] = vec_json(*rotation_correction_deg);

@@ -124,7 +124,8 @@ struct EvalReport {
 //       "rates_frame": "body" | "camera" | "unstated"   (the frame the rates file states)
 //       "time_offset_s": number   (shift applied, t_imu = t_cam + offset, readout/2 included)
 //       "time_offset_estimate" (with --time-offset auto): {"offset_s", "std_error_s", "contrast",
-//            "confidence", "at_range_edge", "pairs", "rmse_deg_s", "rmse_at_zero_deg_s"}
+//            "confidence", "at_range_edge", "pairs", "rmse_deg_s", "rmse_at_zero_deg_s",
+//            "excitation_deg_s", "explained"}
 //       "rotation_correction_deg": xyz    (only when --rotation-correction applied one)
 //       "bias": {"source": string, "imu_frame_rad_s": xyz (when a bias is known)}
 //       "raw", "bias_corrected" (null without a bias): {"frames": int, "rmse_deg_s": xyz,
