@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "inertialnet/eval/rotation_fit.hpp"
 #include "inertialnet/runtime/error.hpp"
 
 namespace inertialnet {
@@ -97,6 +98,17 @@ EvalReport evaluate(const RatesTable& all_rates, const EurocSequence& seq, const
                     (compare_in_camera ? "camera" : "body (IMU)") + " frame of the comparison.");
   }
 
+  if (options.rotation_correction_deg) {
+    // R_BS,true = R · R_BS: the IMU-frame prediction p becomes R·p; a camera-frame one, R_cs·R·R_csᵀ·p.
+    const Mat3 correction = rotation_from_vector_deg(*options.rotation_correction_deg);
+    std::optional<Mat3> r_cs;
+    if (compare_in_camera) r_cs = imu_to_camera_rotation(seq);
+    for (auto& w : predicted) w = r_cs ? mul(*r_cs, mul(correction, mul_transposed(*r_cs, w))) : mul(correction, w);
+    r.rotation_correction_deg = options.rotation_correction_deg;
+    notes.push_back("Predictions rotated by the camera-IMU rotation correction " +
+                    fmt3(*options.rotation_correction_deg, "%+.3f") + " deg (rotation vector, IMU frame).");
+  }
+
   const auto& calibration = options.input.camera_imu;
   const bool calibrated_shift = !options.time_offset_s && calibration && calibration->timeshift_cam_imu_s;
   const double offset = options.time_offset_s ? *options.time_offset_s
@@ -166,21 +178,28 @@ EvalReport evaluate(const RatesTable& all_rates, const EurocSequence& seq, const
              !seq.imu.empty()) {
     const StaticStartCheck still = check_static_start(seq.imu, sync.static_start);
     const std::int64_t end = seq.imu.front().t_ns + std::llround(sync.static_start.window_s * 1e9);
+    // Whether the images show rotation is asked of the file's first estimator (wx,wy,wz) whichever
+    // is evaluated: a rule that looked at each estimator's own predictions could compare two
+    // estimators of one file with two different truths (issue 22). |ω| needs no frame rotation.
+    const RatesTable first = all_rates.ok_rows("");
+    const std::vector<Vec3> first_predicted = first.rates("");
     double sum2 = 0;
     std::size_t rows_in_window = 0;
-    for (std::size_t i = 0; i < rates.size() && rates.t_ns[i] <= end; ++i) {
-      if (rates.t_ns[i] < seq.imu.front().t_ns) continue;
-      sum2 += predicted[i][0] * predicted[i][0] + predicted[i][1] * predicted[i][1] + predicted[i][2] * predicted[i][2];
+    for (std::size_t i = 0; i < first.size() && first.t_ns[i] <= end; ++i) {
+      if (first.t_ns[i] < seq.imu.front().t_ns) continue;
+      const Vec3& w = first_predicted[i];
+      sum2 += w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
       ++rows_in_window;
     }
     const double image_rms = rows_in_window ? std::sqrt(sum2 / static_cast<double>(rows_in_window)) : 0;
     if (!still.is_static && rows_in_window >= 3 && image_rms < sync.static_start.max_image_rate_rad_s) {
       sync.bias = BiasSource::StaticStart;
       sync.static_start.max_std_rad_s = std::numeric_limits<double>::infinity();
-      char buf[320];
+      char buf[400];
       std::snprintf(buf, sizeof buf,
                     "The gyro moves over the first %.2f s (std %.4g, %.4g, %.4g rad/s, above the static limit %.3g) "
-                    "but the images show no rotation there (predicted |w| RMS %.4f rad/s over %zu frame pairs): "
+                    "but the images show no rotation there (the file's first estimator, wx,wy,wz, predicts |w| RMS %.4f rad/s "
+                    "over %zu frame pairs): "
                     "taken as vibration on a still platform, so the static-start bias is used.",
                     sync.static_start.window_s, still.std[0], still.std[1], still.std[2], options.sync.static_start.max_std_rad_s,
                     image_rms, rows_in_window);
@@ -323,6 +342,10 @@ std::string EvalReport::table() const {
     s += buf;
     if (time_offset_estimate) s += "  " + time_offset_estimate->summary() + "\n";
   }
+  if (rotation_correction_deg) {
+    s += "  camera-IMU rotation correction applied: " + fmt3(*rotation_correction_deg, "%+.3f") +
+         " deg (rotation vector, IMU frame)\n";
+  }
   s += "\n";
 
   std::vector<RmseRow> rows;
@@ -369,8 +392,12 @@ std::string EvalReport::json(bool include_series) const {
                                  {"at_range_edge", e.at_range_edge}, {"pairs", e.pairs},
                                  {"rmse_deg_s", e.rmse_deg_s},   {"rmse_at_zero_deg_s", e.rmse_at_zero_deg_s},
                                  {"determined", e.determined}};
+    // What the verdict weighs besides the curvature (time_offset.hpp): added under eval/1.
+    j["time_offset_estimate"]["excitation_deg_s"] = e.excitation_deg_s;
+    j["time_offset_estimate"]["explained"] = e.explained;
     if (!e.determined) j["time_offset_estimate"]["undetermined_reason"] = e.undetermined_reason;
   }
+  if (rotation_correction_deg) j["rotation_correction_deg"] = vec_json(*rotation_correction_deg);
   j["bias"] = {{"source", to_string(bias_source)}};
   if (bias_source != BiasSource::None) j["bias"]["imu_frame_rad_s"] = vec_json(bias_imu_frame);
   j["raw"] = stats_json(raw);

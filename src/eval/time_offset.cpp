@@ -9,6 +9,7 @@
 #include <regex>
 
 #include "inertialnet/eval/metrics.hpp"
+#include "inertialnet/eval/rotation_fit.hpp"
 #include "inertialnet/eval/spline.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/runtime/excerpt.hpp"
@@ -48,9 +49,36 @@ double centred_rms(const std::vector<Vec3>& values) {
 
 std::string TimeOffsetEstimate::confidence() const {
   if (!determined) return "none";
-  if (at_range_edge || !std::isfinite(std_error_s) || contrast > 0.9) return "low";
-  if (std_error_s < 0.002 && contrast < 0.5) return "high";
+  // The curvature's σ assumes the residual is noise around a true alignment; when the predictions
+  // explain little of a gyro that barely moves, the minimum is noise fitted to noise and its σ
+  // is as small as any (a near-still clip gave a spurious +6 ms rated high, issue 22).
+  if (at_range_edge || !std::isfinite(std_error_s) || contrast > 0.9 || explained < kLowExplained ||
+      excitation_deg_s < kLowExcitationDegS) {
+    return "low";
+  }
+  if (std_error_s < 0.002 && contrast < 0.5 && explained >= kHighExplained && excitation_deg_s >= kHighExcitationDegS) {
+    return "high";
+  }
   return "medium";
+}
+
+std::string TimeOffsetEstimate::unreliable_reason() const {
+  char buf[200];
+  if (!determined) return undetermined_reason;
+  if (at_range_edge) return "the best alignment lies on the edge of the search range";
+  if (!std::isfinite(std_error_s)) return "the alignment cost has no distinct minimum";
+  if (excitation_deg_s < kLowExcitationDegS) {
+    std::snprintf(buf, sizeof buf, "the gyro moves only %.2f deg/s RMS over these frames (below %.2g): too still to time",
+                  excitation_deg_s, kLowExcitationDegS);
+    return buf;
+  }
+  if (explained < kLowExplained) {
+    std::snprintf(buf, sizeof buf, "the aligned predictions explain only %.0f %% of the gyro's motion (below %.0f %%)",
+                  100 * explained, 100 * kLowExplained);
+    return buf;
+  }
+  if (contrast > 0.9) return "the alignment cost is nearly flat";
+  return "";
 }
 
 std::string TimeOffsetEstimate::summary() const {
@@ -58,12 +86,14 @@ std::string TimeOffsetEstimate::summary() const {
     return "camera-IMU time offset not determined: " + undetermined_reason + " (" + std::to_string(pairs) +
            " frame pairs)";
   }
-  char buf[320];
+  char buf[400];
   std::snprintf(buf, sizeof buf,
                 "camera-IMU time offset %+.2f ms (t_imu = t_cam + offset) +- %.2f ms (1 sigma), confidence %s "
-                "(cost contrast %.3f, %zu frame pairs; residual %.3f deg/s, %.3f deg/s without the offset)%s",
-                offset_s * 1e3, std_error_s * 1e3, confidence().c_str(), contrast, pairs, rmse_deg_s,
-                rmse_at_zero_deg_s, at_range_edge ? "; the minimum lies at the edge of the search range" : "");
+                "(cost contrast %.3f, %zu frame pairs, gyro %.2f deg/s RMS, %.0f %% explained; residual %.3f deg/s, "
+                "%.3f deg/s without the offset)%s",
+                offset_s * 1e3, std_error_s * 1e3, confidence().c_str(), contrast, pairs, excitation_deg_s,
+                100 * explained, rmse_deg_s, rmse_at_zero_deg_s,
+                at_range_edge ? "; the minimum lies at the edge of the search range" : "");
   return buf;
 }
 
@@ -107,45 +137,77 @@ TimeOffsetEstimate estimate_time_offset(const std::vector<std::int64_t>& from, c
                         std::to_string(options.range_s) + " s; at least 3 are needed (narrow the range?).");
   }
   std::vector<Vec3> truth(pred.size());
-  const auto cost_at = [&](double tau) {
-    for (std::size_t i = 0; i < pred.size(); ++i) {
+  // The centred cost of the predictions `p` shifted by τ.
+  const auto cost_at = [&](const std::vector<Vec3>& p, double tau) {
+    for (std::size_t i = 0; i < p.size(); ++i) {
       for (int k = 0; k < 3; ++k) truth[i][k] = spline[k].mean(a[i] + tau, b[i] + tau);
     }
-    return centred_cost(pred, truth);
+    return centred_cost(p, truth);
   };
 
   const long steps = std::lround(options.range_s / options.step_s);
   const double step = options.range_s / static_cast<double>(steps);
+  const double n3 = 3.0 * static_cast<double>(pred.size());
   std::vector<double> cost(static_cast<std::size_t>(2 * steps + 1));
-  std::size_t best = 0;
-  for (long j = -steps; j <= steps; ++j) {
-    const auto idx = static_cast<std::size_t>(j + steps);
-    cost[idx] = cost_at(static_cast<double>(j) * step);
-    if (cost[idx] < cost[best]) best = idx;
-  }
+  // One grid search with its parabolic refinement over the predictions `p`; fills the offset,
+  // its error, the contrast, the range edge and the residuals of `e`.
+  const auto search = [&](const std::vector<Vec3>& p, TimeOffsetEstimate& e) {
+    std::size_t best = 0;
+    for (long j = -steps; j <= steps; ++j) {
+      const auto idx = static_cast<std::size_t>(j + steps);
+      cost[idx] = cost_at(p, static_cast<double>(j) * step);
+      if (cost[idx] < cost[best]) best = idx;
+    }
+    double tau = (static_cast<double>(best) - static_cast<double>(steps)) * step;
+    double curvature = 0;  // d²cost/dτ²
+    e.at_range_edge = best == 0 || best + 1 == cost.size();
+    if (!e.at_range_edge) {
+      const double cm = cost[best - 1], c0 = cost[best], cp = cost[best + 1];
+      curvature = (cm - 2 * c0 + cp) / (step * step);
+      if (curvature > 0) tau += std::clamp(0.5 * step * (cm - cp) / (cm - 2 * c0 + cp), -step, step);
+    }
+    e.offset_s = tau;
+    const double cost_min = std::min(cost_at(p, tau), cost[best]);
+    // `truth` now holds the gyro at τ: how much it moves, and how much of that the predictions explain.
+    const double gyro_energy = centred_cost(truth, std::vector<Vec3>(truth.size(), Vec3{0, 0, 0}));
+    e.excitation_deg_s = std::sqrt(gyro_energy / n3) * kDegreesPerRadian;
+    e.explained = gyro_energy > 0 ? 1 - cost_min / gyro_energy : 0;
+    const double dof = std::max(1.0, n3 - 3.0);
+    const double sigma2 = cost_min / dof;
+    e.std_error_s = curvature > 0 ? std::sqrt(2 * sigma2 / curvature) : std::numeric_limits<double>::infinity();
+    std::vector<double> sorted = cost;
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(sorted.size() / 2), sorted.end());
+    const double median = sorted[sorted.size() / 2];
+    e.contrast = median > 0 ? cost_min / median : 1.0;
+    e.rmse_deg_s = std::sqrt(cost_min / n3) * kDegreesPerRadian;
+    e.rmse_at_zero_deg_s = std::sqrt(cost[static_cast<std::size_t>(steps)] / n3) * kDegreesPerRadian;
+  };
 
   TimeOffsetEstimate e;
   e.pairs = pred.size();
-  double tau = (static_cast<double>(best) - static_cast<double>(steps)) * step;
-  double curvature = 0;  // d²cost/dτ²
-  e.at_range_edge = best == 0 || best + 1 == cost.size();
-  if (!e.at_range_edge) {
-    const double cm = cost[best - 1], c0 = cost[best], cp = cost[best + 1];
-    curvature = (cm - 2 * c0 + cp) / (step * step);
-    if (curvature > 0) tau += std::clamp(0.5 * step * (cm - cp) / (cm - 2 * c0 + cp), -step, step);
+  search(pred, e);
+  if (options.fit_rotation) {
+    // Alternation: the rotation fitted at the current offset, then the offset searched again with
+    // the predictions rotated. Each step lowers the same cost; on a few degrees of rotation the
+    // second round moves neither by a measurable amount, so two rounds suffice.
+    std::vector<Vec3> rotated = pred;
+    for (int round = 0; round < 2 && !e.at_range_edge; ++round) {
+      for (std::size_t i = 0; i < pred.size(); ++i) {
+        for (int k = 0; k < 3; ++k) truth[i][k] = spline[k].mean(a[i] + e.offset_s, b[i] + e.offset_s);
+      }
+      e.rotation = fit_rotation(pred, truth);
+      if (!e.rotation->determined) break;
+      for (std::size_t i = 0; i < pred.size(); ++i) rotated[i] = mul(e.rotation->rotation, pred[i]);
+      search(rotated, e);
+    }
+    if (e.rotation && e.rotation->determined) {
+      // The rotation's residual and error at the offset finally chosen.
+      for (std::size_t i = 0; i < pred.size(); ++i) {
+        for (int k = 0; k < 3; ++k) truth[i][k] = spline[k].mean(a[i] + e.offset_s, b[i] + e.offset_s);
+      }
+      e.rotation = fit_rotation(pred, truth);
+    }
   }
-  e.offset_s = tau;
-  const double cost_min = std::min(cost_at(tau), cost[best]);
-  const double dof = std::max(1.0, 3.0 * static_cast<double>(pred.size()) - 3.0);
-  const double sigma2 = cost_min / dof;
-  e.std_error_s = curvature > 0 ? std::sqrt(2 * sigma2 / curvature) : std::numeric_limits<double>::infinity();
-  std::vector<double> sorted = cost;
-  std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(sorted.size() / 2), sorted.end());
-  const double median = sorted[sorted.size() / 2];
-  e.contrast = median > 0 ? cost_min / median : 1.0;
-  const double n3 = 3.0 * static_cast<double>(pred.size());
-  e.rmse_deg_s = std::sqrt(cost_min / n3) * kDegreesPerRadian;
-  e.rmse_at_zero_deg_s = std::sqrt(cost[static_cast<std::size_t>(steps)] / n3) * kDegreesPerRadian;
 
   // Whether the data fix an offset at all (see the header); the first reason that applies.
   std::vector<Vec3> gyro(pred.size());

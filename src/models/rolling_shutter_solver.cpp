@@ -36,6 +36,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "core/eigen_conversions.hpp"
 #include "inertialnet/io/flow_io.hpp"
@@ -212,6 +213,25 @@ Fit fit_from(const std::vector<RowSample>& samples, RowMotion m, double sigma, i
 
 }  // namespace
 
+std::string rolling_shutter_fallback_reason(const Vec3& start, double start_cost, const Vec3& refined,
+                                            double refined_cost) {
+  char buf[200];
+  if (!(refined_cost <= start_cost)) {
+    std::snprintf(buf, sizeof buf, "its robust cost %.4g is above the global-shutter solution's %.4g", refined_cost,
+                  start_cost);
+    return buf;
+  }
+  const double n_start = std::sqrt(start[0] * start[0] + start[1] * start[1] + start[2] * start[2]);
+  const double n_refined = std::sqrt(refined[0] * refined[0] + refined[1] * refined[1] + refined[2] * refined[2]);
+  if (!(n_refined <= kImplausibleFactor * n_start + kImplausibleMarginRadS)) {
+    std::snprintf(buf, sizeof buf,
+                  "its |w| %.3g rad/s is implausible next to the global-shutter solution's %.3g rad/s (limit %g x + %g)",
+                  n_refined, n_start, kImplausibleFactor, kImplausibleMarginRadS);
+    return buf;
+  }
+  return "";
+}
+
 RotationEstimate refine_rolling_shutter(const std::vector<RowSample>& samples, const RotationEstimate& start,
                                         double sigma) {
   RotationEstimate est = start;
@@ -234,9 +254,16 @@ RotationEstimate refine_rolling_shutter(const std::vector<RowSample>& samples, c
     iterations += fit.iterations;
       if (fit.cost < best.cost) best = fit;
   }
+  est.iterations += iterations;
+  const std::string fallback =
+      rolling_shutter_fallback_reason(start.omega, robust_cost(samples, m, sigma), to_vec3(best.m.omega), best.cost);
+  if (!fallback.empty()) {
+    est.method = start.method + "+rows-fallback";
+    est.refinement_note = "rolling-shutter solve not taken: " + fallback;
+    return est;
+  }
   est.omega = to_vec3(best.m.omega);
   est.translation_direction = to_vec3(best.m.v.dot(start_v) < 0 ? Eigen::Vector3d(-best.m.v) : best.m.v);
-  est.iterations += iterations;
   est.converged = start.converged && best.converged;
   return est;
 }

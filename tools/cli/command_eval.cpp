@@ -1,5 +1,7 @@
 // `inertialnet eval RATES.csv SEQ`: the paper's metrics — per-axis RMSE (deg/s, its Table 1),
 // RMS(t) (its Eq. 1), error histograms and time-series plots (its Figs. 5–10).
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -10,12 +12,14 @@
 #include "input_options.hpp"
 #include "inertialnet/eval/evaluate.hpp"
 #include "inertialnet/io/rates_csv.hpp"
+#include "inertialnet/runtime/error.hpp"
+#include "inertialnet/runtime/excerpt.hpp"
 
 namespace inertialnet::cli {
 
 namespace {
 struct EvalCliOptions {
-  std::string rates, sequence, plot, target, gyro_bias, head, time_offset, readout_time;
+  std::string rates, sequence, plot, target, gyro_bias, head, time_offset, readout_time, rotation_correction;
   double offset_range = 0.2;
   bool json = false, series = false, camera_frame = false;
   ImuCliOptions input;
@@ -40,6 +44,9 @@ Command register_eval(CLI::App& app, const GlobalOptions&) {
                  "default: what the rates file states, else 0");
   app.add_option("--time-offset-range", o->offset_range, "with --time-offset auto: search +-this many seconds")
       ->capture_default_str();
+  app.add_option("--rotation-correction", o->rotation_correction,
+                 "camera-IMU rotation correction rx,ry,rz in degrees (a rotation vector in the IMU frame, as "
+                 "calibrate-time prints it): predictions are rotated by it before the comparison");
   app.add_option("--readout-time", o->readout_time,
                  "rolling-shutter readout time in seconds (rates belong to mid-exposure); default: the rates file's");
   app.add_option("--gyro-bias", o->gyro_bias, "gyro bias x,y,z in rad/s (IMU frame), or auto: a constant fitted against the predictions by least squares; "
@@ -60,6 +67,15 @@ Command register_eval(CLI::App& app, const GlobalOptions&) {
       options.time_offset_search.range_s = o->offset_range;
     } else if (!o->time_offset.empty()) {
       options.time_offset_s = parse_seconds(o->time_offset, "--time-offset");
+    }
+    if (!o->rotation_correction.empty()) {
+      const Vec3 v = parse_vec3(o->rotation_correction, "--rotation-correction");
+      // A correction is small; past 180° the same rotation has a shorter vector, so a larger one is a typo.
+      if (std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) > 180) {
+        throw invalid_input("--rotation-correction should be a rotation vector of at most 180 degrees, found \"" +
+                            excerpt(o->rotation_correction) + "\".");
+      }
+      options.rotation_correction_deg = v;
     }
     if (!o->readout_time.empty()) options.readout_time_s = parse_seconds(o->readout_time, "--readout-time");
     options.sync.camera_frame = o->camera_frame;
@@ -101,6 +117,19 @@ Command register_eval(CLI::App& app, const GlobalOptions&) {
         options.plot = plot.parent_path() / (plot.stem().string() + suffixes[i] + plot.extension().string());
       }
       const EvalReport report = evaluate(o->rates, o->sequence, options);
+      if (const auto& e = report.time_offset_estimate; e && (e->confidence() == "low" || e->confidence() == "none")) {
+        // An offset applied silently would be read as measured; metrics without it would not be
+        // what `auto` asked for. Refuse, say why and what to do instead.
+        char estimate[64];
+        std::snprintf(estimate, sizeof estimate, "%+.2f ms, confidence low", e->offset_s * 1e3);
+        throw invalid_input(std::string("--time-offset auto: the camera-IMU time offset") +
+                            (report.estimator.empty() ? "" : " of " + report.estimator) +
+                            (e->determined ? std::string(" estimated (") + estimate + ") is not reliable: "
+                                           : std::string(" is not determined: ")) +
+                            e->unreliable_reason() +
+                            "; not applying it. Give the offset instead (--time-offset 0, or a calibration's), or a "
+                            "wider --time-offset-range when the best alignment lies on its edge.");
+      }
       if (!o->json) {
         info("target " + to_string(report.target) +
              (o->target.empty() ? " (chosen for the estimator; --target spline|mean to change it)" : ""));

@@ -54,6 +54,10 @@ struct EvalOptions {
   std::optional<double> readout_time_s;
   bool estimate_time_offset = false;
   TimeOffsetOptions time_offset_search;
+  // The camera–IMU rotation correction (rotation_fit.hpp; calibrate-time's estimate), a rotation
+  // vector in degrees in the IMU frame: predictions are compared as R · ω in the IMU frame (and
+  // R conjugated into the camera frame with --camera-frame), before any offset is estimated.
+  std::optional<Vec3> rotation_correction_deg;
   // How the overload taking paths reads the sequence (an IMU file, the camera–IMU calibration,
   // the frame rate of a folder or a video: imu_sequence.hpp). In both overloads a calibration's
   // timeshift_cam_imu is the time offset unless time_offset_s is given (over the rates file's).
@@ -84,6 +88,7 @@ struct EvalReport {
   bool predictions_rotated = false;  // rotated from the file's frame into the comparison's
   double time_offset_s = 0;          // shift applied: t_imu = t_cam + this (offset + readout / 2)
   std::optional<TimeOffsetEstimate> time_offset_estimate;  // with estimate_time_offset
+  std::optional<Vec3> rotation_correction_deg;  // applied (EvalOptions::rotation_correction_deg)
 
   // Matched frames, in time order.
   std::vector<std::int64_t> t_ns;
@@ -119,7 +124,9 @@ struct EvalReport {
 //       "rates_frame": "body" | "camera" | "unstated"   (the frame the rates file states)
 //       "time_offset_s": number   (shift applied, t_imu = t_cam + offset, readout/2 included)
 //       "time_offset_estimate" (with --time-offset auto): {"offset_s", "std_error_s", "contrast",
-//            "confidence", "at_range_edge", "pairs", "rmse_deg_s", "rmse_at_zero_deg_s"}
+//            "confidence", "at_range_edge", "pairs", "rmse_deg_s", "rmse_at_zero_deg_s",
+//            "excitation_deg_s", "explained"}
+//       "rotation_correction_deg": xyz    (only when --rotation-correction applied one)
 //       "bias": {"source": string, "imu_frame_rad_s": xyz (when a bias is known)}
 //       "raw", "bias_corrected" (null without a bias): {"frames": int, "rmse_deg_s": xyz,
 //            "mean_error_deg_s": xyz, "max_abs_error_deg_s": xyz,

@@ -18,7 +18,10 @@
 // cost_min / (3N − 3)), the cost's curvature c at the minimum gives the offset's standard error
 // sqrt(2σ² / c). `contrast` is cost_min over the median cost of the grid: near 0 for a sharp,
 // well-defined minimum, near 1 for a flat curve (a still camera carries no timing information).
-// An estimate at the edge of the range is flagged.
+// An estimate at the edge of the range is flagged. The curvature's σ holds only when there is
+// motion to align: `excitation_deg_s` is the gyro's RMS over the pairs and `explained` the share
+// of its motion (variance) the aligned predictions account for. On a near-still clip both sides
+// are noise, the minimum is noise fitted to noise, and its curvature-σ is as small as a real one.
 //
 // Not determined: when the predictions show no rotation (constant or textureless frames), the
 // gyro shows none (a still platform or a zero gyro), the cost has no interior minimum (it lies on
@@ -26,14 +29,22 @@
 // data cannot say when the camera's frames were taken. The estimate then says so
 // (`determined` false, `undetermined_reason` in words, offset_s 0, std_error_s infinite) rather
 // than offering a range edge or an infinitely uncertain value to apply (issue 20, item 9).
+//
+// With `fit_rotation` (calibrate-time) the camera–IMU rotation correction (rotation_fit.hpp) is
+// fitted with the offset, alternately: the offset on the predictions as given, the rotation at
+// that offset, the offset again on the rotated predictions, twice; then the rotation once more at
+// the final offset. A rotation error leaks rate from one axis into the others, which the offset
+// search alone would partly absorb; the alternation lowers one cost over both unknowns.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "inertialnet/core/vec3.hpp"
+#include "inertialnet/eval/rotation_fit.hpp"
 #include "inertialnet/io/euroc.hpp"
 
 namespace inertialnet {
@@ -41,6 +52,7 @@ namespace inertialnet {
 struct TimeOffsetOptions {
   double range_s = 0.2;    // candidates over [−range_s, range_s]
   double step_s = 0.001;   // grid step before the parabolic refinement
+  bool fit_rotation = false;  // also fit the camera–IMU rotation correction (see above)
 };
 
 struct TimeOffsetEstimate {
@@ -51,13 +63,28 @@ struct TimeOffsetEstimate {
   std::size_t pairs = 0;       // frame pairs used
   double rmse_deg_s = 0;       // per-axis-mean-removed RMS residual at the estimate (over 3 axes)
   double rmse_at_zero_deg_s = 0;  // the same with no offset
+  double excitation_deg_s = 0;    // the gyro's per-axis-mean-removed RMS over the pairs, at the estimate
+  double explained = 0;           // 1 − residual² / excitation²: the share of the gyro's motion predicted
   bool determined = true;         // false: the data fix no offset; nothing to apply
   std::string undetermined_reason;  // why not, in words ("the gyro shows no rotation …")
+  std::optional<RotationFit> rotation;  // with fit_rotation (unset when the offset search ended on the edge)
   std::string summary() const; // one line for reports
-  // A rough verdict: "none" (not determined), "high" (σ < 2 ms and contrast < 0.5), "low" (flat),
-  // else "medium".
+  // The verdict: "none" (not determined); "low" (on the range edge, no curvature, contrast > 0.9,
+  // under kLowExplained explained or under kLowExcitationDegS of gyro motion); "high" (σ < 2 ms,
+  // contrast < 0.5, at least kHighExplained explained and kHighExcitationDegS of motion); else
+  // "medium". eval --time-offset auto refuses "low" and "none" (docs/cli.md).
   std::string confidence() const;
+  // Why the estimate is "low" or "none", in words; "" otherwise.
+  std::string unreliable_reason() const;
 };
+
+// Thresholds of the verdict. Below 0.5 deg/s RMS a real gyro's noise and vibration are of the
+// size of the motion; under half the gyro's variance explained, the predictions and the gyro do
+// not describe the same motion (a still platform, a wrong extrinsic, a failing estimator).
+inline constexpr double kLowExcitationDegS = 0.5;
+inline constexpr double kLowExplained = 0.5;
+inline constexpr double kHighExcitationDegS = 2.0;
+inline constexpr double kHighExplained = 0.8;
 
 // `pairs_from[i]`, `pairs_to[i]`: frame pair i's times on the camera clock (t_{k−1}, t_k);
 // `predicted[i]`: its predicted rate, in the IMU frame (rad/s); `imu`: the gyro. Throws

@@ -109,6 +109,10 @@ struct RotationEstimate {
   // UnanswerablePair instead when they cannot solve at all (too few vectors, a degenerate grid).
   PairStatus status = PairStatus::Ok;
   std::string status_reason;
+  // Why a refinement was not taken (the rolling-shutter solve fell back to the global-shutter
+  // solution: its cost was worse or its ω implausible; src/models/rolling_shutter_solver.hpp);
+  // "" when none was refused.
+  std::string refinement_note;
 };
 
 // A rotation that fewer than this share of the usable vectors (or this many) agree with is not
