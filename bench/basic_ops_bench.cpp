@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The memory-bound ops on the device under benchmark ($INERTIALNET_DEVICE or the default):
 // FlowNet2's input normalisation at 512×384, the head's first max-pool (16×480×752, a EuRoC
 // frame) and an elementwise add/copy on a 3×384×512 frame. GB/s counts the bytes the kernels

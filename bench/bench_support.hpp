@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What every benchmark suite shares: the device under benchmark, deterministic input data, and
 // the one timing loop (warm-up outside the timed loop, queue.finish() inside it).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Every FlowNet2 convolution and up-convolution shape at a 512×384 input (batch 1), through the
 // library's conv2d / conv_transpose2d (im2col or col2im + CLBlast GEMM + fused bias/activation),
 // on the device under benchmark ($INERTIALNET_DEVICE or the default). The shapes, FLOP and byte

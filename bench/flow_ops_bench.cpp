@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // FlowNet2's flow-specific ops at 512×384 on the device under benchmark ($INERTIALNET_DEVICE or
 // the default): FlowNetC's correlation (256×48×64 features → 441 channels) in every kernel
 // variant, the warp of a 3×384×512 frame, the channel norms and the ×4 flow upsampling.

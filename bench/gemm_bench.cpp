@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // SGEMM through the library's gemm() (CLBlast today; whatever backend the plan picks later) on the
 // device under benchmark ($INERTIALNET_DEVICE or the default), against OpenBLAS on the host in the
 // same process: square sizes, then the GEMM of every FlowNet2 conv/deconv at 512×384

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // SGEMM on FlowNet2's layer shapes, interleaved in one process: the packed-panel kernels,
 // CLBlast on the same device, and OpenBLAS on the host (loaded at run time, so the library never
 // links it and this benchmark runs without it). Rounds alternate the three so machine load

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Whole networks on the device under benchmark ($INERTIALNET_DEVICE or the default): FlowNet2
 // frame pairs per second at 512×384 and at 768×512 (EuRoC's 752×480 after padding to
 // multiples of 64), the InertialNet head at EuRoC size, and the device memory each needs

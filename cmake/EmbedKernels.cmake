@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Embeds kernels_cl/*.cl into the library as C++ raw strings (as CLBlast does with its .opencl
 # files), so the library never reads kernel files at run time. `#include "common.cl"` in a
 # kernel file is inlined here (OpenCL compilers get no include path for embedded sources).

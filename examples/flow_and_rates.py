@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Angular rates of a synthetic sequence with the weight-free path, step by step and in one call.
 
     pip install .                      # from a clone (needs the packages of tools/setup.sh)

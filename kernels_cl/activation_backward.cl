@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The gradient through a fused activation, from the activation's output y (what a forward pass
 // keeps): ReLU passes the gradient where y > 0 (PyTorch's threshold_backward on the result),
 // LeakyReLU where y > 0 and scales it by the slope elsewhere (for a positive slope y > 0 exactly

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The epilogue of the GEMM-based ops (conv2d, linear), in place:
 // x = ACTIVATE(x + bias[channel]). x is [batch, channels, plane] with samples `batch_stride`
 // apart (a channel slice of a wider tensor leaves the elements between its samples alone).

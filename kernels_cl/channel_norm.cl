@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The norm over channels (flownet2-pytorch's ChannelNorm, norm degree 2), accumulated in
 // float32: out[n, 0, p] = sqrt(Σ_c in[n, c, p]²), one work-item per pixel p of sample n.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // col2im for transposed convolutions, with the bias and the activation fused.
 // The GEMM produced columns [co·KH·KW, H·W]: entry ((c·KH + ky)·KW + kx, iy·W + ix) is what input
 // pixel (iy, ix) contributes to output pixel (iy·STRIDE − PAD + ky, ix·STRIDE − PAD + kx) of

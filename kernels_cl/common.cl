@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Helpers shared by the kernels. A kernel file includes this one by name; the build
 // (cmake/EmbedKernels.cmake) replaces that line by this file's text, so the program cache key, a
 // hash of the embedded source, changes whenever this file does.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Direct convolution for layers with very few output channels (FlowNet's predict_flow*: 2
 // channels, 3×3): an im2col + GEMM there would write and read a column matrix KH·KW times the
 // input to feed a matrix product of only COUT rows. Each work-item computes 16 consecutive

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // FlowNetC correlation (see include/inertialnet/ops/correlation.hpp for the exact semantics).
 //
 // Build options (all set by src/ops/correlation.cpp):

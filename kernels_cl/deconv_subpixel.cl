@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Transposed convolution 4×4 / stride 2 / padding 1 by sub-pixel decomposition: output pixel
 // (2a + py, 2b + px) only meets the kernel taps ky ≡ 1 − py, kx ≡ 1 − px (mod 2), so each of the
 // four output phases (py, px) is a 2×2 convolution of the input, and no column matrix or col2im

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Training-mode dropout with a counter-based mask: element i of the tensor is kept when the top
 // 24 bits of splitmix64(key + i) reach `threshold` (key = splitmix64(seed), from the host).
 // Range (sample, batch) over row-strided views as in elementwise.cl; i = n * sample + j is the

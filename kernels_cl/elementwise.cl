@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Elementwise kernels over a flat range of `count` elements. Tensor arguments follow the
 // library's convention: (buffer, element offset). Every kernel guards its index, so the host
 // may round the global size up to a multiple of the work-group size.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Packed-panel SGEMM for CPU devices: C = alpha·A·B (+ beta·C), then + bias[row] and the
 // activation, stored into a strided view of C.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Matrix × vector for fully connected layers with few samples (the InertialNet head's fc1 is a
 // 92 MB matrix times one vector): y[row] = ACTIVATE(Σ_q W[row][q]·x[q] + bias[row]).
 // The matrix is read once, in its stored layout (no packing), 16 floats at a time: the kernel

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Deterministic reductions for training: no float atomics, a fixed summation order for a given
 // work-group size (the host picks it from the device only, so one device always sums alike).
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // im2col: unfolds one NCHW sample into the column matrix of a convolution, so that the
 // convolution becomes one GEMM (weights [co, ci·KH·KW] × columns [ci·KH·KW, Ho·Wo]).
 // Build options: -DKH, -DKW (kernel size), -DSTRIDE, -DPAD (zero padding on every side).

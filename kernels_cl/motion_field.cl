@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The motion-field reductions (include/inertialnet/ops/motion_field.hpp defines the
 // quantities; src/ops/motion_field.cpp launches them, the geometric head iterates them).
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // FlowNet2's input normalisation: per-(sample, channel) mean over both frames, then
 // (frame − mean) / rgb_max into the two halves of a 2C-channel output.
 // Frames are [N, C, H, W] views: element (n, c, p) at offset + n * batch_stride + c * plane + p.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Parameter updates, one work-item per parameter, on contiguous tensors. The formulas are
 // PyTorch's (torch.optim.SGD with dampening 0, torch.optim.Adam without amsgrad), so a run can be
 // compared with theirs; the step-dependent constants come from the host in double precision.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Packing for gemm_packed.cl: a matrix rearranged into panels of WIDTH lines, depth-major.
 // Line i (a row of A, a column of B) of depth k lands in panel i / WIDTH at
 // (i / WIDTH)·depth·WIDTH + q·WIDTH + i % WIDTH for q in [0, depth); lines past `lines` are zero

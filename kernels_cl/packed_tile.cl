@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The register tile of the packed-panel GEMM, shared by every kernel that runs its inner loop
 // (gemm_packed.cl, deconv_subpixel.cl) so that they differ only in how the tile is stored:
 // MR rows of A broadcast against 32 columns of B, 2·MR float16 accumulators (see gemm_packed.cl).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Max pooling, square window POOL_KERNEL, step POOL_STRIDE (build options), no padding.
 // Range (out_w, out_h, N * C), rounded up in x and y to the work-group shape. Element
 // (n, c, y, x) of a tensor lives at offset + n * batch_stride + (c * H + y) * W + x, so both

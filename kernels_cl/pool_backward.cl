@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Max-pool backward: the gradient of each window goes to its argmax, the element PyTorch's max
 // pooling picks — the first maximum in scan order (row by row), or the last NaN when the window
 // holds one (its rule is `v > max || isnan(v)`). Each work-item owns one input element and

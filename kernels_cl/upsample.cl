@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Resampling with PyTorch interpolate() semantics (include/inertialnet/ops/upsample.hpp).
 // One work-item per output element: x, y and the (sample, channel) pair as the three global
 // dimensions. ratio_y/ratio_x are in/out sizes in float32, as PyTorch computes them; every

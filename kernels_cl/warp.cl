@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Backward warp by a flow field (flownet2-pytorch's Resample2d, kernel size 1); semantics in
 // include/inertialnet/ops/warp.hpp. One work-item per output pixel: the flow vector, the four
 // corner indices and the weights are computed once and reused for every channel.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Winograd F(2×2, 3×3) for 3×3 stride-1 convolutions on CPU devices (src/ops/winograd.cpp):
 // Y = Aᵀ [ (G g Gᵀ) ⊙ (Bᵀ d Bᵀᵀ) ] A per 2×2 output tile, with the 16 element-wise products summed
 // over input channels as 16 packed GEMMs (kernels_cl/gemm_packed.cl). Transforms (Lavin & Gray):

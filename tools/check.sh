@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The README's test command: set up, build, and run every test (on PoCL unless another device
 # is selected with INERTIALNET_TEST_DEVICE / INERTIALNET_DEVICE): the C++ suites, the CLI, the
 # Python package's pytest suite on the build tree, and `pip install .` with the suite again.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The Python package as a user installs it: `pip install .` into a fresh virtual environment (a
 # full build of the library through scikit-build-core), then the pytest suite against the
 # installed package and the command line in build/.

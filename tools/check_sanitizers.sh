@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The sanitizer pass, run by CI after the normal suites (.ci/run): a second build (build-asan/,
 # clang) with AddressSanitizer, LeakSanitizer and UBSan on the project's own targets
 # (INERTIALNET_SANITIZE; not CMAKE_CXX_FLAGS), running the unit and OpenCL suites and replaying

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Convert a flownet2-pytorch checkpoint or an InertialNet head state_dict to safetensors.
 
 Inputs:

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Runs every libFuzzer target of tests/fuzz for a set time and prints each one's executions, one
 # grep-able line per target: `fuzz <target>: N executions in S s` (or `fuzz <target>: FAILED ...`).
 #   bash tools/fuzz.sh [SECONDS_PER_TARGET] [TARGET...]     (default 30 s, every target)

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Makes (or completes) a Python virtual environment with what building and testing the Python
 # package needs, from PyPI: pybind11 and scikit-build-core (the build), numpy, pytest (the tests),
 # pandas (the rates CSV read back with its defaults), rosbags (an independent writer of the

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The README's main command: set up, build, and run the main job on the bundled default — a
 # synthetic EuRoC-layout sequence with exact gyro ground truth (rendered on the first run into
 # data/synthetic-rotation/), angular rates for every frame pair, and the paper's metrics.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Installs the Debian packages that building, testing and running InertialNet-CL need (OpenCL
 # headers and ICD loader, PoCL for the CPU, CLBlast, OpenCV, FFmpeg's libraries for videos;
 # sqlite3, zstd, lz4 and bz2 for ROS bags; GStreamer's base plugins and gst-launch for the

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Soak test: PAIRS frame pairs at 128×96 through `inertialnet predict`, its resident memory
 # (VmRSS) and the 1-minute load average sampled every second, and the verdict: flat when every
 # sample after the warm-up (the first WARMUP_PERCENT of the samples, default 20) and before the

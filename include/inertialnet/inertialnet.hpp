@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The whole public API: every public header of every layer, lowest layer first.
 #pragma once
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """InertialNet-CL for Python: camera angular velocity from image sequences.
 
 FlowNet2 optical flow and the InertialNet rotation head run as OpenCL kernels (any GPU, or the

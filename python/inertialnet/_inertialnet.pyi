@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Type stubs of the native module (python/src/bindings.cpp). The package's own classes (Rates,
 # Sequence, FlowNet, InertialNetHead) and predict/evaluate are typed in their Python files.
 import os

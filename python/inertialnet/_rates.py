@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The rates of :func:`inertialnet.predict`: one row per frame pair, with what the rates CSV states.
 
 A :class:`Rates` is what ``inertialnet predict`` writes to its CSV (schema ``inertialnet.rates/3``,

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """inertialnet.Sequence: a recording's frames as a Python sequence."""
 
 from __future__ import annotations

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """``inertialnet.stream()``: rates pair by pair as they are computed, from any source ``predict``
 reads and from live ones (a camera, a GStreamer pipeline), through the library's streaming
 predictor (python/src/stream_bindings.cpp)."""

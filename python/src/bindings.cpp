@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The Python module `inertialnet._inertialnet`: the library's API for NumPy users. The pure
 // Python package (python/inertialnet/__init__.py) re-exports it and adds the model classes,
 // Sequence (_sequence.py) and the Rates of predict() (_rates.py).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // inertialnet.stream(): the streaming predictor (include/inertialnet/pipeline/streaming_predictor.hpp)
 // as a Python iterator. Each step fetches the source's next frame, pushes it, and hands out the
 // pairs finished by then, one (timestamp_ns, rates, status) per pair, in pair order, as they come:

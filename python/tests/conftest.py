@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Shared fixtures: a small synthetic sequence and the `inertialnet` command line to compare with.
 
 The command line is $INERTIALNET_CLI, else build/inertialnet in the repository (what

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Bad arguments get readable Python errors, as the CLI's checks would give them: a matrix that is
 no rotation, a flow the learned head cannot read, negative counts and indices, a negative rate,
 exhausted memory. None of them is ignored, and none is answered with pybind11's list of overloads

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """A ROS bag as a Sequence: the frames and header stamps of its image topic, as the same frames
 given as a EuRoC folder (the bag written by tests/support/write_bag.py with PyPI rosbags)."""
 import subprocess

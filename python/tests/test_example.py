@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The example script runs as documented."""
 import pathlib
 import subprocess

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Flow files and pictures: .flo and KITTI round trips, and the Middlebury colour convention of
 flow_to_color and `inertialnet viz` checked against an independent NumPy implementation."""
 import numpy as np

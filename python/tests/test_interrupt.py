@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Long calls stop when asked: Ctrl-C raises KeyboardInterrupt within a pair or two instead of
 after the whole run, and predict()'s progress callback reports and can stop the run.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The networks through Python: FlowNet2 (synthetic weights, small frames) against the CLI's .flo
 bit for bit, batches, and the InertialNet head against `inertialnet predict`."""
 import numpy as np

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Acceptance: Python computes the numbers of the command line.
 
 DIS flow + the geometric head, through predict() and step by step through dis_flow() and

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The package behaves as Python code expects: Sequence is a collections.abc.Sequence (videos
 included), heads take the batches the flow functions return, float images in [0, 1] are images,
 missing files are FileNotFoundError, colours come in either channel order, and every object has a

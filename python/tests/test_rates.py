@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Rates carry what the CLI's rates CSV states, so that evaluate() gives `inertialnet eval`'s numbers.
 
 predict() used to return a bare structured array: evaluate() then assumed the spline target and

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """ROS 2 bags as a Sequence, in both rosbag2 storages and in each form a user has them (the bag
 folder, its .db3 or .mcap file): the frames and header stamps of the EuRoC folder they were written
 from (by tests/support/write_bag.py with PyPI rosbags). Damaged bags are a ValueError naming them."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """inertialnet.stream(): pair by pair, the numbers of predict() in its order; live sources (a
 GStreamer pipeline) as they come; Ctrl-C raises KeyboardInterrupt on a source that never ends."""
 import math

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Conversions between the core's plain arrays (Vec3, Mat3: what the public headers use, so that
 // they need no Eigen) and Eigen, for the library files that compute with Eigen. Private: Eigen
 // is linked privately and no public header names it.

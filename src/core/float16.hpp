@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // IEEE binary16 ↔ binary32 on the host: F16 tensors of weight files, and the training set's
 // flow cache, which stores flows at half the size of float32 (a few hundredths of a pixel of
 // rounding at the flows a head sees, far below DIS's own error).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The rotation group SO(3) in Eigen: the hat map, the exponential and logarithm, and the right
 // Jacobian. Shared by the synthetic renderer (closed-form trajectories) and the geometric head
 // (ω = log(R)/dt). Private, like every use of Eigen in the library.

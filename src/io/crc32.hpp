@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // CRC-32 as zlib, PNG and MCAP compute it (polynomial 0xEDB88320, reflected, inverted), shared by
 // the readers that check one (PNG chunks in image_io.cpp, MCAP chunks in bag/mcap.cpp). A table
 // of our own rather than zlib's crc32(): the library does not otherwise link zlib. Not part of

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "io/csv_util.hpp"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Internal helpers shared by the CSV readers (EuRoC files, rates CSV): line iteration with line
 // numbers, field splitting with whitespace trimming, locale-independent number parsing, and the
 // timestamp order / gap checks. Not part of the public API.

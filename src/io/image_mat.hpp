@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Inside the library only: OpenCV images to the planar RGB frames the networks take. Kept out of
 // the public headers so users of the library need no OpenCV include path.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Internal helper shared by the binary readers of io (images, .flo files): opening an input file
 // with one message per way it can be missing. Not part of the public API.
 #pragma once

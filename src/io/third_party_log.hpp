@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Inside the library only: what FFmpeg and OpenCV would print on stderr by themselves ("[mjpeg @
 // 0x…] error dc", "deprecated pixel format used", OpenCV's "[ WARN:0@…]" lines) is kept off the
 // user's terminal. FFmpeg's lines go to our logger at Debug ("FFmpeg: …", seen with the CLI's -v);

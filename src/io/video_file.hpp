@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Inside the library only: a video file read with FFmpeg (libavformat, libavcodec, libswscale), for
 // the video frame source. FFmpeg rather than OpenCV's VideoCapture, because VideoCapture (4.6,
 // FFmpeg backend) skips a frame it cannot decode without saying so, renumbers the ones after it

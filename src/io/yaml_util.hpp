@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Internal helpers shared by the YAML readers (EuRoC sensor.yaml, --T-cam-imu files, Kalibr
 // camchains), all through OpenCV's cv::FileStorage: opening a file whatever its YAML directive,
 // finite numbers and lists with messages naming the file and key, and the 4×4 rigid transforms

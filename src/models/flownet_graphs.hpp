@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The FlowNet2 family as graphs (docs/model_spec.md, to the letter). Each builder adds one
 // sub-network to a graph, reading its parameters under `prefix` ("flownetc.", or "" for the
 // standalone checkpoints), and returns its finest prediction flow2 (flow0 for the fusion

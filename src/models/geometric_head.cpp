@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The geometric head (include/inertialnet/models/geometric_head.hpp): the device-side state (the
 // camera's coordinate map) and the choice between the two solvers, src/models/motion_field_solver
 // and src/models/opengv_head.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Networks as graphs of ops, with activation memory planned once per input size.
 //
 // A model builds a Graph for a given input shape: values (tensors, with shapes inferred as the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "inertialnet/models/head_backprop.hpp"
 
 #include "inertialnet/ops/activation_backward.hpp"

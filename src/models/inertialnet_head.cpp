@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "inertialnet/models/inertialnet_head.hpp"
 
 #include "inertialnet/runtime/error.hpp"

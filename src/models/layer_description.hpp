@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What a graph node is, for the per-layer profile: its kind label and FLOPs (the op running it
 // reports its GEMM backend to the profiler itself).
 #pragma once

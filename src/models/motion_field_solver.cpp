@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The motion-field solver (src/models/motion_field_solver.hpp).
 //
 // The algorithm, its assumptions, and why

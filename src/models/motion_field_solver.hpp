@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The motion-field solver of the geometric head (GeometricSolver::MotionField): robust
 // iteratively reweighted least squares over the motion-field reductions
 // (include/inertialnet/ops/motion_field.hpp). Private to the geometric head.

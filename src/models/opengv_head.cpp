@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The geometric head's OpenGV solver (src/models/opengv_head.hpp).
 //
 // OpenGV is a compiled library whose headers are Eigen templates: objects cross the boundary

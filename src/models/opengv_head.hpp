@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The geometric head's OpenGV solver (GeometricSolver::OpenGV): relative rotation between two
 // frames from bearing-vector correspondences sampled from the flow, with OpenGV's RANSAC.
 // Private to the geometric head; no OpenGV or Eigen type appears here, so only

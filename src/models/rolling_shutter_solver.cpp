@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The rolling-shutter refinement (src/models/rolling_shutter_solver.hpp).
 //
 // The model, and why

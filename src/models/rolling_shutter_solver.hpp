@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The rolling-shutter refinement of the motion-field solver's general model
 // (GeometricHeadOptions::readout_time_s > 0): rotation and translation linear in the row, the
 // per-pixel depth eliminated, solved on the host from the global-shutter solution. Private to

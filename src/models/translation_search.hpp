@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The general model's search for the translation direction T (the motion-field solver's stage 2,
 // src/models/motion_field_solver.cpp): the quadratic form one General-mode reduction pass
 // yields, and the searches over the half sphere of directions that minimise it. Private to the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Sub-pixel decomposition of the 4×4 / stride 2 / padding 1 transposed convolutions (FlowNet's
 // deconv* and upsample_flow* layers) on the packed backend: the four output phases are 2×2
 // convolutions of the input, computed as one packed GEMM of [4·co × 4·ci] prepared weights by the

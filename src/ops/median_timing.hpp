@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Host-side timing of device work for the searches that pick a faster variant (timed plans,
 // `tune`): the queue is drained before and after, so a run's time is its own; one warm-up run
 // first (it builds the kernels and touches the buffers), then the median of `runs`.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "inertialnet/ops/motion_field.hpp"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Helpers shared by the host code of the ops: work-group sizes, the GEMM ops' column budget,
 // tensor and aliasing checks and the two-level (sample, batch) launch layout that lets every
 // tensor be a channel slice.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Winograd F(2×2, 3×3) convolution for the winograd plan on CPU devices: 3×3 stride-1 layers
 // of at least kWinogradMinChannels output and kWinogradMinInputChannels input channels do 16
 // GEMMs of [co × ci]·[ci × tiles] (4 multiplies per output pixel and channel pair instead of 9)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Writing a file so that its final name only ever names a complete file.
 //
 // The content goes to a temporary file in the same folder (so that the rename stays within one

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // CLBlast parameters per device, kept as data (as CLBlast keeps its own database).
 //
 // CLBlast's database has no entry for CPUs under PoCL, whose generic defaults run SGEMM at a

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The kernels_cl/*.cl sources, embedded by cmake/EmbedKernels.cmake.
 #pragma once
 

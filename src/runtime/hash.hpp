@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // FNV-1a, 64 bit: a stable, dependency-free hash for cache keys and for the synthetic-weight
 // generator of docs/model_spec.md (which fixes this exact function).
 #pragma once

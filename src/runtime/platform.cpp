@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Platform and device discovery, and the device table.
 #include <algorithm>
 #include <cstdio>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The body (= IMU) state of a synthetic sequence: the camera trajectory carried to the body
 // through EuRoC cam0's T_BS and written in the z-up ground-truth frame R (R's x = W's z,
 // R's z = −W's y, so that gravity is −z as in EuRoC). Private to src/synth.

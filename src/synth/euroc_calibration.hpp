@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // EuRoC's cam0 and imu0 calibration, which every synthetic sequence reuses (cam0's intrinsics
 // scaled to the chosen size, its extrinsics as they are; imu0's noise densities). Private to
 // src/synth.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The text files of a synthetic EuRoC sequence: numbers as EuRoC's files print them, and the
 // sensor.yaml of cam0 and imu0. Private to src/synth.
 #pragma once

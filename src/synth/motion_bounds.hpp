@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Bounds every synthetic camera motion keeps, shared by the option checks, the trajectory and
 // the scene builder. Private to src/synth.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The ray caster of the synthetic sequences: global-shutter snapshots of the scene
 // (src/synth/scene.hpp). Private to src/synth.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The synthetic scene: textured planes in the renderer's world frame W, sized for a trajectory.
 // Private to src/synth.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The EuRoC writer of `synth` (include/inertialnet/synth/synthetic_sequence.hpp): IMU samples
 // and ground truth from the trajectory, frames from the renderer, all assembled in a staging
 // folder that is renamed into place.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Procedural textures for the synthetic scene's planes. Private to src/synth.
 #pragma once
 

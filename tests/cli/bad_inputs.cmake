@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Bad inputs through the CLI: each case asserts the exit code (2 bad input, 1 runtime failure)
 # and a fragment of the one-line message. Cases edit a copy of a small synthetic sequence.
 #   cmake -DCLI=<inertialnet> -DWORK=<scratch dir> -P bad_inputs.cmake

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # `inertialnet bench --json` at a tiny size: the document parses and holds every field of the
 # schema documented in tools/cli/bench_report.hpp ("inertialnet.bench/1").
 #   cmake -DCLI=<inertialnet> -P bench_json.cmake

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # `calibrate-time`: a synthetic sequence whose camera stamps lag the IMU by 40 ms. Predicting
 # in the command (no rates file) and from predict's CSV must both find the offset.
 include(${CMAKE_CURRENT_LIST_DIR}/run_helpers.cmake)

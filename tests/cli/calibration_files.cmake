@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # --calibration FILE (predict, eval, calibrate-time) on the frames of synthetic EuRoC sequences given
 # as plain image folders (mav0/cam0/data, nanosecond names): the camera in each format — EuRoC
 # sensor.yaml, a Kalibr camchain (with and without T_cam_imu, several cameras), OpenCV's

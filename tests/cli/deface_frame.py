@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Replaces one frame of a EuRoC-layout sequence with what real recordings hold now and then:
 a frame of noise (a flash, a sensor fault), a uniform grey frame or a black one (a covered lens,
 a frame a camera filled in). The frame is written as a binary PGM under the PNG's name (OpenCV

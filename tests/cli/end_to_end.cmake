@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # synth → weights → flow → predict → eval through the CLI, as a user runs them, at a small size.
 #   cmake -DCLI=<inertialnet> -DWORK=<scratch dir> -P end_to_end.cmake
 file(REMOVE_RECURSE "${WORK}")

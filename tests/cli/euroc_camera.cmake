@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # `--camera cam0|cam1` (predict, eval, calibrate-time) on a EuRoC sequence with two cameras: a
 # synthetic sequence whose mav0/cam1 lists every other image of cam0, stamped 1 ms later, so that
 # rates from cam1 are told from cam0's by their count and their times.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Runs one command line and checks its exit code and output (stdout + stderr together).
 #   cmake -DCOMMAND=<a|b|c> -DEXIT=<code> -DMATCH=<regex|regex> [-DNOMATCH=<regex>] [-DENV=<K=V|…>] -P expect.cmake
 string(REPLACE "|" ";" _command "${COMMAND}")

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # inertialnet export (docs/cli.md, "export"): synth → predict → export in each format, the lines
 # checked against the rates file they come from; a pair without an answer left out (gyroflow,
 # euroc-imu) or held (tum); bad inputs refused with exit 2 before anything is written.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # A first run says that it compiles kernels (once per device, naming the cache folder); a run
 # served from the cache says nothing; --stats times pairs only, after the compile; -q hides
 # notes, -v adds the library's debug messages. The program cache is a private folder here, so

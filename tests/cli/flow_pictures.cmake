@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Flow without weights and flow pictures: `flow --flow dis`, `predict --save-flow --flow-format`,
 # and `viz` on .flo and KITTI files (colours are checked pixel by pixel in python/tests).
 #   cmake -DCLI=<inertialnet> -DWORK=<scratch dir> -P flow_pictures.cmake

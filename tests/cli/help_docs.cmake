@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Every --help (top level and each subcommand) ends with examples and lists the global options;
 # the bash and zsh completions and the man page, generated from the same definitions, name every
 # subcommand and every option that --help shows; the bash script is valid bash (and the zsh one

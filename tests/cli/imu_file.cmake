@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # An IMU file for any input (`eval --imu FILE`, `calibrate-time --imu FILE`): the frames of a
 # synthetic EuRoC sequence as a plain folder of images (mav0/cam0/data, nanosecond names), its
 # imu0/data.csv given with --imu and the rotation to the camera given three ways (16 numbers,

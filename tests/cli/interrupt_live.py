@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Ctrl-C (SIGINT) ends `inertialnet predict` on a never-ending live source cleanly: exit 0,
 every pair computed written, rows flushed one at a time while it runs (so `| tail -f` follows it),
 and with -o the file put in place (docs/cli.md, "Live input").

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # The machine-readable outputs parse, carry their schema name, and keep one shape: `eval --json`
 # is one object with a list of estimators (one or two), three-vectors are {"x","y","z"};
 # `devices --json` names each device once ("index", "address"); `--series` without `--json` is

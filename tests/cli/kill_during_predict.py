@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """`kill -9` in the middle of `inertialnet predict -o r.csv`: the rows so far are in r.csv.partial
 (whole rows, a valid rates CSV) with its sidecar r.csv.partial.json, an earlier complete r.csv and
 its sidecar r.csv.json are untouched, and nothing else is left beside them (docs/cli.md, "When a

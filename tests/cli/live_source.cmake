@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Live input (issue 21): predict on a GStreamer pipeline as a live source. The same frames as a
 # EuRoC folder give the same rates, bit for bit, and eval gives the same figures; Ctrl-C on a
 # never-ending source is a clean end; a missing camera or a bad pipeline is exit 2 with a message.

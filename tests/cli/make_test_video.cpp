@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // make_test_video <folder>: the videos of tests/cli/video_integrity.cmake, made as the library's
 // tests make them (tests/support/test_video.hpp): clip.avi (40 frames of 188 × 120, MJPG at
 // 20 Hz), damaged.avi (frame 15's scan garbled, frame 16 without JPEG data) and cut.avi (the

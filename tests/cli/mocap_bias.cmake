@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # TUM-VI's mocap0 gives eval its gyro bias when there is neither a ground-truth bias nor a static
 # start: a synthetic sequence (whose first second moves) with its ground truth's poses written as
 # mav0/mocap0/data.csv (TUM-VI's 8 columns, every other row: 100 Hz) and the ground truth removed.

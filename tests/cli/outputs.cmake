@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Where the CLI's output goes: it never replaces what is not a regular file, writes through
 # symbolic links, and never exits 0 when an output (standard output included) could not be written.
 # Non-regular targets are private FIFOs in the scratch folder, never the system's /dev.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Every frame pair accounted for (docs/cli.md, "Rates CSV"): one bad frame costs its pairs, never
 # the run or a confident wrong number; a run that fails or is killed never replaces good output.
 #   cmake -DCLI=<inertialnet> -DPYTHON=<python3> -DWORK=<scratch dir> -P pairs_accounted.cmake

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Writes the frames of a EuRoC folder's camera (8-bit grayscale PNGs, as `inertialnet synth` makes
 them) one after another as raw GRAY8 bytes, for GStreamer's rawvideoparse to play back as a live
 source (GStreamer's base plugins have no PNG decoder). Python's standard library only.

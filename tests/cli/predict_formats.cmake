@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # `inertialnet predict --format csv|gcsv|euroc-imu|tum` (docs/cli.md, "Output formats"): each
 # format read back by an independent reader (read_predicted.py: pandas and numpy for the CSV, the
 # sidecar's row count and hash, read_exports.py's gcsv/EuRoC/TUM parsers, the TUM trajectory

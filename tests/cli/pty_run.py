@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Runs a command on a pseudo-terminal, as a person at a terminal would, and prints what it wrote.
 
     pty_run.py [--interrupt-after REGEX] [--timeout SECONDS] -- COMMAND [ARG...]

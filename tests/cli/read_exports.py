@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """An independent reader of what `inertialnet export` writes, with the standard library only:
 each format parsed as its own documentation describes it (Gyroflow's gcsv: a first line, key,value
 lines, scales, then t,gx,gy,gz; EuRoC's imu0/data.csv; TUM's `t tx ty tz qx qy qz qw`) and

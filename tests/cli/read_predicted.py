@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """What `inertialnet predict --format csv|gcsv|euroc-imu|tum` writes, read back by readers that
 share no code with ours (issue 21, "Outputs"):
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Rewrites an MCAP file with other chunk compression, through PyPI `mcap` (independent of ours).
 
     python recompress_mcap.py IN.mcap OUT.mcap --compression none|zstd|lz4

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # ROS 2 bags in every form a user has them (predict, eval): the .db3 file of a rosbag2 sqlite3
 # bag, its folder (metadata.yaml), the .mcap file of an MCAP bag and its folder, and MCAP with zstd
 # and lz4 chunks. A synthetic EuRoC sequence is written into the bags by independent writers

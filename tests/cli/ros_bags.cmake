@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # ROS bags as sequences (predict, eval, calibrate-time): a synthetic EuRoC sequence converted into
 # bags by an independent writer (tests/support/write_bag.py, PyPI rosbags) in every lossless image
 # encoding must give the rates of the same frames as an image folder with the same intrinsics —

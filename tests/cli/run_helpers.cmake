@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # What the CLI scripts share (end_to_end, outputs, bad_inputs, bench_json, tune): run a command in ${WORK}, check
 # its exit code, and match its output.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # calibrate-time's self-calibration (issue 22): a synthetic sequence whose camera stamps lag the IMU
 # by 40 ms and whose cam0/sensor.yaml states a camera–IMU rotation 3° off the one the images were
 # rendered with. calibrate-time must recover both (rotation within 0.5°, offset within 2 ms), with

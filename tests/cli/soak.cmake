@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # tools/soak.sh: its verdict on samples made up here (flat, a step, a dip, the warm-up left out),
 # and a short DIS soak end to end (warm-up run, samples, summary file). The long soaks are not
 # run here (see docs/performance.md).

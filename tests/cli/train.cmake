@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # `inertialnet train` as a user meets it, on tiny synthetic sequences: the per-epoch report and
 # CSV, the loss plot, best/last checkpoints with training metadata that predict loads, resuming,
 # predict refusing a head of another flow size, and bad usage; and that no result is lost or

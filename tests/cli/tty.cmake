@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # What a person at a terminal sees: the progress line ends before any summary, after a normal
 # run and after Ctrl-C, and -q draws none. Runs the CLI on a pseudo-terminal (pty_run.py).
 #   cmake -DCLI=<inertialnet> -DPYTHON=<python3> -DWORK=<scratch dir> -P tty.cmake

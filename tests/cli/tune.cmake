@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # `inertialnet tune`: the quick search writes an "inertialnet.tune/1" document (schema in
 # include/inertialnet/runtime/device_tuning.hpp) beside the program cache, a second process picks
 # it up (`tune --show`, `bench --json`'s gemm_tuning), --no-cache neither reads nor writes it,

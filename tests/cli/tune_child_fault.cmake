@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # `inertialnet tune`'s CLBlast search runs each step in a child process: a child that crashes or
 # hangs becomes a warning naming the shape and a "failed" step in the document, and tune still
 # stores the packed search's result and exits 0. The child is made to fail at once through the

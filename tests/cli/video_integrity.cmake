@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Videos as the user brings them (issue 20, item 3): a clip cut short is said and read as far as it
 # goes; a clip with two damaged frames keeps the true times of every other frame, and the pairs of
 # the damaged frames are decode_error rows naming them; FFmpeg prints nothing itself (with -v its

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Lists the devices through the installed library: proves headers, library and package
 // config fit together for a consumer.
 #include <inertialnet/inertialnet.hpp>

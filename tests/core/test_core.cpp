@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The dependency-free basics: the generator's published values and its stream discipline, and
 // the SO(3) helpers the synthetic renderer and the geometric head share.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Test helper: writes a small EuRoC (ASL) folder from an analytic angular rate, so that readers,
 // synchronisation and metrics can be checked against exact values. Header-only; used by
 // tests/io and tests/eval.

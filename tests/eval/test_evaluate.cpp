@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // evaluate(): a rates CSV against a synthetic EuRoC sequence with known errors.
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Gyro → camera timestamps on synthetic EuRoC folders (cam 20 Hz, IMU 200 Hz, V1_01's start time).
 #include <gtest/gtest.h>
 

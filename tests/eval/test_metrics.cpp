@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Per-axis RMSE (Table 1), RMS(t) (Eq. 1) and error histograms on constructed predictions.
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The gyro bias from TUM-VI's mocap0 (mocap_bias.hpp): recovered from poses that integrate a known
 // rate, refused when the poses overlap the IMU too little; and mocap0/data.csv's bad rows named.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // PNG plots: written, decodable, of the requested size, with both curves / the bars drawn.
 #include <gtest/gtest.h>
 #include <sys/resource.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The camera–IMU rotation correction (fit_rotation, and estimate_time_offset with fit_rotation):
 // recovered from rates with a known rotation, bias and noise; its 1σ matches the scatter of the
 // estimates; a rotation about an axis the rates never turn about is not determined.

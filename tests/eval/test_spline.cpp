@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Natural cubic spline against analytic signals.
 #include "support/testing.hpp"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The camera–IMU time offset (estimate_time_offset, eval's --time-offset) and the frames a rates
 // file states (eval rotates whichever side needs it), on synthetic EuRoC folders with exact rates.
 #include <gtest/gtest.h>

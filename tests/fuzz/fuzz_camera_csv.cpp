@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // mav0/cam0/data.csv: timestamps and image names (images not looked up).
 #include "fuzz_support.hpp"
 #include "inertialnet/io/euroc.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The device-spec grammar (--device, INERTIALNET_DEVICE): indices, P:D, types, names, lists.
 #include <string_view>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The Middlebury .flo reader: magic, width and height, then the interleaved u, v floats.
 #include "fuzz_support.hpp"
 #include "inertialnet/io/flow_io.hpp"

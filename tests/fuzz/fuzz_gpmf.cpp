@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // --imu rec.mp4 (gpmf.hpp): a GoPro MP4's boxes, sample tables and GPMF payloads, read through
 // read_gyro_log's dispatch by content as a user's file is.
 #include "fuzz_support.hpp"

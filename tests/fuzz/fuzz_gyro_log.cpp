@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // --imu's gyro logs (gyro_log.hpp): EuRoC and gyro-only CSVs with named time units, Gyroflow's
 // .gcsv with its scales; read as a .csv and as a .gcsv, with and without a time unit given.
 #include "fuzz_support.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Image loading: the PNG/JPEG truncation walk, then OpenCV's decoder and the conversion to
 // planar RGB.
 #include "fuzz_support.hpp"

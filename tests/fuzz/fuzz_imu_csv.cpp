@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // mav0/imu0/data.csv: timestamps, gyro and accelerometer columns.
 #include "fuzz_support.hpp"
 #include "inertialnet/io/euroc.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The MCAP reader (src/io/bag/mcap.cpp): records, chunks (plain, zstd, lz4) and their lengths,
 // sizes and CRCs; every message of every channel read through a cursor.
 #include "fuzz_support.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The rates CSV that predict writes and eval reads.
 #include "fuzz_support.hpp"
 #include "inertialnet/io/rates_csv.hpp"

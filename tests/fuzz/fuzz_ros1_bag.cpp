@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The ROS 1 bag reader (src/io/bag/ros1_bag.cpp): records, header fields, chunks (none, bz2, lz4)
 // and their lengths; every message of every connection read through a cursor and decoded as the
 // sensor_msgs type its connection names (ros_messages.hpp, over the ROS 1 field reader).

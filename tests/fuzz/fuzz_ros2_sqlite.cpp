@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The rosbag2 sqlite3 reader (src/io/bag/ros2_sqlite.cpp) on damaged databases: the content check,
 // the topics and messages tables, every message read through a cursor. SQLite parses the file;
 // what is checked here is that its every failure reaches the user as our invalid_input.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The safetensors reader: the 8-byte length, the JSON header, the offsets and shapes it declares.
 #include "fuzz_support.hpp"
 #include "inertialnet/io/safetensors.hpp"

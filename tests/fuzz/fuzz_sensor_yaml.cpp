@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // mav0/cam0/sensor.yaml (through OpenCV's FileStorage), then the camera model built from it,
 // whose lens check undistorts and distorts a grid of pixels.
 #include "fuzz_support.hpp"

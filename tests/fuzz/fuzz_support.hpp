@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What the libFuzzer targets share: the input as a file (the readers take paths, as users give
 // them), and the rule every target checks. A reader may refuse any input, but only with
 // inertialnet::Error; any other exception (a raw std:: or OpenCV error reaching the user), a

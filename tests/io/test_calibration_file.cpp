@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // --calibration files: EuRoC sensor.yaml, Kalibr camchains, OpenCV calibrateCamera YAML and XML
 // (written here by cv::FileStorage itself, the writer those files come from, and by hand), and the
 // fit of a calibration to frames of another size. Bad values are refused naming file and key.

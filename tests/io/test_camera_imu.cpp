@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Camera–IMU calibrations (--T-cam-imu, Kalibr camchains) and sequences read with an IMU file.
 // The camchain fixture (tests/data/kalibr/) is written by hand in Kalibr's layout, which OpenCV's
 // YAML parser does not take as it is.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // EuRoC ASL reader and image-folder listing on synthetic folders written by the test.
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Middlebury .flo files and the Middlebury flow colour coding.
 #include <gtest/gtest.h>
 #include <sys/stat.h>

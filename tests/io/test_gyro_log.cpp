@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The gyro logs `--imu` reads (gyro_log.hpp): EuRoC's CSV, a gyro-only CSV in seconds or another
 // named unit, Gyroflow's .gcsv with its scales; every bad number named by file, line and value.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Loading frames into planar RGB floats: bit depths, channel layouts and broken files.
 #include <gtest/gtest.h>
 

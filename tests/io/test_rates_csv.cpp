@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The rates CSV (schema inertialnet.rates/3: timestamp_ns,wx,wy,wz,status[,…] and its sidecar):
 // round trip, statuses, schema-1 and -2 files, the sidecar, the journal a run writes, and errors.
 #include <gtest/gtest.h>

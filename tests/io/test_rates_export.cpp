@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The rates in other tools' formats (io/rates_export.hpp): Gyroflow's .gcsv, EuRoC's imu0/data.csv
 // and a TUM orientation trajectory, checked against hand-computed lines and values, with rows
 // that have no answer left out (gcsv, EuRoC) or held (TUM).

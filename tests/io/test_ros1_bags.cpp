@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // ROS 1 bags (src/io/bag/ros1_bag.cpp) and the sensor_msgs decoders (ros_messages.hpp) over the
 // field reader for both encodings (src/io/bag/message_fields.hpp). The bags are written here by
 // a small writer of the format's records (http://wiki.ros.org/Bags/Format/2.0), so that damage

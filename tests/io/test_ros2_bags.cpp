@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The ROS 2 bag containers (src/io/bag/ros2_sqlite.cpp, mcap.cpp) on bags written by independent
 // writers: `rosbags` (rosbag2 folders, sqlite3 schema versions 8 and 9, MCAP plain and zstd) and
 // PyPI `mcap` (lz4 and zstd chunks with CRCs), made by write_ros2_bags.py before this suite runs

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The safetensors reader and writer: round trips, every malformed-file error (files written byte
 // by byte here), exact F16 conversion, and the model-fit check's single error message.
 #include "inertialnet/io/safetensors.hpp"

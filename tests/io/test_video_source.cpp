@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Videos as frame sources (FFmpeg, src/io/video_file.cpp): every frame at the time the container
 // gives it, a frame that cannot be decoded reported as that frame while the rest go on, a video
 // cut short said, and FFmpeg's own log kept off stderr.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Writes the small ROS 2 bags that test_ros2_bags reads, with writers independent of ours.
 
     python write_ros2_bags.py OUT_FOLDER

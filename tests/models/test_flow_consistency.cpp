@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The forward-backward check (include/inertialnet/models/flow_consistency.hpp): a consistent
 // field is kept whole; a patch whose backward flow disagrees is marked unknown, and only it.
 #include "inertialnet/models/flow_consistency.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The FlowNet2 family against the independent PyTorch reference (tools/reference/), through
 // the committed fixtures: same synthetic weights (seed 1), same frames, every block's flow.
 // The reference computes in float64; we compute in float32.

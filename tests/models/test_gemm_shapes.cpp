@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The GEMM shapes `tune` times come from the model's own graph: every conv, deconv and linear
 // layer is in exactly one shape, with the sizes of docs/model_spec.md.
 #include <algorithm>

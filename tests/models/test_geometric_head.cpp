@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The geometric head: the normalised-coordinate map against a forward lens model, and ω
 // recovered from exact flow fields of known motions (tests/support/motion_fields.hpp: a room of
 // planes at 1.5–6 m, EuRoC's cam0 at a quarter of its size with its lens distortion, 15 % random

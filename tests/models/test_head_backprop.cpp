@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // HeadBackprop: the InertialNet head's training step on the library's backward ops, checked
 // against torch autograd (the committed fixture of tools/reference/make_head_gradient_fixture.py),
 // against central finite differences of a float64 forward pass written here from

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The InertialNet head against the PyTorch reference fixtures (tools/reference/head.py):
 // default hyper-parameters at two sizes (one odd, so the pools floor) and a custom
 // configuration, all with synthetic weights of seed 1 and the configuration from the fixture.

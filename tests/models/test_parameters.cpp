@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Parameter tables against docs/model_spec.md: exact counts, flownet2-pytorch names and
 // shapes, fan-ins and gains, the head's FC1 width, HeadConfig JSON and model-kind names.
 #include "inertialnet/models/parameters.hpp"

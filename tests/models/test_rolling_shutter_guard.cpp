@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The rolling-shutter solve's guard (issue 22): the global-shutter solution stands when the richer
 // model's cost is worse or its rate implausible, with the reason recorded; a refinement that
 // improves on the start is kept.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Deterministic synthetic weights (docs/model_spec.md): bit-exact against values computed
 // independently in Python and, once committed, against tests/data/fixtures/synthetic_weights.json
 // written by the Python twin in tools/reference/.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Helpers for the op suites: the one slice harness (views that are channel slices of a larger,
 // randomly filled tensor, to check that ops read and write only their view, and the host side of
 // such slices) and exact comparison.

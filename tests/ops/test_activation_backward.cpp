@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // activation_backward (ReLU, LeakyReLU, none) from the forward output, and dropout_backward with
 // the forward mask, against tests/reference/: views, in place, and bad arguments.
 #include <string>

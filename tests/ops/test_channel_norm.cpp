@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The channel norm kernels against tests/reference/flow_ops.
 #include <cmath>
 #include <functional>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Channel concatenation: copy_into_channels and concat_channels against the reference, with
 // sliced sources and destinations, FlowNet2's concatenation shapes at a 64×64 input.
 #include "inertialnet/ops/concat.hpp"

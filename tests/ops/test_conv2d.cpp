@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // conv2d (im2col + CLBlast GEMM + fused bias/activation) against the direct convolution of
 // tests/reference/conv.cpp: every FlowNet2 convolution shape at a 64×64 input, odd sizes,
 // batches, channel-slice inputs and outputs, the InertialNet head's convolutions, bad shapes.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // conv2d_backward_data / _weight against the double loops of tests/reference/backward.cpp: odd
 // shapes, strides and paddings, 1×1 layers, batches, channel-slice gradients, the InertialNet
 // head's layer shapes (at the CI size and conv1 at EuRoC's 752×480), determinism and bad shapes.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // conv_transpose2d (GEMM + gather col2im with fused bias/activation, and the sub-pixel form of
 // the 4×4 / stride 2 / padding 1 layers) against the scatter definition of tests/reference/conv.cpp:
 // every FlowNet2 up-convolution at a 64×64 input on each algorithm, other kernels/strides/paddings,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The correlation kernel against tests/reference/flow_ops (a plain loop over the spec's formula).
 #include <cmath>
 #include <functional>

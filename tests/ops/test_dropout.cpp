@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Dropout: identity at inference; in training an exact match with the reference mask, the keep
 // rate within a bound a broken mask cannot meet, and the mask's independence from view layout.
 #include "inertialnet/ops/dropout.hpp"

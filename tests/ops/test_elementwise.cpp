@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Elementwise ops and the standalone activation against tests/reference/basic_ops, on
 // contiguous tensors and on channel slices (inputs and outputs).
 #include "inertialnet/ops/elementwise.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The CLBlast GEMM wrapper against the plain C++ loop of tests/reference.
 #include <clblast.h>
 

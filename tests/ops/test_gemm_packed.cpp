@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The packed-panel GEMM, im2col into panels and the GEMV against the plain references of
 // tests/reference: odd sizes around the tile (m, n, k not multiples of MR or 32), every tile
 // height, FlowNet2's GEMM shapes, bias and activation in the store, strided output views.

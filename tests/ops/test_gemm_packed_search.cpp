@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The packed GEMM's parameter search (`inertialnet tune`) and the device's stored choice: the
 // search tries every combination and keeps a valid one; a device's tuned MR and PANELS_FIRST are
 // what packing and the GEMM then use, with the same results as the defaults.

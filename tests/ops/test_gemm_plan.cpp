@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Timed GEMM plans ($INERTIALNET_PLAN=auto): the on-disk plan cache (round trip, corrupt and
 // foreign files), forced plans over cached ones, and a timed layer that still matches the
 // reference convolution whichever candidate won.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // linear (CLBlast GEMM + fused bias/activation) against the plain loop of tests/reference/conv.cpp:
 // the InertialNet head's fully connected layers, batches, flattened NCHW inputs, channel-slice
 // inputs and outputs, bad shapes.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // linear_backward_data / _weight and bias_gradient against tests/reference/backward.cpp: the head's
 // fully connected shapes, odd sizes, a flattened NCHW input read as a channel slice, accumulation.
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The motion-field reductions (ops/motion_field) against the plain C++ reference
 // (tests/reference/motion_field), on exact flow of a known motion with every kind of sample.
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // mse_loss: the value and the gradient against tests/reference/backward.cpp, sizes around and
 // above one work-group, and bad shapes.
 #include "inertialnet/ops/mse_loss.hpp"

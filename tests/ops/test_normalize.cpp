@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // FlowNet2's input normalisation against the reference: the per-channel mean reduction
 // (float32 tree on the device vs a double sum), the normalised x6, slices and in-place use.
 #include "inertialnet/ops/normalize.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // sgd_step and adam_step against tests/reference/backward.cpp over several steps (momentum,
 // weight decay, Adam's bias corrections), and bad arguments.
 #include "inertialnet/ops/elementwise.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Max pooling against the reference: the head's 2×2/2 on its real shapes, odd sizes (floor
 // semantics), general windows and strides, channel slices in and out, NaN propagation.
 #include "inertialnet/ops/pool.hpp"

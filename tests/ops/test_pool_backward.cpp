@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // max_pool2d_backward against tests/reference/backward.cpp: the head's 2×2/2 pooling at odd
 // sizes (the dropped last row and column get zero), overlapping windows, ties resolved as
 // PyTorch does (first maximum in scan order), NaN windows, channel slices.

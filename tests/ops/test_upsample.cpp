@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Upsampling / resizing (PyTorch interpolate semantics) and the flow resize, against
 // tests/reference/flow_ops and hand-computed PyTorch results.
 #include <functional>

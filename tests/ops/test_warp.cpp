@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The warp (Resample2d) kernel against tests/reference/flow_ops and against hand-built cases.
 #include <algorithm>
 #include <cmath>

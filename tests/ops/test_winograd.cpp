@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Winograd F(2×2, 3×3) (the winograd plan's 3×3 stride-1 convolutions) against the direct
 // convolution of tests/reference/conv.cpp: every FlowNet2 3×3 stride-1 shape of ≥ 16 output and
 // ≥ 32 input channels at a 64×64 network input, odd sizes, batch 3, channel-slice inputs and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The scheduler against the plain sequential loop it replaces: identical rates, in order, with
 // one device and with two (CTest runs this suite with POCL_DEVICES="pthread pthread"), each
 // frame decoded once, and clean stops on cancellation and on a bad frame.

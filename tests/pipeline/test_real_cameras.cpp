@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What real recordings bring that the EuRoC-layout synthetic sequences did not: a camera–IMU time
 // offset, recovered and applied through the weight-free path, and video input, which must give
 // the rates its frames give as a folder of images.

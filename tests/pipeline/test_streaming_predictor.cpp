@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The streaming predictor: frames pushed one at a time give the rates Prediction::run gives on the
 // same frames from the folder, pair for pair, in order and bit for bit; a frame pushed as
 // undecodable costs its two pairs; the queues hold a caller that pushes faster than the pipeline

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The weight-free path end to end on synthetic sequences: frames → DIS optical flow → geometric
 // head through the pipeline, against the exact camera rates the sequence was rendered from.
 // The bounds are those of the issue (pure rotation ≤ 1 deg/s, general motion ≤ 3 deg/s per

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Plain C++ gradients of the head's layers, the loss and the optimiser steps, written from the
 // PyTorch definitions (the chain rule on the loops of conv.cpp and basic_ops.cpp, not from the
 // kernels), accumulated in double. Tensors are dense row-major NCHW vectors.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Plain C++ loops for the memory-bound ops: elementwise, activation, concat, max pooling,
 // FlowNet2's input normalisation and dropout. Host vectors hold tensors contiguously in
 // row-major (NCHW) order; written from docs/model_spec.md's semantics, not from the kernels.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Plain C++ convolution, transposed convolution and fully connected layer, written from the
 // PyTorch definitions (Conv2d, ConvTranspose2d, Linear), accumulated in double: the references
 // for the GEMM-based ops. Tensors are dense row-major NCHW vectors.

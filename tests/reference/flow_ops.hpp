@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Plain C++ loops of FlowNet2's flow-specific layers, written from docs/model_spec.md
 // (Correlation, Warp, ChannelNorm, the FlowNet2 up-sampling steps, "Any input size"): the
 // references for kernels_cl/{correlation,warp,channel_norm,upsample}.cl. Tensors are

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Plain C++ GEMM, row-major, accumulated in double: the reference for the CLBlast wrapper and
 // for every GEMM-based op.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Plain C++ reference of the motion-field reductions (kernels_cl/motion_field.cl), in double,
 // one sample at a time, written from the definitions in include/inertialnet/ops/motion_field.hpp.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The --device grammar, without hardware: parsing and resolution over made-up device lists.
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The stored `inertialnet tune` result: its schema read back, foreign and damaged files
 // ignored (a damaged one with a warning, never an exception), applied when a device opens, and
 // neither read with the disk cache off.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The library's logger: levels filter before the sink, a sink replaces stderr, an empty sink
 // restores it.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The on-disk program cache, observed through its statistics (never through timing).
 #include <sys/stat.h>
 #include <unistd.h>

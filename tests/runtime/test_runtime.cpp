@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Devices, queues, embedded kernels and tensors on the real OpenCL platform (PoCL in CI).
 #include <algorithm>
 #include <cstdint>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Device selection on real PoCL devices. CTest runs this suite with POCL_DEVICES="pthread
 // pthread", so PoCL exposes two CPU devices on one platform and every selector form can be
 // exercised against real handles.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Every FlowNet2 convolution and up-convolution shape, in one table shared by the op tests (at a
 // small network input) and the benchmarks (at 512×384), with the work each layer does: FLOPs,
 // the minimum bytes it must move, and the GEMM it becomes.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Exact optical flow of known camera motions, for the tests of the motion-field op and the
 // geometric head: a room of planes at 1.5–6 m seen by EuRoC's cam0 at a quarter of its size
 // (with its lens distortion), with random outlier vectors and Gaussian flow noise.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // SHA-256 (FIPS 180-4) for tests that compare tensors with fixtures by digest; kept in the tests
 // so the library itself needs no crypto dependency.
 #pragma once

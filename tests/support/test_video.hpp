@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Test videos made in the tests: Motion-JPEG AVIs written by OpenCV from synthetic frames, and
 // damaged copies of them (frames overwritten in the middle, the file cut short), for the video
 // frame source's tests and the CLI's (tests/cli/make_test_video.cpp).

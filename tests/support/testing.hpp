@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Helpers shared by the test suites: the device under test, random data and comparisons.
 #pragma once
 

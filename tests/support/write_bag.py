@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Converts a EuRoC-layout folder into a ROS bag with PyPI `rosbags`, a writer independent of ours.
 
     python write_bag.py SEQUENCE OUT [--storage ros1|sqlite3|mcap] [--encoding ENCODING]

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """A GoPro-like MP4 from a EuRoC sequence, written independently of inertialnet's reader (gpmf.cpp)
 for the tests: a video track of the cam0 PNG files as they are (sample entry 'png ', which FFmpeg
 decodes losslessly) and a 'meta' track with sample description 'gpmd' whose payloads are GPMF

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // synth sequences: read back by the EuRoC reader, gyro against the generating rates, images
 // against the rotation (docs/data_conventions.md's sign convention), ground-truth consistency, determinism,
 // coverage of the field of view, and errors.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Flip augmentation's signs, derived in include/inertialnet/train/flip_augmentation.hpp, checked
 // on the exact rotational motion field: the mirrored field of ω is the field of the flipped ω,
 // for each flip, and body-frame targets follow through the camera-to-body rotation.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Training the InertialNet head end to end on PoCL at a small size (64×48 flows): DIS flows of
 // synthetic general-motion sequences (translation and depth variation, rates up to 60 deg/s) of
 // several seeds, validated on sequences of other seeds. Checks that learning works (per-axis

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The packed GEMM's own rate beside each GEMM-based layer kind of a `bench` profile: for every
 // kind, the product (M×N×K) of its heaviest layer is timed on the packed kernel alone, so a run
 // shows how far the layers (with their im2col, col2im, transforms and stores) are from what the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What `inertialnet bench` measured on one device, and its two renderings: a text report and
 // JSON with a stable schema.
 //

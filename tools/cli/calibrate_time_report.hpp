@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What `inertialnet calibrate-time` found — the camera–IMU time offset and rotation correction
 // with their uncertainties — and its two renderings: text lines and JSON with a stable schema.
 //

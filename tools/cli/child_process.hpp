@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Runs this program again as a child process (`/proc/self/exe` with other arguments) and reads
 // what it writes on file descriptor 3, so that work which may crash the process doing it
 // (CLBlast's tuner running candidate kernels through PoCL) cannot take the caller down. exec, not

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `inertialnet bench`: how fast FlowNet2 (or a family member) and the InertialNet head run on a
 // device — pairs per second, the split into upload / flow / head / download, a per-layer-kind
 // profile with GFLOP/s and GEMM backend, and the device memory. Synthetic weights (the work is

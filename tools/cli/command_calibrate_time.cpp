@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `inertialnet calibrate-time SEQ [RATES.csv]`: the camera–IMU time offset and rotation
 // correction of a EuRoC-layout sequence, or of an image folder or a video with --imu FILE,
 // estimated by aligning predicted rates with its gyro (include/inertialnet/eval/time_offset.hpp,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `inertialnet devices`: every OpenCL platform and device, as a table or JSON. With --device it
 // shows what the spec selects (and fails, listing the devices, when it selects nothing).
 #include <iostream>

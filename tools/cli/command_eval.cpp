@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `inertialnet eval RATES.csv SEQ`: the paper's metrics — per-axis RMSE (deg/s, its Table 1),
 // RMS(t) (its Eq. 1), error histograms and time-series plots (its Figs. 5–10).
 #include <cmath>

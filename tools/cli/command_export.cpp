@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `inertialnet export RATES.csv --format gyroflow|euroc-imu|tum -o OUT`: the rates in the formats
 // of the tools users open next (io/rates_export.hpp): a Gyroflow gyro log, a EuRoC imu0-style
 // "virtual gyro", a TUM orientation trajectory for evo.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `inertialnet flow IMG1 IMG2 [--weights W]`: one optical-flow field (FlowNet2 family with weights,
 // OpenCV DIS without), as Middlebury .flo, a KITTI flow PNG and/or a colour-wheel PNG.
 #include <chrono>

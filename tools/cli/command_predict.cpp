@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `inertialnet predict SEQ`: angular rates for every frame pair of a sequence, through the
 // pipelined scheduler, as a rates CSV (timestamp_ns,wx,wy,wz; rad/s; stamped with t_k) and its
 // sidecar, or with --format in the formats of `export` (io/rates_export.hpp).

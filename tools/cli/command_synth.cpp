@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `inertialnet synth OUT_DIR`: a EuRoC-layout sequence rendered from a known camera motion, with
 // exact gyro ground truth (include/inertialnet/synth/synthetic_sequence.hpp).
 #include <cstdio>

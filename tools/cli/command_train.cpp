@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `inertialnet train`: trains the InertialNet head on flows of EuRoC sequences against their gyro
 // (include/inertialnet/train/trainer.hpp), on the selected OpenCL device. Writes the best head by
 // validation RMSE (-o), the last one (<stem>.last.safetensors) and a resumable state

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `inertialnet tune`: measures this device's GEMM parameters on the shapes a network runs and
 // stores what won beside the program cache, where every later start applies it
 // (runtime/device_tuning.hpp has the file's schema, docs/performance.md the figures). Two

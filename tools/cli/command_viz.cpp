@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `inertialnet viz FLOW... [-o DIR]`: Middlebury .flo and KITTI flow PNG files as colour-wheel
 // PNGs, each on its own scale, on one fixed scale (--max-magnitude), or on the largest flow of
 // all the files (--shared-scale, for a sequence), with an optional legend wheel.

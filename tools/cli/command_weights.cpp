@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `inertialnet weights`: write deterministic synthetic weights (for benchmarks and for trying
 // the tools without a checkpoint), or describe a weight file.
 #include <iostream>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The subcommands of `inertialnet`. Each registers its options on the app and returns the
 // function that runs it; main() owns parsing, error reporting and exit codes.
 #pragma once

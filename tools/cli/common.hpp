@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What several subcommands share: opening the selected device, reading sizes, telling the user
 // about synthetic weights.
 #pragma once

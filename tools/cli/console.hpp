@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What the CLI writes to stderr besides its reports: the library's log messages and its own
 // notes (through the sink -q/-v configure), and the one-line progress display. They share the
 // terminal line: a message that arrives while a progress line is open first ends that line, so

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Writes the shell completions and the man page that `inertialnet` generates from its own option
 # definitions into a share/ tree (run by the build; `cmake --install` copies them).
 #   cmake -DCLI=<inertialnet> -DOUT=<share dir> -P generate_docs.cmake

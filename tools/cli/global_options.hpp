@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The options every subcommand takes (--device, --no-cache, -q, -v), registered once on the
 // top-level app and once on each subcommand, bound to the same GlobalOptions: they may stand
 // before or after the subcommand, and each subcommand's --help lists them under "Global options".

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The examples every --help ends with (top level and each subcommand), kept apart from the
 // option definitions so that each command file holds only its options and its work.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Options that say how to read an input that is not a EuRoC folder, shared by the commands that
 // take one: the checks of numbers a camera is described with, the camera intrinsics (--fx …) for
 // the weight-free path, and the IMU beside a folder of images or a video (--imu, --T-cam-imu,

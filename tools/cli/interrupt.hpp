@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Ctrl-C and SIGTERM during a long command (predict, train): the handler only sets a flag that
 // the command polls, so it stops between pairs or batches and leaves complete output behind.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // inertialnet — angular rates from image sequences with FlowNet2 + InertialNet on OpenCL.
 // Exit codes: 0 success, 1 runtime failure, 2 bad usage or bad input.
 #include <cstdlib>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `--profile`: the per-layer and per-kind tables of one profiled network run, on stderr.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A one-line progress bar on stderr, shown only when stderr is a terminal and -q is not given.
 // finish() ends the line (the destructor does it when finish() was not called), so a summary
 // printed after finish() starts on a line of its own.

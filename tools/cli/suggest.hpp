@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Typos answered with the nearest name: when CLI11 refuses a command line, the words are walked
 // again to find the first unknown subcommand or option, which is then named with its nearest
 // known spelling ("unknown subcommand 'predcit'; did you mean 'predict'?").

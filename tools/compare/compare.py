@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Seconds per frame pair, ours against PyTorch, interleaved in one run on one machine.
 
 For each round and each model, runs `inertialnet bench --json` (our OpenCL network, its "flow"

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """FlowNetC's correlation as one batched matrix product, PyTorch at its best.
 
 The reference (tools/reference/flownet2.py) writes the correlation as 441 shifted elementwise

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """correlation_bmm equals the reference's correlation (tools/reference/flownet2.py).
 
     .venv-reference/bin/python -m pytest -q -p no:cacheprovider tools/compare

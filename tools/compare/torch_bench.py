@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Seconds per frame pair of the repository's PyTorch reference (tools/reference/flownet2.py), in
 float32 with a given thread count, on the frames `inertialnet bench` uses, with the deterministic
 synthetic weights. Correlation: `bmm` (correlation_bmm.py, default) or `shift` (the reference's).

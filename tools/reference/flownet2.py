@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Independent PyTorch reference of the FlowNet2 family, written from docs/model_spec.md.
 
 Only torch built-ins are used (F.conv2d, F.conv_transpose2d, F.leaky_relu, F.interpolate, gather,

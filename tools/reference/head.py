@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """InertialNet rotation head (docs/model_spec.md, "InertialNet head").
 
 flow [B, 2, H, W] (pixels, times flow_scale) -> conv1 kxk + ReLU -> max-pool -> conv2 kxk + ReLU

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Writes the committed test fixtures of tests/data/fixtures/ (see tools/reference/README.md).
 
 Every network runs with the deterministic synthetic weights (synthetic.py). The reference runs

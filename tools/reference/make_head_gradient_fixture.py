@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Writes tests/data/fixtures/head_gradients_14x10.safetensors: a small InertialNet head's
 training step computed by torch autograd in float64, to check the library's backward ops
 (include/inertialnet/models/head_backprop.hpp) against an independent implementation.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Regenerates every fixture of tests/data/fixtures/ with the PyTorch reference, in one command:
 #   tools/reference/regenerate_fixtures.sh
 # Creates the ignored virtual environment .venv-reference (override with INERTIALNET_REFERENCE_VENV)

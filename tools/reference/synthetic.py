@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Deterministic synthetic weights (docs/model_spec.md, "Deterministic synthetic weights").
 
 The C++ library implements the same generator; both must agree bit for bit, which

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Mathematical constants used across the layers (one definition, so no file types π again).
 #pragma once
 

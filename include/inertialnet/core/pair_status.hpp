@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Why a frame pair has no trustworthy answer.
 //
 // Every frame pair of a run gets a row in the rates CSV (schema inertialnet.rates/2): its rates

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The project's one random-number generator: splitmix64 (Steele, Lea and Flood, 2014).
 //
 // Fully specified and counter-based, so a seed gives the same numbers with any compiler and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A tensor's shape, and a tensor's name with its shape: the one vocabulary that weight files,
 // parameter tables, device tensors and error messages share.
 //

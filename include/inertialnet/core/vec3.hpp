@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A three-vector of doubles: an angular rate (ωx, ωy, ωz), an acceleration, a bias.
 //
 // Plain std::array so that the data and evaluation headers need neither Eigen nor OpenCV.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `inertialnet eval`: predicted angular rates (a rates CSV) against a EuRoC sequence's gyroscope.
 //
 // Each rates row is matched to the camera frame with the same timestamp (rows are stamped with

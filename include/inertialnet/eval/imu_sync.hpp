@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The gyroscope brought onto camera timestamps: the ground truth an angular-rate prediction is
 // compared with.
 //

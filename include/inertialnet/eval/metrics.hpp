@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The paper's error metrics for predicted angular rates. Inputs are rad/s; every output is in
 // deg/s, the unit of the paper's tables and figures.
 //   per-axis RMSE       — Table 1 / Table 2;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A gyro bias from motion capture (TUM-VI's mav0/mocap0), for sequences that neither carry a
 // ground-truth bias (EuRoC's state_groundtruth_estimate0) nor start static.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // PNG figures of an evaluation, drawn with OpenCV: predicted vs ground-truth angular rate per
 // axis over time (the paper's Figs. 5–8) and the per-axis error histograms (Figs. 9–10).
 // Rates are given in rad/s and drawn in deg/s. Both throw invalid_input when the file cannot be

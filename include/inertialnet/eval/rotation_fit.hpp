@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The camera–IMU rotation correction, fitted on the recording: the small rotation R that best
 // maps the predicted rates (already rotated into the IMU frame with the calibration's camera–IMU
 // rotation) onto the gyro, ω_imu ≈ R · ω_pred + b. A calibration a few degrees off (issue 22

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Natural cubic spline y(x) through points (x_i, y_i) with strictly increasing x.
 //
 // Built in O(n) with a tridiagonal (Thomas) solve for the knot second derivatives, with

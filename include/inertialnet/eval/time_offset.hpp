@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The camera–IMU time offset, estimated from the data: the shift of the camera timestamps that
 // best aligns predicted angular rates with the gyro.
 //

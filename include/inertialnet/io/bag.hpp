@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Recorded ROS topics: a ROS 1 bag (.bag, format 2.0), a ROS 2 bag in its sqlite3 storage (.db3,
 // or the bag folder with its metadata.yaml) or in MCAP (.mcap, rosbag2's default storage). A
 // BagReader lists the bag's connections (topic, message type, encoding) and hands out the raw

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A ROS bag (bag.hpp) as a sequence: the frames of an image topic (sensor_msgs/Image or
 // CompressedImage) as a FrameSource, the camera calibration of a CameraInfo topic, and the IMU
 // samples of a sensor_msgs/Imu topic, all at their header stamps (docs/data_conventions.md).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The topics of a ROS bag that a sequence is read from (--image-topic, --imu-topic,
 // --camera-info-topic); bag_source.hpp reads them.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A camera calibration file given with --calibration, for inputs that have no EuRoC sensor.yaml of
 // their own (an image folder, a video) or to replace the one they have. Four formats, told apart
 // by their keys:

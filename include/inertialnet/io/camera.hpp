@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The camera model: pinhole intrinsics with optional lens distortion, read from a EuRoC
 // calibration, and the undistorted normalised coordinates of its pixels (what the geometric
 // head measures flow in).

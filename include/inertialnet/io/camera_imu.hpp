@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The camera–IMU calibration of an input that has no EuRoC sensor.yaml files (a folder of images,
 // a video): the rotation from the IMU frame to the camera frame, given as a 4×4 T_cam_imu (on the
 // command line or in a YAML file) or read from a Kalibr camchain, and the camchain's time shift.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Readers for the EuRoC MAV "ASL" folder layout (also used by TUM-VI) and for plain image folders.
 //
 // Only listings, calibration and inertial data are read here; images are decoded elsewhere.

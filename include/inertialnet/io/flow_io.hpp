@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Optical flow on the host: the Middlebury `.flo` file format and the Middlebury colour coding.
 //
 // `.flo` (Baker et al., "A Database and Evaluation Methodology for Optical Flow"): the float

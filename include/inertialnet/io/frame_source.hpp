@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Where frames come from: a EuRoC sequence (mav0/cam0), a folder of images, a video file, or a ROS
 // bag's image topic (bag_source.hpp).
 // Frames carry int64 nanosecond timestamps; decoding yields planar RGB (grayscale replicated).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The gyro a GoPro embeds in its MP4 (GPMF, github.com/gopro/gpmf-parser), read for `--imu rec.mp4`.
 //
 // The MP4 (ISO base media) boxes are walked to the track whose sample description is `gpmd`

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The gyro log that `--imu FILE` names (eval, calibrate-time): what cameras, phones and loggers
 // write, read into the IMU samples of a sequence (rad/s, int64 nanoseconds). Three layouts, told
 // apart by the file's content:

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Loading a camera frame into the network's input layout on the host.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A sequence with its gyro for evaluation, whatever the input: a EuRoC folder as read_euroc reads
 // it, or a folder of images or a video with an IMU file beside it (`eval --imu FILE`).
 //

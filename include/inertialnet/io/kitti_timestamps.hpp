@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // KITTI raw's frame times: `image_02/timestamps.txt` beside `image_02/data/`, one line per image,
 // `2011-09-26 13:02:25.964389445` (date, time of day, up to nine decimals of a second). They are
 // read as nanoseconds since 1970-01-01 taken as UTC: only differences matter to the pairs, and an

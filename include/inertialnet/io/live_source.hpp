@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Live input: a camera or any capture OpenCV's VideoCapture opens, as a frame source that ends
 // when the capture does (or never: a camera runs until the run is stopped).
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // TUM-VI's motion-capture poses, mav0/mocap0/data.csv: `#timestamp [ns],p_RS_R_x [m],p_RS_R_y [m],
 // p_RS_R_z [m],q_RS_w [],q_RS_x [],q_RS_y [],q_RS_z []` at 120 Hz: the pose of the IMU (S) in the
 // mocap room frame (R), w first, on the IMU's clock (TUM-VI's export aligned them). Marker

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The angular-rates CSV that `predict` writes and `eval` reads (schema inertialnet.rates/3):
 //
 //   rates.csv                                   rates.csv.json (the sidecar)

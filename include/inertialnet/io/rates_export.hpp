@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The rates CSV (io/rates_csv.hpp) in the formats of the tools users open next:
 //
 //  * gyroflow: Gyroflow's `.gcsv` gyro log (docs.gyroflow.xyz, "GCSV format"):

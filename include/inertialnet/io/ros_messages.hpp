@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The sensor_msgs messages a bag's topics carry, decoded from a BagMessage (bag.hpp) whatever its
 // encoding (ROS 1 or CDR) and whichever spelling its type has ("sensor_msgs/Image" in ROS 1,
 // "sensor_msgs/msg/Image" in ROS 2):

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // safetensors weight files: the format's element types and a memory-mapped, fully validated
 // reader (the writer is safetensors_writer.hpp, the model-fit check weight_fit.hpp).
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Writing safetensors weight files: float32 tensors, atomically.
 //
 // The layout is the one safetensors.hpp reads: 8-byte little-endian header length, a JSON header,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Does a set of weights fit a model? The one check behind every "do not fit" message.
 //
 // A model lists the tensors it expects (names and shapes, from its parameter table); the weights

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The weight-free flow estimator: OpenCV's DIS optical flow (Kroeger et al., "Fast Optical Flow
 // using Dense Inverse Search", 2016) at its MEDIUM preset, on the frames' BT.601 luminance.
 //

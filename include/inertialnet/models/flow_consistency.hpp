@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Forward-backward consistency of a dense flow: a vector whose round trip (forward to q = p + f(p),
 // then the backward flow at q) does not come back near p is marked unknown, so that the geometric
 // head (and anything else that skips unknown flow) leaves it out. Occlusions at depth edges and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The FlowNet2 family on a device: FlowNet2, FlowNet2-CS, FlowNet2-CSS and the standalone
 // FlowNet2-C, -S and -SD, exactly as docs/model_spec.md specifies them.
 //

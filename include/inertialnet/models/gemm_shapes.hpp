@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The matrix products a model runs on frames of a given size, read off the graph it builds
 // (so they follow the model as it is, not a hand-kept list): one entry per distinct (m, n, k),
 // listing the layers of that size. Batch 1; the sizes are those of the network's own input

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The geometric head: the camera's angular velocity from a dense optical-flow field by geometry
 // alone (no learned weights), the counterpart of the InertialNet CNN head.
 //

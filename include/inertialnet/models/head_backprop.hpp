@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The InertialNet head (docs/model_spec.md, "InertialNet head") for training: its forward pass in
 // training mode with the activations kept, the MSE loss against target rates, and the backward
 // pass to the gradient of every parameter, all on the library's OpenCL ops (ops/*_backward.hpp),

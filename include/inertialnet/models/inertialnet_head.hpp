@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The InertialNet rotation head (docs/model_spec.md, "InertialNet head"):
 // flow [N, 2, H, W] in pixels → conv1 + ReLU → max-pool → conv2 + ReLU → max-pool →
 // 1×1 conv3 + ReLU → flatten → (dropout, training only) → fc1 + ReLU → fc2 → (ωx, ωy, ωz) in

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The parameter tables of every network: names (exactly flownet2-pytorch's state_dict keys),
 // shapes, layer kinds and the fan-in and gain the synthetic weights use (docs/model_spec.md).
 // A model loads its weights by these names; a weight file is checked against these shapes.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Deterministic synthetic weights (docs/model_spec.md "Deterministic synthetic weights"):
 // every tensor is a pure function of (seed, tensor name, fan-in, gain), bit-identical to the
 // Python twin in tools/reference/, so full-size networks can be compared with PyTorch without

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Whether a frame shows anything optical flow can follow.
 //
 // A uniform grey or black frame (a covered lens, an over- or under-exposed frame, a dropped frame

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Network parameters on a device, by flownet2-pytorch state_dict name.
 //
 // Weights come from one or more safetensors files (FlowNet2 and head tensors may sit in one

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The activations fused into convolutions, deconvolutions and linear layers, and applied
 // standalone. FlowNet2 uses LeakyReLU(0.1) everywhere; the InertialNet head uses ReLU.
 //

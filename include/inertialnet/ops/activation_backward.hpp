@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The gradient through an activation, computed from the activation's *output* y (what the forward
 // pass of a fused conv/linear + activation leaves): ReLU passes grad where y > 0, LeakyReLU(s)
 // passes grad where y > 0 and s·grad elsewhere (valid for s > 0, where y > 0 exactly when the

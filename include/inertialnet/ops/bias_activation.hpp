@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The epilogue of the GEMM-based ops (conv2d, linear), in place:
 //   x[n, c, …] = activation(x[n, c, …] + bias[c])
 // for every channel c of dimension 1 (for a rank-2 tensor [N, F] the features are the channels).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The gradient of a per-channel bias: grad_bias[c] = Σ_n Σ_(spatial) grad_output[n, c, …], for
 // conv2d ([N, C, H, W]) and linear ([N, C]) alike. One work-group per channel with a fixed
 // summation order (a tree in local memory, no atomics): the same inputs give the same bits on one

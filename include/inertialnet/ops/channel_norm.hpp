@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // flownet2-pytorch's ChannelNorm: the Euclidean norm over channels,
 //   out[n, 0, y, x] = sqrt(Σ_c in[n, c, y, x]²),
 // one output channel, usually a channel slice of a concatenation. FlowNet2 mostly takes the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Channel concatenation (axis 1). FlowNet2 builds its concatenations without copies wherever it
 // can: the producers write straight into channel slices of one preallocated tensor
 // (Tensor::channels). These functions cover the cases where a copy cannot be avoided (x6's

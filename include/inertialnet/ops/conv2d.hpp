@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // 2-D convolution (PyTorch Conv2d semantics, dilation 1, groups 1) through im2col + CLBlast GEMM,
 // with the bias and the activation fused into one pass after the GEMM.
 //

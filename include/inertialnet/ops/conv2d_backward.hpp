@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The gradients of conv2d (ops/conv2d.hpp) with respect to its input and its weight, through
 // the GEMM backend of the device (gemm_backend(): the packed kernels on CPUs, CLBlast elsewhere),
 // like the forward pass. The bias gradient is bias_gradient() (ops/bias_gradient.hpp); an

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // 2-D transposed convolution (PyTorch ConvTranspose2d semantics, output_padding 0, dilation 1,
 // groups 1): FlowNet's 4×4 / stride 2 / padding 1 up-convolutions, any kernel, stride, padding.
 //

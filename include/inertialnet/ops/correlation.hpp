@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // FlowNetC's correlation layer (flownet2-pytorch's Correlation, corr_multiply 1).
 //
 // Inputs f1, f2: [N, C, H, W]. With kernel radius kr = (k − 1)/2, displacement radius

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Dropout (the InertialNet head's 30 % between conv3 and fc1).
 //
 // Inference: the identity, with no kernel and no copy unless the caller asks for the result in

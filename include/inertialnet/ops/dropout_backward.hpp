@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The gradient of training-mode dropout (ops/dropout.hpp). Its mask is a pure function of
 // (seed, element index, p), so the backward pass regenerates the forward mask from the same
 // options instead of storing it: grad_input = keep ? grad_output · 1/(1 − p) : 0, which is the

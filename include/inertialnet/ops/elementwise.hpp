@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Elementwise ops on tensors of any rank whose first axis is the batch, typically NCHW. Every
 // tensor may be a view with a batch stride larger than its sample (a channel slice of a
 // concatenation, Tensor::channels), inputs and outputs alike; the elements of an output outside

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Fully connected layer (PyTorch Linear): y = activation(x · Wᵀ + b), one CLBlast GEMM plus the
 // fused bias/activation pass.
 //

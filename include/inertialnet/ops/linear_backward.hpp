@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The gradients of linear (ops/linear.hpp) with respect to its input and its weight, each one
 // GEMM on the device's backend (deterministic); the bias gradient is bias_gradient().
 //   grad_input [N, in]  = grad_output [N, out] · W [out, in]

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The motion-field reductions (kernels_cl/motion_field.cl): the two passes over a dense flow
 // field that the geometric head's solvers need (include/inertialnet/models/geometric_head.hpp).
 //

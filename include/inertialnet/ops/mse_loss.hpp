@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Mean squared error, PyTorch's MSELoss with reduction "mean": loss = Σ (p − t)² / count over every
 // element, and its gradient with respect to the prediction, 2 (p − t) / count. The sum runs in one
 // work-group in a fixed order (deterministic).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // FlowNet2's input normalisation (step 1 of docs/model_spec.md's FlowNet2): for frames [N, C, H, W]
 // in [0, 255] (C = 3, RGB),
 //   rgb_mean[n, c] = mean over both frames and all pixels of channel c,

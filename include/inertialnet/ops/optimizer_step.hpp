@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // One optimiser update of a parameter tensor on its device, one work-item per element: PyTorch's
 // torch.optim.SGD (dampening 0, no Nesterov) and torch.optim.Adam (no amsgrad), so a run can be
 // checked against theirs. The state tensors (velocity, first and second moments) have the

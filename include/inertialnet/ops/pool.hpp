@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Max pooling over the spatial axes of NCHW tensors, without padding and with PyTorch's floor
 // semantics: out = floor((in − kernel) / stride) + 1 per axis, so an odd size drops its last
 // row or column under the 2×2/2 pooling of the InertialNet head. NaN propagates (as in PyTorch).

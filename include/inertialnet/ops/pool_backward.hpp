@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The gradient of max_pool2d (ops/pool.hpp): each window's gradient goes to the element PyTorch
 // selects as its argmax (the first maximum in row-by-row scan order; the last NaN where the
 // window holds NaN). The argmax is recomputed from the forward input, so the forward pass keeps

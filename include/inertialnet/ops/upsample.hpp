@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Resampling of NCHW tensors to another spatial size, with PyTorch's interpolate() semantics,
 // and the flow-field resize of docs/model_spec.md "Any input size".
 //

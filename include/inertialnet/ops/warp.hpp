@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Backward warping by a flow field: flownet2-pytorch's Resample2d with kernel size 1.
 //
 // out[n, c, y, x] is the bilinear sample of image[n, c] at (x + u, y + v), (u, v) =

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The host scheduler: angular rates for every frame pair of a sequence, with several pairs in
 // flight.
 //

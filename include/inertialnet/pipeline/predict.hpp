@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `predict` as one library call: the settings of `inertialnet predict` resolved into the frame
 // source, the devices with their weights, the camera and the pair processor, then run through
 // the pipeline. The CLI and the Python package both go through it, so they compute the same

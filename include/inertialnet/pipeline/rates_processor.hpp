@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The pair processors the pipeline runs: what turns two frames into angular rates.
 //
 // Flow comes from FlowNet2 (or a lighter family member, on the device) or from OpenCV's DIS

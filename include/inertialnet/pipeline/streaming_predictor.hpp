@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Frames pushed one at a time, rates out as each pair finishes: the streaming face of predict.
 //
 //   push(t, frame) ──▶ bounded queue ──▶ the pipeline (pipeline.hpp; decode → lanes → reorder)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Device buffers, recycled. Releasing a Tensor returns its buffer to the pool of its device,
 // so ops that allocate temporaries (im2col columns, GEMM results) do not hit the driver's
 // allocator on every call. Networks plan their activations on top of this (see models/).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Keeping the on-disk cache private to its user.
 //
 // Cached program binaries are native code that the driver loads and runs: a cache folder that

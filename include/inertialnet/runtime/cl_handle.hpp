@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // RAII ownership of OpenCL objects: every object the library creates is released exactly once,
 // also when an exception unwinds the stack.
 #pragma once

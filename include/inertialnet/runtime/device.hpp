@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // An opened OpenCL device: its context, its default in-order queue, its compiled programs and
 // its buffer pool. Everything that runs on a device goes through one of these.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What the OpenCL platforms of this machine offer: one DeviceInfo per device, numbered
 // globally in platform order. Discovery never filters by type: CPUs (PoCL) are first-class.
 #pragma once

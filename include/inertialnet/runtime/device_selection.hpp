@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The --device grammar (docs/architecture.md, "Devices and the program cache"):
 //   N            global device index                 --device 1
 //   P:D          platform index : device index       --device 0:1

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What `inertialnet tune` found for one device, stored beside the program cache and applied
 // whenever the device opens.
 //

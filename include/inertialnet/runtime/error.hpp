@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The library's one error type.
 //
 // Every failure that reaches a user is an inertialnet::Error. Its kind decides the CLI's exit

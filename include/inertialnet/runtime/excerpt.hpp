@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What a message quotes of a value the user gave: the text itself when short, else its first
 // characters and "…", so that a pasted 300-digit number or a whole file pasted into an option does
 // not flood the terminal (issue 20, item 9). One rule for the CLI's parsers and the library's.

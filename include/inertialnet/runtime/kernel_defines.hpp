@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The -D build options of a kernel program, assembled from typed values:
 //   KernelDefines().add("KH", 3).add("HAS_BIAS", true).add("NEGATIVE_SLOPE", 0.1f)
 // gives "-DKH=3 -DHAS_BIAS=1 -DNEGATIVE_SLOPE=0x1.99999ap-4f". The string is part of the program

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Device time per network layer, for `--profile` and `inertialnet bench`.
 //
 // A profiler attached to a profiling queue (Queue::set_profiler) is told by the graph executor

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The library's messages to the user (a kernel compile on a first run, a driver's asynchronous
 // report, a tuning parameter CLBlast refused) go through one logger instead of straight to
 // stderr, so that an application decides where they go and how many it wants.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The one place that includes the OpenCL C API, so that every translation unit agrees on the
 // API level. 1.2 entry points exist on every platform we target (PoCL, NVIDIA, AMD, Intel);
 // the device's own OpenCL C version still decides the kernels' -cl-std.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Compiled OpenCL programs, once per (device, driver, source, options).
 //
 // Kernel sources are the files of kernels_cl/, embedded into the library at build time, one

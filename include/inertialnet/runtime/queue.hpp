@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // An in-order command queue and the kernels launched on it.
 //
 // Kernel objects carry argument state, so they are not shared between host threads: each Queue

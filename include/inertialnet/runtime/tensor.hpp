@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Float32 tensors on a device, NCHW.
 //
 // A Tensor is a shape, a shared device buffer, the element offset of its first element and the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The versions of this library and of what it was built against, for `inertialnet --version`
 // and bug reports. The OpenCL platforms and drivers are run-time facts: see discover_devices().
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What a `synth` sequence is made of: its length, frame size, rates, kind of motion, seed and
 // noise (include/inertialnet/synth/synthetic_sequence.hpp writes one).
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `synth`: a EuRoC (ASL) sequence rendered from a known camera motion, with exact gyro ground
 // truth, so that the reader, IMU synchronisation, the pipeline and the metrics can be checked
 // end to end against rates that are known exactly.

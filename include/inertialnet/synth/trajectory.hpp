@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The camera motion of a `synth` sequence, in closed form.
 //
 // The camera orientation is R_WC(t) = Exp(θ(t)), with θ(t) a sum of three sinusoids per axis

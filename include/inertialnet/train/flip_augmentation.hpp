@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Flip augmentation for training: a flow field mirrored horizontally and/or vertically, with the
 // angular rate that produces the mirrored field.
 //

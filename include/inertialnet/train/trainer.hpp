@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Training the InertialNet head on the library's OpenCL ops (models/head_backprop.hpp): seeded
 // initialisation and shuffling, mini-batches, SGD or Adam (ops/optimizer_step.hpp) with a
 // learning-rate schedule, per-epoch validation (loss, per-axis RMSE in deg/s against the zero

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The per-epoch CSV of a training run (`inertialnet train --log`): one row per epoch with its
 // learning rate, losses, per-axis validation RMSE beside the zero predictor's, spread ratios,
 // whether it was the best so far, and its time.

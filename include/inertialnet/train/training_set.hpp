@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A training (or validation) set for the InertialNet head: every consecutive frame pair of one or
 // more sequences, as a flow at the head's input size and the angular rate it should predict.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // is_bag() and open_bag(): which container a path holds, told by its content (a ROS 1 bag's first
 // line, MCAP's magic, an SQLite database with rosbag2's tables), not by its extension; a folder is
 // a rosbag2 bag when it holds a metadata.yaml, and its storage file is opened.

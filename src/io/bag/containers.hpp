@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The three bag containers behind open_bag() (include/inertialnet/io/bag.hpp), one file each.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // ROS 2 bags in MCAP (https://mcap.dev/spec), rosbag2's default storage since Iron. No MCAP library
 // is packaged in Debian and the format is a small, documented record format, so it is read here:
 // the magic, then records (an opcode byte, a little-endian u64 length, the content), some of them

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Inside the library only: the fields of one serialised ROS message, read in declaration order,
 // for both encodings a bag holds (bag.hpp's MessageEncoding):
 //   - ROS 1: packed little-endian, no alignment; a string is a u32 length and its bytes (no NUL);

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // ROS 1 bags, format 2.0 (http://wiki.ros.org/Bags/Format/2.0): after the "#ROSBAG V2.0\n" line,
 // records of <u32 header length><header fields name=value><u32 data length><data>. The ops read
 // here: the bag header (0x03), chunks (0x05: uncompressed, bz2 or lz4 — roslz4 writes LZ4 frames),

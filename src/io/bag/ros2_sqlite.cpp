@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // ROS 2 bags in rosbag2's sqlite3 storage (.db3), and the rosbag2 bag folder (metadata.yaml beside
 // its storage file, .db3 or .mcap). The database is read with SQLite's C API (Debian's
 // libsqlite3-dev), read-only: the `topics` table (id, name, type, serialization_format) and the

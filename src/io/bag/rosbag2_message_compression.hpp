@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // rosbag2's per-message compression (`ros2 bag record --compression-mode message`): every message
 // of a .db3 or .mcap is a zstd frame instead of CDR. The bag folder says so in metadata.yaml
 // (refused by ros2_storage_file()); a storage file given alone does not, so its cursors look at

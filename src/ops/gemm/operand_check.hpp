@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Checks shared by the GEMM backends (CLBlast wrapper, packed GEMM, GEMV).
 #pragma once
 

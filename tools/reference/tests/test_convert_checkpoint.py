@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """tools/convert_checkpoint.py on checkpoints the reference models save themselves.
 
 Run: .venv-reference/bin/python -m pytest tools/reference/tests -q

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The committed fixtures of tests/data/fixtures/: budget, metadata, and agreement with a fresh run
 of the reference (for the models that are quick to recompute; the rest share their code).
 

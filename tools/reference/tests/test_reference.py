@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Self-test of the PyTorch reference: the generator, parameter counts and names, and each op
 against a loop written straight from docs/model_spec.md (test_fixtures.py checks the fixtures).
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Which implementation runs a layer's matrix product: CLBlast (any OpenCL device; the choice on
 // GPUs) or the project's packed-panel kernels written for CPU devices (ops/gemm/packed_gemm.hpp,
 // with a direct convolution for layers of very few output channels and a GEMV for

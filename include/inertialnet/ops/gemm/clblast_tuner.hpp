@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // One step of CLBlast's own tuner on a network's GEMM shapes (`inertialnet tune`):
 // clblast::TuneXgemm (a random search over `fraction` of its parameter space) on `search_shape`,
 // then the set in use now and the set it found timed through clblast::Gemm on all of `shapes`.

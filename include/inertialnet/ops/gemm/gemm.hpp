@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Single-precision GEMM, row-major: C = alpha·op(A)·op(B) + beta·C with op(A) m×k, op(B) k×n
 // and C m×n, through CLBlast or the packed-panel kernels (ops/gemm/backend.hpp says which).
 // Convolutions and fully connected layers end here.

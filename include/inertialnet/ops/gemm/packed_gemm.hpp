@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The project's own SGEMM for CPU devices (kernels_cl/gemm_packed.cl): both operands are
 // rearranged into panels that one work-item streams through in order, one MR×32 tile of C per
 // work-item held in registers, bias and activation applied as the tile is stored.

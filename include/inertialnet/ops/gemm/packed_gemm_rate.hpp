@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The packed GEMM's own speed on one product size: the kernel alone on operands packed
 // beforehand (no im2col, no packing, no col2im), so a layer's rate can be set beside the best its
 // product could reach on the device (`bench --json`, per layer kind).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The parameter search of the packed GEMM (`inertialnet tune`): every combination of the build
 // options packed_gemm_parameters() lists (MR from `tile_rows`, PANELS_FIRST 0 and 1) timed on a
 // network's GEMM shapes, the combination with the least total time kept. Each candidate's

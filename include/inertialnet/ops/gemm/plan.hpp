@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // "Plan then enqueue" for the GEMM-based layers: the backend of a layer and its weights in the
 // layout that backend reads are decided once per layer, when a model first runs, not per call.
 //

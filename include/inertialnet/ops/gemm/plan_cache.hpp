@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The timed GEMM plans of one device and driver ($INERTIALNET_PLAN=auto, ops/gemm/backend.hpp),
 // kept on disk beside the program cache so that a layer shape is timed once per machine:
 //

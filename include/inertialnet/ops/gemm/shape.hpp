@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The size of one matrix product a network runs: C (m×n) = A (m×k) · B (k×n), with the layers
 // that run it. A convolution is m = output channels, n = output pixels, k = input channels ·
 // kernel area; a transposed convolution m = output channels · kernel area, n = input pixels,
