@@ -21,7 +21,7 @@ batches) within a pair or a layer: ``KeyboardInterrupt``.
 from __future__ import annotations
 
 import os
-from typing import Callable, Iterable, Optional, Sequence as _Seq, Union
+from typing import Callable, Iterable, List, Optional, Sequence as _Seq, Union
 
 import numpy as np
 
@@ -186,6 +186,8 @@ def predict(
     cy: Optional[float] = None,
     calibration: Optional[PathLike] = None,
     calibration_camera: str = "",
+    image_topic: Optional[str] = None,
+    camera_info_topic: str = "",
     rate_hz: float = 0.0,
     camera: str = "cam0",
     time_offset: Optional[float] = None,
@@ -200,8 +202,8 @@ def predict(
 ):
     """Angular rates of every frame pair of a sequence, as ``inertialnet predict`` computes them.
 
-    ``sequence`` is a path (EuRoC folder, image folder, video) or a :class:`Sequence` (its
-    ``rate_hz`` is used unless one is given). Returns :class:`Rates`: one row per frame pair,
+    ``sequence`` is a path (EuRoC folder, image folder, video, ROS bag) or a :class:`Sequence` (its
+    ``rate_hz`` and ``image_topic`` are used unless given). Returns :class:`Rates`: one row per frame pair,
     ``.timestamps_ns`` (the pair's second frame), ``.w`` (N, 3) rad/s, ``.status`` (``"ok"``, or
     why the pair has no answer, e.g. ``"no_texture"``; its rates are then NaN), and what the CLI's
     rates CSV states: ``.estimator``, ``.frame``, ``.time_offset_s``, ``.readout_time_s``. With
@@ -211,6 +213,8 @@ def predict(
     ``calibration`` is ``--calibration`` (EuRoC sensor.yaml, Kalibr camchain, OpenCV YAML/XML;
     ``calibration_camera`` picks a camchain's camera) and ``fx``, ``fy``, ``cx``, ``cy`` are
     ``--fx`` … (None: not given; ``cx=0`` is a principal point at the corner);
+    ``image_topic`` and ``camera_info_topic`` are a ROS bag's ``--image-topic`` and
+    ``--camera-info-topic`` (None: a :class:`Sequence`'s own, else the bag's only image topic);
     ``time_offset`` and ``readout_time`` are ``--time-offset`` and ``--readout-time`` (seconds;
     stated in the rates for :func:`evaluate`, the readout time also corrects the geometric head);
     ``flow_check`` is ``--flow-check`` (the DIS forward-backward check for the geometric head,
@@ -228,6 +232,7 @@ def predict(
     ``KeyboardInterrupt``; the pairs computed so far are dropped."""
     if isinstance(sequence, Sequence) and not rate_hz:
         rate_hz = sequence.rate_hz
+    image_topic = _image_topic_of(sequence, image_topic)
     if isinstance(weights, (str, os.PathLike)):
         weights = [weights]
     columns, t_ns, values, flows, statuses, metadata = _native._predict(
@@ -235,7 +240,7 @@ def predict(
         *(None if v is None else float(v) for v in (fx, fy, cx, cy)), float(rate_hz), _device_spec(device),
         keep_flow, max_pairs, int(lanes), int(decode_threads), float(flow_check), progress,
         None if time_offset is None else float(time_offset), float(readout_time), camera,
-        "" if calibration is None else os.fspath(calibration), calibration_camera)
+        "" if calibration is None else os.fspath(calibration), calibration_camera, image_topic, camera_info_topic)
     rates = _rates_of_predict(columns, t_ns, values, statuses, metadata)
     return (rates, flows) if keep_flow else rates
 
@@ -248,6 +253,23 @@ def write_rates_csv(path: PathLike, rates: Union[Rates, np.ndarray]) -> None:
 
 def _as_rates(rates: Union[Rates, np.ndarray]) -> Rates:
     return rates if isinstance(rates, Rates) else Rates.from_records(np.asarray(rates))
+
+
+def _image_topic_of(sequence, image_topic: Optional[str]) -> str:
+    """A bag's image topic: the one given, else a :class:`Sequence`'s own, else "" (the only one)."""
+    if image_topic is not None:
+        return str(image_topic)
+    return sequence.image_topic if isinstance(sequence, Sequence) else ""
+
+
+def _pair_of_words(value, name: str, *, count: int) -> List[str]:
+    """``imu_columns=`` / ``imu_units=`` as the CLI's comma lists: a string "a,b" or a sequence."""
+    if value is None:
+        return []
+    words = value.split(",") if isinstance(value, str) else [str(v) for v in value]
+    if len(words) != count:
+        raise ValueError(f"{name} must hold {count} values, got {len(words)}: {value!r}")
+    return [w.strip() for w in words]
 
 
 def _t_cam_imu_text(T_cam_imu) -> str:
@@ -277,6 +299,11 @@ def evaluate(
     readout_time: Optional[float] = None,
     imu: Optional[PathLike] = None,
     imu_time_unit: Optional[str] = None,
+    imu_columns: Union[None, str, _Seq[Union[str, int]]] = None,
+    imu_units: Union[None, str, _Seq[str]] = None,
+    image_topic: Optional[str] = None,
+    imu_topic: str = "",
+    camera_info_topic: str = "",
     T_cam_imu=None,
     camchain: Optional[PathLike] = None,
     calibration: Optional[PathLike] = None,
@@ -297,7 +324,10 @@ def evaluate(
     ``gyro_bias`` (x, y, z rad/s in the IMU frame, or "auto"), ``camera_frame``, ``time_offset``
     (seconds, t_imu = t_cam + offset, or "auto" to estimate it within ±``time_offset_range``;
     None: the rates' own), ``readout_time`` (seconds; None: the rates' own), ``imu`` (a gyro log:
-    EuRoC CSV, gyro-only CSV, Gyroflow .gcsv; ``imu_time_unit`` s|ms|us|ns), ``T_cam_imu`` (IMU to
+    EuRoC CSV, any CSV, Gyroflow .gcsv, a GoPro MP4; ``imu_time_unit`` s|ms|us|ns; ``imu_columns``
+    the time and gyro columns by name or index, ``imu_units`` (time unit, gyro unit), as
+    ``--imu-columns t,gx,gy,gz --imu-units s,deg/s``), a ROS bag's ``image_topic``, ``imu_topic``,
+    ``camera_info_topic`` (``--image-topic`` …; None/"": its only one), ``T_cam_imu`` (IMU to
     camera: a 4x4 matrix, 16 numbers, or a YAML file), ``camchain`` (a Kalibr camchain's cam0),
     ``calibration`` (a calibration file whose camera-IMU extrinsic, if it has one, stands for
     ``camchain``; ``calibration_camera`` picks a camchain's camera), ``camera`` (a EuRoC sequence's cam0 or cam1), ``rate_hz`` (a folder's or video's
@@ -318,7 +348,9 @@ def evaluate(
             _as_rates(rates).to_csv(path)
             return evaluate(path, sequence, target=target, head=head, gyro_bias=gyro_bias, camera_frame=camera_frame,
                             time_offset=time_offset, time_offset_range=time_offset_range,
-                            readout_time=readout_time, imu=imu, imu_time_unit=imu_time_unit, T_cam_imu=T_cam_imu,
+                            readout_time=readout_time, imu=imu, imu_time_unit=imu_time_unit,
+                            imu_columns=imu_columns, imu_units=imu_units, image_topic=image_topic,
+                            imu_topic=imu_topic, camera_info_topic=camera_info_topic, T_cam_imu=T_cam_imu,
                             camchain=camchain, calibration=calibration, calibration_camera=calibration_camera,
                             camera=camera, rate_hz=rate_hz, plot=plot, series=series)
     if isinstance(gyro_bias, str):
@@ -332,5 +364,7 @@ def evaluate(
         float(time_offset_range), None if readout_time is None else float(readout_time),
         "" if imu is None else os.fspath(imu), imu_time_unit or "", _t_cam_imu_text(T_cam_imu),
         "" if camchain is None else os.fspath(camchain), camera, float(rate_hz),
-        "" if calibration is None else os.fspath(calibration), calibration_camera)
+        "" if calibration is None else os.fspath(calibration), calibration_camera,
+        _pair_of_words(imu_columns, "imu_columns", count=4), _pair_of_words(imu_units, "imu_units", count=2),
+        _image_topic_of(sequence, image_topic), imu_topic, camera_info_topic)
     return json.loads(text)

@@ -98,14 +98,15 @@ def _predict(sequence: _Path, weights: list[str], model: str, flow: str, head: s
              fx: Optional[float], fy: Optional[float], cx: Optional[float], cy: Optional[float], rate_hz: float,
              device: str, keep_flow: bool, max_pairs: SupportsIndex, lanes: int, decode_threads: int,
              flow_check: float, progress: Optional[Callable[[int, int], object]], time_offset: Optional[float],
-             readout_time: float, camera: str, calibration: str, calibration_camera: str
-             ) -> tuple[list[str], npt.NDArray[np.int64], npt.NDArray[np.float64], list[npt.NDArray[np.float32]],
+             readout_time: float, camera: str, calibration: str, calibration_camera: str, image_topic: str,
+             camera_info_topic: str) -> tuple[list[str], npt.NDArray[np.int64], npt.NDArray[np.float64], list[npt.NDArray[np.float32]],
                         list[list[str]], list[tuple[str, str]]]: ...
 def _evaluate_json(rates: _Path, sequence: _Path, target: str, head: str, gyro_bias: Union[None, str, list[float]],
                    camera_frame: bool, plot: str, series: bool, time_offset: Union[None, float, str],
                    time_offset_range: float, readout_time: Optional[float], imu: str, imu_time_unit: str,
                    T_cam_imu: str, camchain: str, camera: str, rate_hz: float, calibration: str,
-                   calibration_camera: str) -> str: ...
+                   calibration_camera: str, imu_columns: list[str], imu_units: list[str], image_topic: str,
+                   imu_topic: str, camera_info_topic: str) -> str: ...
 def _write_rates_csv(path: _Path, columns: list[str], t: npt.ArrayLike, values: npt.ArrayLike,
                      status_names: list[str], statuses: list[list[str]], metadata: list[tuple[str, str]]) -> None: ...
 def _read_rates_csv(path: _Path) -> tuple[list[str], npt.NDArray[np.int64], npt.NDArray[np.float64], list[str],

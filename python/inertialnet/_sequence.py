@@ -76,6 +76,11 @@ class Sequence(collections.abc.Sequence):
         return self._native.path
 
     @property
+    def image_topic(self) -> str:
+        """A ROS bag's image topic as given ("": the bag's only one, or not a bag)."""
+        return self._native.image_topic
+
+    @property
     def rate_hz(self) -> float:
         """The frame rate given (0: the source's frame times)."""
         return self._native.rate_hz

@@ -857,7 +857,9 @@ std::string evaluate_json(const std::filesystem::path& rates, const std::filesys
                           double time_offset_range, const py::object& readout_time, const std::string& imu,
                           const std::string& imu_time_unit, const std::string& T_cam_imu, const std::string& camchain,
                           const std::string& camera, double rate_hz, const std::string& calibration,
-                          const std::string& calibration_camera) {
+                          const std::string& calibration_camera, const std::vector<std::string>& imu_columns,
+                          const std::vector<std::string>& imu_units, const std::string& image_topic,
+                          const std::string& imu_topic, const std::string& camera_info_topic) {
   existing(rates, "the rates file");
   existing(sequence, "the sequence");
   EvalOptions options;
@@ -900,6 +902,33 @@ std::string evaluate_json(const std::filesystem::path& rates, const std::filesys
     if (!unit) throw invalid_input("imu_time_unit must be s, ms, us or ns, got '" + imu_time_unit + "'");
     options.input.imu_time_unit = unit;
   }
+  // imu_columns=, imu_units= are --imu-columns and --imu-units (the CLI's checks, keyword names).
+  if (!imu_units.empty()) {
+    if (imu.empty()) throw invalid_input("imu_units describes the gyro log of imu=FILE; give imu= too.");
+    if (!imu_time_unit.empty()) throw invalid_input("imu_units and imu_time_unit both give the time unit: give one of them.");
+    if (imu_units.size() != 2) {
+      throw invalid_input("imu_units must be (time unit, gyro unit), e.g. (\"s\", \"deg/s\"); got " +
+                          std::to_string(imu_units.size()) + " values");
+    }
+    options.input.imu_format.time_unit = parse_time_unit(imu_units[0]);
+    if (!options.input.imu_format.time_unit) {
+      throw invalid_input("imu_units' time unit must be s, ms, us or ns, got '" + imu_units[0] + "'");
+    }
+    options.input.imu_format.gyro_unit = parse_gyro_unit(imu_units[1]);
+    if (!options.input.imu_format.gyro_unit) {
+      throw invalid_input("imu_units' gyro unit must be rad/s or deg/s, got '" + imu_units[1] + "'");
+    }
+    options.input.imu_format.time_unit_option = "imu_units";
+  }
+  if (!imu_columns.empty()) {
+    if (imu.empty()) throw invalid_input("imu_columns names the columns of imu=FILE; give imu= too.");
+    if (imu_columns.size() != 4) {
+      throw invalid_input("imu_columns must name four columns (time, gx, gy, gz) by header name or 0-based index; got " +
+                          std::to_string(imu_columns.size()));
+    }
+    options.input.imu_format.columns = imu_columns;
+  }
+  options.input.bag = BagTopics{image_topic, imu_topic, camera_info_topic};
   if (!T_cam_imu.empty() && !camchain.empty()) {
     throw invalid_input("T_cam_imu and camchain both give the camera-IMU rotation: give one of them.");
   }
@@ -1128,7 +1157,8 @@ PYBIND11_MODULE(_inertialnet, m) {
            const py::object& fy, const py::object& cx, const py::object& cy, double rate_hz, const std::string& device,
            bool keep_flow, const py::object& max_pairs, int lanes, int decode_threads, double flow_check,
            const py::object& progress, const py::object& time_offset, double readout_time, const std::string& camera,
-           const std::string& calibration, const std::string& calibration_camera) {
+           const std::string& calibration, const std::string& calibration_camera, const std::string& image_topic,
+           const std::string& camera_info_topic) {
           // The CLI's checks of --max-pairs, --rate, --fx, --fy: a value they refuse is a ValueError
           // here, not ignored (a negative rate or focal length was taken as "not given").
           const std::int64_t pairs = integer_of(max_pairs, "max_pairs");
@@ -1177,6 +1207,8 @@ PYBIND11_MODULE(_inertialnet, m) {
           s.cy = given_cy;
           s.calibration = calibration.empty() ? std::filesystem::path() : existing(calibration, "the calibration file");
           s.calibration_camera = calibration_camera;
+          s.bag.image = image_topic;
+          s.bag.camera_info = camera_info_topic;
           s.rate_hz = rate_hz;
           s.device = device;
           s.keep_flow = keep_flow;

@@ -37,3 +37,44 @@ def test_a_missing_topic_lists_the_bags_topics(sequence, tmp_path):
     write_bag(sequence, bag)
     with pytest.raises(ValueError, match=r"has no topic /cam1/image_raw .*/cam0/image_raw \(sensor_msgs/Image, 5 messages\)"):
         inertialnet.Sequence(bag, image_topic="/cam1/image_raw")
+
+
+def test_predict_and_evaluate_on_a_bag_give_the_euroc_folders_numbers(sequence, tmp_path):
+    # predict(Sequence(bag, image_topic=…)) carries the topic; evaluate takes the bag's IMU topic
+    # and its camera-IMU rotation as eval --imu-topic --T-cam-imu do.
+    bag = tmp_path / "mono8.bag"
+    write_bag(sequence, bag, "--camera-info")
+    from_bag = inertialnet.predict(inertialnet.Sequence(bag, image_topic="/cam0/image_raw"))
+    camera = inertialnet.Sequence(sequence).camera  # the synthetic camera has no distortion
+    from_frames = inertialnet.predict(sequence / "mav0" / "cam0" / "data", fx=camera.fx, fy=camera.fy, cx=camera.cx,
+                                      cy=camera.cy)
+    assert from_bag.frame == from_frames.frame == "camera"  # a CameraInfo has no extrinsics
+    np.testing.assert_array_equal(from_bag.w, from_frames.w)
+    sensor = sequence / "mav0" / "cam0" / "sensor.yaml"
+    on_bag = inertialnet.evaluate(from_bag, bag, image_topic="/cam0/image_raw", imu_topic="/imu0", T_cam_imu=sensor)
+    on_folder = inertialnet.evaluate(inertialnet.predict(sequence), sequence)
+    rmse = lambda report: report["estimators"][0]["bias_corrected"]["rmse_deg_s"]
+    np.testing.assert_allclose([rmse(on_bag)[k] for k in "xyz"], [rmse(on_folder)[k] for k in "xyz"], atol=1e-5)
+
+
+def test_evaluate_reads_a_gyro_csv_by_its_columns_and_units(sequence, tmp_path):
+    # EuRoC's imu0 rewritten as seconds and deg/s, columns reordered among others: imu_columns and
+    # imu_units (eval's --imu-columns and --imu-units) give the EuRoC folder's numbers.
+    rows = np.loadtxt(sequence / "mav0" / "imu0" / "data.csv", delimiter=",", comments="#")
+    gyro = tmp_path / "gyro.csv"
+    with open(gyro, "w") as f:
+        f.write("temp,gz,stamp,gx,gy\n")
+        for r in rows:
+            f.write(f"21.5,{np.degrees(r[3])!r},{r[0] / 1e9!r},{np.degrees(r[1])!r},{np.degrees(r[2])!r}\n")
+    frames = sequence / "mav0" / "cam0" / "data"
+    sensor = sequence / "mav0" / "cam0" / "sensor.yaml"
+    rates = inertialnet.predict(frames, calibration=sensor)
+    by_columns = inertialnet.evaluate(rates, frames, imu=gyro, imu_columns="stamp,gx,gy,gz", imu_units=("s", "deg/s"),
+                                      calibration=sensor)
+    euroc = inertialnet.evaluate(rates, frames, imu=sequence / "mav0" / "imu0" / "data.csv", calibration=sensor)
+    rmse = lambda report: report["estimators"][0]["bias_corrected"]["rmse_deg_s"]
+    np.testing.assert_allclose([rmse(by_columns)[k] for k in "xyz"], [rmse(euroc)[k] for k in "xyz"], atol=1e-5)
+    with pytest.raises(ValueError, match="imu_units"):
+        inertialnet.evaluate(rates, frames, imu=gyro, imu_units="s,furlongs")
+    with pytest.raises(ValueError, match="imu_columns must hold 4 values"):
+        inertialnet.evaluate(rates, frames, imu=gyro, imu_columns=["stamp", "gx"])
