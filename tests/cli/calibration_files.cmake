@@ -197,15 +197,6 @@ run(2 ${CLI} predict plain/mav0/cam0/data)
 expect_match("give --calibration FILE \\(EuRoC sensor.yaml, Kalibr camchain, OpenCV YAML/XML\\) or --fx")
 
 # --- eval: the file's extrinsic, as --camchain gives it ---------------------------------------
-# rmse_of(<var> <json>): "x y z" of the raw RMSE of the document's first estimator.
-function(rmse_of var document)
-  set(values "")
-  foreach(axis x y z)
-    expect_json("${document}" estimators 0 raw rmse_deg_s ${axis})
-    list(APPEND values "${value}")
-  endforeach()
-  set(${var} "${values}" PARENT_SCOPE)
-endfunction()
 set(imu --imu radtan/mav0/imu0/data.csv)
 foreach(frame "" "--camera-frame")
   run(0 ${CLI} eval radtan.csv radtan --json ${frame})

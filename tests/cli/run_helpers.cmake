@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: Apache-2.0
-# What the CLI scripts share (end_to_end, outputs, bad_inputs, bench_json, tune): run a command in ${WORK}, check
-# its exit code, and match its output.
+# What the CLI scripts share (end_to_end, outputs, bad_inputs, bench_json, tune, the input tests): run a
+# command in ${WORK}, check its exit code, match its output, compare eval's RMSE.
 
 # run(<expected exit code> <command>...): runs in ${WORK}; sets `output` to stdout + stderr.
 function(run expect_code)
@@ -43,6 +43,30 @@ function(expect_no_match regex)
   if(output MATCHES "${regex}")
     message(FATAL_ERROR "output matches '${regex}', which it should not")
   endif()
+endfunction()
+
+# rmse_of(<var> <eval --json document>): "x;y;z" of the raw RMSE of the document's first estimator.
+function(rmse_of var document)
+  set(values "")
+  foreach(axis x y z)
+    expect_json("${document}" estimators 0 raw rmse_deg_s ${axis})
+    list(APPEND values "${value}")
+  endforeach()
+  set(${var} "${values}" PARENT_SCOPE)
+endfunction()
+
+# expect_same_rmse(<expected> <actual> <what>): two rmse_of lists agree to five decimals (CMake
+# has no floating-point arithmetic: compared as text).
+function(expect_same_rmse expected actual what)
+  foreach(k 0 1 2)
+    list(GET expected ${k} e)
+    list(GET actual ${k} a)
+    string(REGEX MATCH "^-?[0-9]+\\.[0-9][0-9][0-9][0-9][0-9]" e6 "${e}")
+    string(REGEX MATCH "^-?[0-9]+\\.[0-9][0-9][0-9][0-9][0-9]" a6 "${a}")
+    if(NOT e6 STREQUAL a6)
+      message(FATAL_ERROR "${what}: RMSE ${actual} deg/s, the EuRoC path gives ${expected}")
+    endif()
+  endforeach()
 endfunction()
 
 # running_as_root(<var>): TRUE when the tests run as root (device nodes and other users'
