@@ -10,11 +10,7 @@ file(REMOVE_RECURSE "${WORK}")
 file(MAKE_DIRECTORY "${WORK}")
 
 run(0 ${CLI} synth seq --frames 20 --size 188x120 --seed 3)
-file(READ "${WORK}/seq/mav0/cam0/sensor.yaml" yaml)
-if(NOT yaml MATCHES "intrinsics: \\[([^,]+), ([^,]+), ([^,]+), ([^]]+)\\]")
-  message(FATAL_ERROR "no intrinsics in the synthetic sensor.yaml")
-endif()
-set(intrinsics --fx ${CMAKE_MATCH_1} --fy ${CMAKE_MATCH_2} --cx ${CMAKE_MATCH_3} --cy ${CMAKE_MATCH_4})
+intrinsics_flags(intrinsics seq/mav0/cam0/sensor.yaml)
 set(imu --imu seq/mav0/imu0/data.csv)
 # The inverse of synth's (EuRoC's) cam0 T_BS: IMU → camera.
 set(row0 "0.0148655429818, 0.999557249008, -0.0257744366974, 0.06522290953550845")

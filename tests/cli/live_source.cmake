@@ -15,9 +15,7 @@ expect_match("96x64 8")
 set(playback "gst:filesrc location=${WORK}/frames.raw ! rawvideoparse width=96 height=64 format=gray8 framerate=20/1 ! appsink")
 
 # The same camera on both sides: the synthetic camera's intrinsics, given as flags.
-file(READ "${WORK}/seq/mav0/cam0/sensor.yaml" sensor)
-string(REGEX MATCH "intrinsics: \\[([^,]+), ([^,]+), ([^,]+), ([^]]+)\\]" _ "${sensor}")
-set(camera --fx ${CMAKE_MATCH_1} --fy ${CMAKE_MATCH_2} --cx ${CMAKE_MATCH_3} --cy ${CMAKE_MATCH_4})
+intrinsics_flags(camera seq/mav0/cam0/sensor.yaml)
 
 # 1. The frames as a EuRoC folder and as a live source. The capture clock cannot give the folder's
 # stamps (GStreamer's position is the pipeline's running time, not exact 50 ms steps), so the live

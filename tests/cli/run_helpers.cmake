@@ -45,6 +45,27 @@ function(expect_no_match regex)
   endif()
 endfunction()
 
+# intrinsics_flags(<var> <sensor.yaml under ${WORK}>): "--fx;F;--fy;F;--cx;C;--cy;C" from a EuRoC
+# sensor.yaml's intrinsics line (the camera of a synthetic sequence, given as flags).
+function(intrinsics_flags var sensor_yaml)
+  file(READ "${WORK}/${sensor_yaml}" yaml)
+  if(NOT yaml MATCHES "intrinsics: \\[([^,]+), ([^,]+), ([^,]+), ([^]]+)\\]")
+    message(FATAL_ERROR "no intrinsics in ${sensor_yaml}")
+  endif()
+  set(${var} --fx ${CMAKE_MATCH_1} --fy ${CMAKE_MATCH_2} --cx ${CMAKE_MATCH_3} --cy ${CMAKE_MATCH_4} PARENT_SCOPE)
+endfunction()
+
+# rates_lines_of(<var> <csv under ${WORK}>): the CSV's lines but # comments (header and rows); at
+# least five, else FATAL_ERROR.
+function(rates_lines_of var csv)
+  file(STRINGS "${WORK}/${csv}" lines REGEX "^[^#]")
+  list(LENGTH lines n)
+  if(n LESS 5)
+    message(FATAL_ERROR "${csv} holds ${n} lines of rates")
+  endif()
+  set(${var} "${lines}" PARENT_SCOPE)
+endfunction()
+
 # rmse_of(<var> <eval --json document>): "x;y;z" of the raw RMSE of the document's first estimator.
 function(rmse_of var document)
   set(values "")
