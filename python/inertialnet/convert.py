@@ -58,6 +58,7 @@ class InputError(Exception):
 
 FLOWNET2_KINDS = ("FlowNet2", "FlowNet2-C", "FlowNet2-S", "FlowNet2-SD", "FlowNet2-CS", "FlowNet2-CSS")
 FLOWNET2_PREFIXES = ("flownetc", "flownets_1", "flownets_2", "flownets_d", "flownetfusion")
+HEAD_KIND = "InertialNetHead"  # detected, but converted by tools/convert_checkpoint.py (HeadConfig)
 
 
 def _conv(out, name, ci, co, k):  # conv / iconv: Sequential(Conv2d, [LeakyReLU])
@@ -174,7 +175,7 @@ def expected_shapes(kind: str) -> Dict[str, tuple]:
 
 
 def detect_kind(names: Iterable[str]) -> str:
-    """The FlowNet2-family model a set of state_dict names belongs to (raises InputError)."""
+    """The model a set of state_dict names belongs to: a FlowNet2 kind or HEAD_KIND (raises InputError)."""
     names = set(names)
     prefixes = {n.split(".", 1)[0] for n in names}
     if prefixes & set(FLOWNET2_PREFIXES):
@@ -187,8 +188,7 @@ def detect_kind(names: Iterable[str]) -> str:
         raise InputError("the checkpoint has only flownetc.* tensors; no FlowNet2 variant is "
                          "a FlowNetC with a prefix (pass --model to force one)")
     if "head" in prefixes or {"fc1.weight", "fc2.weight", "conv3.weight"} <= names:
-        raise InputError("the checkpoint holds an InertialNet head; convert heads with "
-                         "tools/convert_checkpoint.py --head-input WxH")
+        return HEAD_KIND
     if "conv_redir.0.weight" in names:
         return "FlowNet2-C"
     if "inter_conv2.0.weight" in names or "conv0.0.weight" in names:
@@ -272,10 +272,9 @@ def identify(path: str, sha256: str, layout: str, kind: str, catalogue=None) -> 
     for p in catalogue:
         if not p.sha256_prefix and base == p.file and p.model == kind and layout == "flownet2-pytorch":
             return {"published": p.label(), "url": p.url,
-                    "checksum": f"none published by {p.project}; matched by file name and layout "
-                                "(SHA-256 recorded)"}
+                    "checksum": f"not verified: {p.project} publishes no checksum; matched by file name and layout"}
     return {"published": "none", "url": "",
-            "checksum": "matches no published checkpoint (SHA-256 recorded)"}
+            "checksum": "no published checkpoint has this SHA-256, or this file name and layout"}
 
 
 # ---------------------------------------------------------------- torch checkpoint reading ----
@@ -719,7 +718,7 @@ def check_written(path: str, tensors: Dict[str, Tensor], metadata: Dict[str, str
     if set(got) != set(tensors):
         problems.append(f"names differ: missing {sorted(set(tensors) - set(got))}, extra {sorted(set(got) - set(tensors))}")
     for name in sorted(set(got) & set(tensors)):
-        want = tensors[name].numpy().astype(np.float32)
+        want = np.asarray(tensors[name].numpy(), dtype=np.float32)  # a Tensor here, or a torch tensor
         if got[name].shape != want.shape:
             problems.append(f"{name}: reloaded {_fmt(got[name].shape)}, wrote {_fmt(want.shape)}")
         elif not np.array_equal(got[name].view(np.uint32), want.view(np.uint32)):
@@ -758,6 +757,9 @@ def convert(source: str, output: str, model: Optional[str] = None, check: bool =
     obj, fmt = read_checkpoint(source)
     tensors, layout = state_dict_of(obj, source)
     kind = model or detect_kind(tensors)
+    if kind == HEAD_KIND:
+        raise InputError(f"{source}: holds an InertialNet head; convert heads with tools/convert_checkpoint.py "
+                         "--head-input WxH (the head's input size is not in its weights)")
     expected = expected_shapes(kind)
     validate(tensors, expected, kind)
     origin = identify(source, sha256, layout, kind, catalogue)
@@ -772,9 +774,9 @@ def convert(source: str, output: str, model: Optional[str] = None, check: bool =
 
 
 def list_published() -> str:
-    lines = [f"{'checkpoint':34} {'model':13} {'SHA-256 begins':15} where"]
+    lines = [f"{'checkpoint':38} {'model':13} {'SHA-256 begins':17} where"]
     for p in PUBLISHED:
-        lines.append(f"{p.file:34} {p.model:13} {p.sha256_prefix or '(none published)':15} {p.url}")
+        lines.append(f"{p.file:38} {p.model:13} {p.sha256_prefix or '(none published)':17} {p.url}")
     return "\n".join(lines)
 
 
@@ -826,9 +828,9 @@ def main(argv=None) -> int:
         meta = done["metadata"]
         print(f"{args.output}: {done['kind']}, {done['tensors']} tensors, {done['parameters']:,} parameters"
               + (", verified bit for bit" if args.check else ""))
-        print(f"  from {meta['inertialnet.checkpoint.layout']} checkpoint ({meta['inertialnet.checkpoint.format']}), "
-              f"published: {meta['inertialnet.checkpoint.published']}; checksum "
-              f"{meta['inertialnet.checkpoint.checksum']}")
+        print(f"  from a {meta['inertialnet.checkpoint.layout']} checkpoint ({meta['inertialnet.checkpoint.format']}); "
+              f"published checkpoint: {meta['inertialnet.checkpoint.published']} (checksum: "
+              f"{meta['inertialnet.checkpoint.checksum']})")
     return EXIT_OK
 
 
