@@ -397,11 +397,27 @@ def _allowed_globals(where) -> Dict[str, object]:
         "torch.device": lambda *args: ":".join(str(a) for a in args),
         "_codecs.encode": _latin1_bytes,
         "builtins.set": set, "builtins.frozenset": frozenset,
+        # A numpy scalar (flownet2-pytorch's training loop can store best_EPE as one): rebuilt from
+        # its dtype and raw bytes by numpy, which runs nothing the pickle chooses.
+        "numpy.dtype": np.dtype,
         "__builtin__.set": set, "__builtin__.frozenset": frozenset,
     }
+    scalar = _numpy_scalar()
+    allowed["numpy.core.multiarray.scalar"] = allowed["numpy._core.multiarray.scalar"] = scalar
     for name in _STORAGE_DTYPES:
         allowed[f"torch.{name}"] = allowed[f"torch.cuda.{name}"] = _StorageType(name)
     return allowed
+
+
+def _numpy_scalar():
+    """numpy's own scalar rebuilder (numpy._core in numpy 2, numpy.core before)."""
+    import importlib
+    for module in ("numpy._core.multiarray", "numpy.core.multiarray"):
+        try:
+            return importlib.import_module(module).scalar
+        except (ImportError, AttributeError):
+            continue
+    raise ImportError("numpy's multiarray.scalar")
 
 
 class _Unpickler(pickle.Unpickler):

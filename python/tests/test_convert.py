@@ -289,3 +289,17 @@ def test_the_source_tree_tool_converts_without_torch(original, tmp_path):
     assert r.returncode == 0, r.stderr
     assert "FlowNet2-S, 42 tensors, 38,676,506 parameters, verified bit for bit" in r.stdout
     assert cv.read_safetensors(str(out))[1]["inertialnet.checkpoint.layout"] == "ptlflow-lightning"
+
+
+def test_numpy_scalars_beside_the_state_dict(original, tmp_path):
+    """A training run of flownet2-pytorch can store best_EPE as a numpy scalar: numpy rebuilds it."""
+    _, arrays = original
+    small = [(n, a) for n, a in arrays if n.startswith("conv1.")]
+    obj = tf.nvidia_checkpoint([(n, tf.StoredTensor.of(a)) for n, a in small])
+    obj["best_EPE"] = np.float64(2.5)
+    path = tmp_path / "trained.pth.tar"
+    tf.write_legacy(path, obj)
+    loaded, fmt = cv.read_checkpoint(str(path))
+    assert fmt == "torch-legacy" and loaded["best_EPE"] == 2.5 and type(loaded["best_EPE"]) is np.float64
+    tensors, layout = cv.state_dict_of(loaded, str(path))
+    assert layout == "flownet2-pytorch" and np.array_equal(tensors["conv1.0.weight"].numpy(), small[0][1])
