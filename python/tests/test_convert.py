@@ -303,3 +303,28 @@ def test_numpy_scalars_beside_the_state_dict(original, tmp_path):
     assert fmt == "torch-legacy" and loaded["best_EPE"] == 2.5 and type(loaded["best_EPE"]) is np.float64
     tensors, layout = cv.state_dict_of(loaded, str(path))
     assert layout == "flownet2-pytorch" and np.array_equal(tensors["conv1.0.weight"].numpy(), small[0][1])
+
+
+def test_a_head_needs_torch_only_for_its_configuration(tmp_path):
+    """The tool detects an InertialNet head; without torch it says what is missing (exit 2), and
+    the torch-free module points to the tool."""
+    tool = REPO / "tools" / "convert_checkpoint.py"
+    if not tool.exists():
+        pytest.skip(f"no source tree beside the tests ({tool})")
+    rng = np.random.default_rng(0)
+    shapes = {"conv1.weight": (16, 2, 3, 3), "conv1.bias": (16,), "conv2.weight": (32, 16, 3, 3), "conv2.bias": (32,),
+              "conv3.weight": (8, 32, 1, 1), "conv3.bias": (8,), "fc1.weight": (128, 8 * 6 * 8), "fc1.bias": (128,),
+              "fc2.weight": (3, 128), "fc2.bias": (3,)}
+    src = tmp_path / "head.pth"
+    tf.write_zip(src, tf.state_dict([(n, rng.standard_normal(s).astype(np.float32)) for n, s in shapes.items()]))
+    with pytest.raises(cv.InputError, match="holds an InertialNet head; convert heads with tools/convert_checkpoint.py"):
+        cv.convert(str(src), str(tmp_path / "m.safetensors"))
+    r = subprocess.run([sys.executable, str(tool), str(src), str(tmp_path / "h.safetensors"), "--head-input", "32x24"],
+                       capture_output=True, text=True)
+    try:
+        import torch  # noqa: F401
+    except ImportError:
+        assert r.returncode == 2 and "converting a head needs torch for tools/reference/head.py" in r.stderr, r.stderr
+    else:
+        assert r.returncode == 0, r.stderr
+        assert json.loads(cv.read_safetensors(str(tmp_path / "h.safetensors"))[1]["inertialnet.head"])["input_width"] == 32
