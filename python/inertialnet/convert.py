@@ -43,6 +43,7 @@ import struct
 import sys
 import tempfile
 import zipfile
+import zlib
 from typing import Dict, Iterable, List, Optional, Tuple
 
 import numpy as np
@@ -397,11 +398,11 @@ def _allowed_globals(where) -> Dict[str, object]:
         "torch.device": lambda *args: ":".join(str(a) for a in args),
         "_codecs.encode": _latin1_bytes,
         "builtins.set": set, "builtins.frozenset": frozenset,
-        # A numpy scalar (flownet2-pytorch's training loop can store best_EPE as one): rebuilt from
-        # its dtype and raw bytes by numpy, which runs nothing the pickle chooses.
-        "numpy.dtype": np.dtype,
         "__builtin__.set": set, "__builtin__.frozenset": frozenset,
+        "numpy.dtype": np.dtype,
     }
+    # A numpy scalar (flownet2-pytorch's training loop can store best_EPE as one): rebuilt from its
+    # dtype and raw bytes by numpy, which runs nothing the pickle chooses.
     scalar = _numpy_scalar()
     allowed["numpy.core.multiarray.scalar"] = allowed["numpy._core.multiarray.scalar"] = scalar
     for name in _STORAGE_DTYPES:
@@ -452,8 +453,8 @@ def _unpickle(data: bytes, where: str, storage_for):
                           storage_for).load()
     except InputError:
         raise
-    except (pickle.UnpicklingError, EOFError, ValueError, TypeError, KeyError, IndexError,
-            AttributeError, UnicodeDecodeError, struct.error) as e:
+    except (pickle.UnpicklingError, EOFError, ValueError, TypeError, KeyError, IndexError, AttributeError,
+            UnicodeDecodeError, struct.error, OverflowError, RecursionError) as e:
         raise InputError(f"{where}: not a readable torch pickle ({type(e).__name__}: {e})") from None
 
 
@@ -486,7 +487,10 @@ def _read_zip(path: str):
         def read(start, count, entry=entry):
             if entry not in cache:
                 cache.clear()  # one storage at a time: a state dict's tensors rarely share one
-                cache[entry] = archive.read(entry)
+                try:
+                    cache[entry] = archive.read(entry)
+                except (zipfile.BadZipFile, zlib.error, EOFError, NotImplementedError) as e:
+                    raise InputError(f"{path}: storage {entry} cannot be read ({e}); damaged download?") from None
             return cache[entry][start:start + count]
         return Storage(Storage.Root(kind, int(numel), read, big_endian, 0), 0, int(numel))
 

@@ -230,13 +230,20 @@ def test_damaged_checkpoints_are_bad_input(original, tmp_path):
         for item in z.namelist():
             if not item.endswith("/data/1"):
                 out.writestr(item, z.read(item))
+    # A flipped bit in a storage's data: the zip's CRC catches it when the tensor is read.
+    cases["bad crc"] = tmp_path / "crc.ckpt"
+    data = bytearray((tmp_path / "full.ckpt").read_bytes())
+    with zipfile.ZipFile(tmp_path / "full.ckpt") as z:
+        info = z.getinfo("full/data/0")
+    data[info.header_offset + 30 + len(info.filename) + len(info.extra) + 1] ^= 1
+    cases["bad crc"].write_bytes(bytes(data))
     cases["past its storage"] = tmp_path / "strides.pth.tar"
     storage = tf.Storage(np.zeros(4, np.float32))
     tf.write_legacy(cases["past its storage"], tf.nvidia_checkpoint([("conv1.0.bias", tf.StoredTensor(storage, 2, (64,), (1,)))]))
     cases["not tensors"] = tmp_path / "values.pth.tar"
     tf.write_legacy(cases["not tensors"], {"epoch": 0, "state_dict": {"conv1.0.bias": 1.5}, "best_EPE": 0.0})
     messages = {"truncated": "truncated", "junk": "neither of torch's checkpoint formats",
-                "missing storage": "which the archive lacks", "past its storage": "reaches past its storage of 4 elements",
+                "missing storage": "which the archive lacks", "bad crc": "storage full/data/0 cannot be read (Bad CRC-32", "past its storage": "reaches past its storage of 4 elements",
                 "not tensors": "state_dict entries that are not tensors: conv1.0.bias (float)"}
     for what, path in cases.items():
         with pytest.raises(cv.InputError, match=re.escape(messages[what])):
