@@ -35,6 +35,16 @@ def run_module(*args):
     return subprocess.run([sys.executable, "-m", "inertialnet.convert", *map(str, args)], capture_output=True, text=True)
 
 
+@pytest.fixture(autouse=True)
+def _remove_large_files(tmp_path):
+    """Each FlowNet2-S checkpoint or weight file is 155 MB: remove them after each test, so that the
+    suite does not leave gigabytes in its temporary folder."""
+    yield
+    for path in tmp_path.rglob("*"):
+        if path.is_file() and path.stat().st_size > (1 << 20):
+            path.unlink()
+
+
 @pytest.fixture(scope="module")
 def original(cli, tmp_path_factory):
     """The original weights: the library's synthetic FlowNet2-S, as (name, array) in state_dict order."""
