@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <utility>
 
 #include "inertialnet/ops/motion_field.hpp"
 #include "inertialnet/runtime/error.hpp"
@@ -192,6 +193,12 @@ TEST(LkFlow, RefusesFramesAndSettingsItCannotUse) {
   HostImage short_data = a;
   short_data.data.resize(a.plane_size());
   EXPECT_THROW(LkFlow().compute(short_data, c, 4, 0.5), Error);
+  // The smallest frames it takes are tracked without an OpenCV assertion (the pyramid stops
+  // where the window no longer fits).
+  for (const auto& [w, h] : {std::pair{16, 16}, std::pair{17, 40}, std::pair{40, 16}}) {
+    const HostImage small = frame(w, h, texture);
+    EXPECT_NO_THROW(LkFlow().compute(small, small, 2, 0.5)) << w << "x" << h;
+  }
   LkFlowOptions bad;
   bad.window = 1;
   EXPECT_THROW(LkFlow{bad}, Error);
