@@ -265,7 +265,6 @@ TimeOffsetEstimate estimate_time_offset(const std::vector<std::int64_t>& from, c
     ReadoutModel model = *options.readout;
     model.camera_to_imu = product(r, model.camera_to_imu);
     e.readout = fit_readout(residual, acceleration, corrected, model);
-    e.readout->offset_confidence = e.confidence();
   }
   return e;
 }

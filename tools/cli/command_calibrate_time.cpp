@@ -196,12 +196,6 @@ Command register_calibration(CLI::App& app, const GlobalOptions& global, bool re
         std::cout << "apply it with: inertialnet eval RATES.csv " << o->sequence << input << " "
                   << calibrate_time_eval_options(e) << "\n";
       }
-      if (calibration.readout && calibration.readout->detected && calibration.readout->confidence() != "low") {
-        char line[160];
-        std::snprintf(line, sizeof line, "predict with the readout: inertialnet predict %s%s --readout-time %.4f",
-                      o->sequence.c_str(), input.c_str(), calibration.readout->readout_s);
-        std::cout << line << "\n";
-      }
     }
     for (const auto& w : report.warnings) warning(w);
     return 0;
