@@ -147,3 +147,21 @@ if(NOT value STREQUAL "low")
 endif()
 expect_json("${doc}" readout_time std_error_s)
 expect_between("rolling-shutter readout 1 sigma" ${value} 0.002 0.02)
+
+# A near-still clip (0.05 deg/s): nothing in calibrate's report may be rated high — the offset is
+# noise fitted to noise (low, with the excitation as the reason), no readout can show — and eval
+# refuses to apply the report's offset.
+run(0 ${CLI} synth still --frames 40 --size 188x120 --seed 1 --max-rate 0.05)
+run(0 ${CLI} predict still -o still.csv)
+run_json(doc ${CLI} calibrate still still.csv --json)
+expect_json("${doc}" time_offset confidence)
+if(NOT value STREQUAL "low")
+  message(FATAL_ERROR "near-still clip: time offset confidence ${value}, expected low")
+endif()
+expect_json("${doc}" readout_time confidence)
+if(NOT value STREQUAL "none")
+  message(FATAL_ERROR "near-still clip: readout confidence ${value}, expected none")
+endif()
+file(WRITE "${WORK}/still.json" "${doc}")
+run(2 ${CLI} eval still.csv still --calibration-from still.json)
+expect_match("--calibration-from still.json: the camera-IMU time offset in it is rated low; not applying it")
