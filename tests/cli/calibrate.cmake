@@ -130,6 +130,13 @@ if(NOT value STREQUAL "OFF" AND NOT value STREQUAL "false")
   message(FATAL_ERROR "readout searched with --no-readout: ${value}")
 endif()
 
+# Without a usable device a rates file still gives the offset and rotation; the readout alone is
+# skipped, with a warning saying why.
+run(0 ${CLI} calibrate rig rates.csv --device 99)
+expect_match("time_offset_s 0\\.0[34]")
+expect_match("warning: the readout time is not fitted: the readout's leak model needs an OpenCL device: There is no device with index 99")
+expect_no_match("readout_time_s")
+
 # A rolling shutter of 30 ms: detected, and of the right size within the bound the model holds
 # (readout_fit.hpp: 50–62 % of the truth recovered on such frames), rated no higher than low.
 run(0 ${CLI} synth rs --frames 60 --size 188x120 --seed 5 --readout-time 0.03)

@@ -140,8 +140,13 @@ Command register_calibration(CLI::App& app, const GlobalOptions& global, bool re
           const Mat3 r = imu_to_camera_rotation(seq);
           model.camera_to_imu = {r[0], r[3], r[6], r[1], r[4], r[7], r[2], r[5], r[8]};
         }
-        model.leak = readout_leak(*solved.camera, solved.head, global.device);
-        options.time_offset_search.readout = model;
+        try {
+          model.leak = readout_leak(*solved.camera, solved.head, global.device);
+          options.time_offset_search.readout = model;
+        } catch (const Error& error) {
+          // A rates file needs no device for the offset and rotation; without one the readout alone is skipped.
+          calibration.readout_skipped = std::string("the readout's leak model needs an OpenCL device: ") + error.what();
+        }
       } else {
         calibration.readout_skipped = "no camera intrinsics to fit it with (the sequence's sensor.yaml)";
       }
@@ -196,6 +201,9 @@ Command register_calibration(CLI::App& app, const GlobalOptions& global, bool re
         std::cout << "apply it with: inertialnet eval RATES.csv " << o->sequence << input << " "
                   << calibrate_time_eval_options(e) << "\n";
       }
+    }
+    if (o->readout && !o->no_readout && !calibration.readout_skipped.empty()) {
+      warning("the readout time is not fitted: " + calibration.readout_skipped);
     }
     for (const auto& w : report.warnings) warning(w);
     return 0;

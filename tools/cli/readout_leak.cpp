@@ -45,7 +45,9 @@ Mat3 readout_leak(const CameraIntrinsics& camera, const GeometricHeadOptions& op
   ideal.coefficients.clear();
   GeometricHeadOptions global_shutter = options;
   global_shutter.readout_time_s = 0;
-  Device device(select_devices(device_spec_or_environment(device_spec), discover_devices()).front());
+  const std::vector<DeviceInfo> devices = select_devices(device_spec_or_environment(device_spec), discover_devices());
+  if (devices.empty()) throw runtime_error("no OpenCL device to solve the leak's flow fields on");
+  Device device(devices.front());
   const auto queue = device.create_queue();
   GeometricHead head(device, ideal, global_shutter);
   const Vec3 base = head.estimate(*queue, rotational_flow(ideal, {0, 0, 0}), kDt).omega;
