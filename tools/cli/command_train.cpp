@@ -45,6 +45,7 @@ struct TrainCliOptions {
   std::string out, log, plot, cache, time_offset;
   std::string head_input = "normalized";  // --head-input (models/head_input.hpp)
   double augment_rotation = 0;            // --augment-rotation, deg/s
+  double dropout = 0.3;                   // --dropout: before fc1, training only
   BagTopics bag;          // --image-topic, --imu-topic, --camera-info-topic: every ROS bag's
   std::string T_cam_imu;  // --T-cam-imu: a ROS bag's IMU-camera rotation
   int epochs = 20, batch = 10;
@@ -145,6 +146,7 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
                  "normalized (flow per second in normalised camera coordinates: any camera, frame rate and size) "
                  "or paper (pixels at the head's size, the paper's)")
       ->capture_default_str();
+  app.add_option("--dropout", o->dropout, "dropout before fc1 during training (the paper: 0.3)")->capture_default_str();
   app.add_option("--augment-rotation", o->augment_rotation,
                  "add to each training flow the exact flow of a random rotation up to this many deg/s per axis, and "
                  "its rate to the target (0: off)")
@@ -160,6 +162,7 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
     TrainerOptions options;
     options.head.input_width = width;
     options.head.input_height = height;
+    options.head.dropout = o->dropout;
     options.optimizer = parse_optimizer(o->optimizer);
     options.schedule = parse_lr_schedule(o->schedule);
     options.lr = o->lr;
@@ -270,6 +273,7 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
       j["seed"] = options.seed;
       j["augment_flips"] = options.flip_augmentation;
       j["augment_rotation_deg_s"] = options.rotation_augmentation_deg_s;
+      j["dropout"] = options.head.dropout;
       j["head_input"] = to_string(set_options.input);
       j["flow"] = to_string(set_options.flow);
       j["input_size"] = std::to_string(options.head.input_width) + "x" + std::to_string(options.head.input_height);
