@@ -41,11 +41,13 @@ namespace {
 
 struct TrainCliOptions {
   std::vector<std::string> train, val, weights;
-  std::string flow = "dis", optimizer = "sgd", schedule = "constant", head_size = "752x480", target = "spline";
+  std::string flow = "dis", optimizer = "sgd", schedule = "constant", head_size = "752x480", target = "mean";
   std::string out, log, plot, cache, time_offset;
   std::string head_input = "normalized";  // --head-input (models/head_input.hpp)
   double augment_rotation = 0;            // --augment-rotation, deg/s
-  double dropout = 0.3;                   // --dropout: before fc1, training only
+  // --dropout before fc1, training only. 0, not the paper's 0.3: dropout acts as a ridge penalty on
+  // fc1 and pulls predictions towards the mean (docs/training.md, "Regression towards the mean").
+  double dropout = 0;
   BagTopics bag;          // --image-topic, --imu-topic, --camera-info-topic: every ROS bag's
   std::string T_cam_imu;  // --T-cam-imu: a ROS bag's IMU-camera rotation
   int epochs = 20, batch = 10;
@@ -136,7 +138,7 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
       ->capture_default_str()
       ->type_name("UINT");
   app.add_option("--head-size", o->head_size, "the head's flow size WxH (flows are resized to it)")->capture_default_str();
-  app.add_option("--target", o->target, "spline (the paper's) or mean")->capture_default_str();
+  app.add_option("--target", o->target, "mean (the gyro over each pair's interval, what its flow measures) or spline (the paper's: at the second frame)")->capture_default_str();
   app.add_option("--time-offset", o->time_offset,
                  "camera-IMU time offset in seconds (t_imu = t_cam + offset) of every sequence: the targets are the "
                  "gyro at the shifted times (as eval --time-offset; estimate it with calibrate-time)");
@@ -146,7 +148,7 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
                  "normalized (flow per second in normalised camera coordinates: any camera, frame rate and size) "
                  "or paper (pixels at the head's size, the paper's)")
       ->capture_default_str();
-  app.add_option("--dropout", o->dropout, "dropout before fc1 during training (the paper: 0.3)")->capture_default_str();
+  app.add_option("--dropout", o->dropout, "dropout before fc1 during training (the paper's: 0.3)")->capture_default_str();
   app.add_option("--augment-rotation", o->augment_rotation,
                  "add to each training flow the exact flow of a random rotation up to this many deg/s per axis, and "
                  "its rate to the target (0: off)")

@@ -4,8 +4,8 @@
 //
 // Sequences are EuRoC folders (mav0/cam0 + imu0, `inertialnet synth` output included) or ROS bags
 // (bag_source.hpp: an image topic and an Imu topic, the IMU-camera rotation given or the identity). The target
-// of pair (k−1, k) is the gyro synchronised onto frame k's time (eval/imu_sync.hpp: `spline`, the
-// paper's, or `mean` over the interval), bias-corrected when a bias is known (ground truth, else a
+// of pair (k−1, k) is the gyro synchronised onto frame k's time (eval/imu_sync.hpp: `mean` over the
+// interval, the default, or `spline` at frame k, the paper's), bias-corrected when a bias is known (ground truth, else a
 // static start), in the body (IMU) frame — so a trained head predicts what the gyro measures, in
 // the frame `predict` reports. Pairs without a target (outside the IMU's span) are skipped.
 //
@@ -54,7 +54,11 @@ struct TrainingSetOptions {
   const WeightSet* flownet_weights = nullptr;
   Device* device = nullptr;
   std::string weights_id;
-  SyncTarget target = SyncTarget::Spline;
+  // The gyro's mean over each pair's interval: what the flow of the pair measures. The paper's
+  // spline value at the second frame's time is another rate than the flow's whenever the rate
+  // changes within the interval — over a dropped frame by tens of deg/s — and a head trained on
+  // it shrinks towards the mean (docs/training.md, "Regression towards the mean").
+  SyncTarget target = SyncTarget::Mean;
   // Camera–IMU time offset of every sequence (t_imu = t_cam + offset, eval/time_offset.hpp): the
   // targets are the gyro at the shifted times, as eval --time-offset compares them.
   double time_offset_s = 0;
