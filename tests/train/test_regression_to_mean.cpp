@@ -62,7 +62,7 @@ Result train_and_validate(const fs::path& root, const Recipe& recipe) {
   o.target = recipe.target;
   o.cache_dir = root / "cache";
   TrainingSet train(o), val(o), held(o);
-  // Training camera 120×75; held-out camera 128×64 (fx 78.1 px, fy 61.0 px against 73.2 and 71.5).
+  // Training camera 120×75 (fx 73.2 px, fy 71.5 px); held-out camera 128×64 (fx 78.1 px, fy 61.0 px).
   for (std::uint64_t seed : {1, 2, 3}) train.add_sequence(root / ("train" + std::to_string(seed)));
   val.add_sequence(root / "val");
   held.add_sequence(root / "held");
