@@ -181,6 +181,11 @@ run(0 ${CLI} predict big --weights head.safetensors -o rates_big.csv)
 expect_match("DIS flow \\+ InertialNet head")
 run(2 ${CLI} predict big --weights head.safetensors --flow flownet2 -o rates_big.csv)
 expect_match("inertialnet: error: --flow flownet2: the InertialNet head in head.safetensors was trained on dis flow")
+# Its input is divided by the focal lengths: an image folder without a calibration is refused
+# (exit 2) before any flow, and with --fx it runs.
+run(2 ${CLI} predict b/mav0/cam0/data --weights head.safetensors -o rates_folder.csv)
+expect_match("this InertialNet head \\(trained on normalized input\\) needs the camera")
+run(0 ${CLI} predict b/mav0/cam0/data --weights head.safetensors --fx 40 -o rates_folder.csv)
 # A head without that metadata (converted, or trained before it) is the paper's: pixel flow,
 # resized the same way; a normalized one needs the camera.
 run(0 ${CLI} weights --synthetic InertialNetHead --size 64x48 -o paper_head.safetensors)
