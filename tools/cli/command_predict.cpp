@@ -156,7 +156,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
   app.add_option("-w,--weights", o->weights,
                  "weights (safetensors) holding FlowNet2 and/or the InertialNet head; repeat for several files");
   app.add_option("--model", o->model, "flow network (default FlowNet2)")->transform(choice("model", flow_model_names()));
-  app.add_option("--flow", o->flow, "flownet2 (default with weights; a trained head's metadata names its own) or dis (OpenCV DIS; default without weights)")
+  app.add_option("--flow", o->flow, "flownet2 (default with weights) or dis (OpenCV DIS; default without weights)")
       ->transform(choice("flow method", {"flownet2", "dis"}));
   app.add_option("--head", o->head, "inertialnet (default with weights), geometric (default without), or both")
       ->transform(choice("head", {"inertialnet", "geometric", "both"}));
