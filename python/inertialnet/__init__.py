@@ -141,14 +141,17 @@ class InertialNetHead:
         return cls(_native._InertialNetHead(weights, device))
 
     def rates(self, flow: np.ndarray, camera: Optional[Camera] = None, dt: Optional[float] = None) -> np.ndarray:
-        """ω in rad/s: ``(3,)`` for one flow ``(H, W, 2)``, ``(N, 3)`` for a batch. The flow must have
-        the size the head was built for (``config``) and a finite, known vector at every pixel: NaN
-        (what ``dis_flow(flow_check=…)`` and the flow readers give for unknown flow), infinity or a
-        value above 1e9 is a ``ValueError`` naming the first such index. ``camera`` and ``dt`` are
-        accepted for symmetry with :class:`GeometricHead` and ignored: the learned head knows its
-        camera and rate."""
-        del camera, dt
-        return self._head.rates(flow)
+        """ω in rad/s: ``(3,)`` for one flow ``(H, W, 2)``, ``(N, 3)`` for a batch, of frames of any
+        size: the flow is turned into the head's input as ``predict`` and ``train`` do (resized to
+        the head's size, ``config["input_width"]`` × ``config["input_height"]``; for a head of
+        ``config["input"] == "normalized"`` also divided by ``dt`` and the focal lengths of
+        ``camera``, which it then needs). Every vector must be finite and known: NaN (what
+        ``dis_flow(flow_check=…)`` and the flow readers give for unknown flow), infinity or a value
+        above 1e9 is a ``ValueError`` naming the first such index. A paper head (``"paper"``)
+        ignores ``camera`` and ``dt``."""
+        return self._head.rates(flow, float(dt) if dt is not None else 0.0,
+                                float(camera.fx) if camera is not None else 0.0,
+                                float(camera.fy) if camera is not None else 0.0)
 
     @property
     def config(self) -> dict:

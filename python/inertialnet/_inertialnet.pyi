@@ -60,8 +60,10 @@ class GeometricHead:
 class _InertialNetHead:
     def __init__(self, weights: Union[_Path, Iterable[_Path]], device: _DeviceArg = None) -> None: ...
     # ValueError naming the index of the first NaN, infinite or unknown (> 1e9) flow value.
-    def rates(self, flow: npt.NDArray[np.float32]) -> npt.NDArray[np.float64]: ...
-    config: dict[str, int]
+    # dt (s), fx, fy (px): needed by a head of normalized input (config["input"]); 0: not given.
+    def rates(self, flow: npt.NDArray[np.float32], dt: float = 0.0, fx: float = 0.0,
+              fy: float = 0.0) -> npt.NDArray[np.float64]: ...
+    config: dict[str, Union[int, str]]
 
 # Wrapped by inertialnet.Sequence (a collections.abc.Sequence, python/inertialnet/_sequence.py).
 class _Sequence:

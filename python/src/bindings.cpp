@@ -635,11 +635,13 @@ class PyInertialNetHead {
     py::gil_scoped_release release;
     weights_ = std::make_unique<WeightSet>(WeightSet::load(*device_, paths));
     head_ = std::make_unique<InertialNetHead>(*device_, *weights_);
+    input_ = read_head_input(paths);
   }
 
-  // (3,) for one flow (H, W, 2), (N, 3) for a batch (N, H, W, 2). The learned head needs neither
-  // camera nor frame interval: it was trained on one camera and rate.
-  py::array_t<double> rates(const py::array& flow_array) {
+  // (3,) for one flow (H, W, 2), (N, 3) for a batch (N, H, W, 2), of frames of any size: turned
+  // into the head's input by head_input() as predict and train do (models/head_input.hpp). A head
+  // of normalized input needs the pair's interval dt (s) and the frames' focal lengths fx, fy.
+  py::array_t<double> rates(const py::array& flow_array, double dt, double fx, double fy) {
     const auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(flow_array);
     const bool batch = a && a.ndim() == 4;
     if (!a || (a.ndim() != 3 && a.ndim() != 4) || a.shape(a.ndim() - 1) != 2) {
@@ -667,10 +669,29 @@ class PyInertialNetHead {
         planar[(2 * k + 1) * plane + i] = v;
       }
     }
+    const HeadConfig& c = head_->config();
+    if (input_.convention == HeadInput::Normalized && !(dt > 0 && fx > 0 && fy > 0)) {
+      throw invalid_input("this InertialNet head was trained on normalized input (flow per second over the focal "
+                          "lengths, its metadata inertialnet.head_input): rates() needs camera= (the frames' "
+                          "focal lengths) and dt= (the pair's interval in seconds, > 0)");
+    }
+    std::int64_t in_h = h, in_w = w;
+    if (input_.convention == HeadInput::Normalized || h != c.input_height || w != c.input_width) {
+      std::vector<float> converted;
+      for (std::size_t k = 0; k < static_cast<std::size_t>(n); ++k) {
+        const auto one = head_input(planar.data() + 2 * k * plane, static_cast<int>(w), static_cast<int>(h),
+                                    static_cast<int>(c.input_width), static_cast<int>(c.input_height),
+                                    input_.convention, dt, fx, fy);
+        converted.insert(converted.end(), one.begin(), one.end());
+      }
+      planar = std::move(converted);
+      in_h = c.input_height;
+      in_w = c.input_width;
+    }
     std::vector<float> omega;
     run_interruptibly([&](const std::atomic<bool>& stop) {
       Queue& queue = device_->queue();
-      const Tensor flow = Tensor::from_host(queue, {n, 2, h, w}, planar);
+      const Tensor flow = Tensor::from_host(queue, {n, 2, in_h, in_w}, planar);
       omega = head_->compute(queue, flow, &stop).to_host(queue);
     });
     py::array_t<double> out(batch ? std::vector<py::ssize_t>{n, 3} : std::vector<py::ssize_t>{3});
@@ -683,6 +704,8 @@ class PyInertialNetHead {
     py::dict d;
     d["input_width"] = c.input_width;
     d["input_height"] = c.input_height;
+    d["input"] = to_string(input_.convention);  // "normalized" or "paper" (models/head_input.hpp)
+    d["flow"] = input_.flow;                     // the flow it was trained on; "" when unknown
     return d;
   }
 
@@ -690,6 +713,7 @@ class PyInertialNetHead {
   std::shared_ptr<Device> device_;
   std::unique_ptr<WeightSet> weights_;
   std::unique_ptr<InertialNetHead> head_;
+  HeadInputInfo input_;
 };
 
 // --- sequences, predict, evaluate ------------------------------------------------------------------
@@ -1130,7 +1154,8 @@ PYBIND11_MODULE(_inertialnet, m) {
 
   py::class_<PyInertialNetHead>(m, "_InertialNetHead")
       .def(py::init<const py::object&, const py::object&>(), py::arg("weights"), py::arg("device") = py::none())
-      .def("rates", &PyInertialNetHead::rates, py::arg("flow"))
+      .def("rates", &PyInertialNetHead::rates, py::arg("flow"), py::arg("dt") = 0.0, py::arg("fx") = 0.0,
+           py::arg("fy") = 0.0)
       .def_property_readonly("config", &PyInertialNetHead::config);
 
   // The Python class inertialnet.Sequence (a collections.abc.Sequence) wraps this one.

@@ -1,6 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
 """The networks through Python: FlowNet2 (synthetic weights, small frames) against the CLI's .flo
 bit for bit, batches, and the InertialNet head against `inertialnet predict`."""
+import json
+
 import numpy as np
 import pytest
 
@@ -75,5 +77,40 @@ def test_inertialnet_head_matches_the_cli(cli, sequence, tmp_path):
     assert w.shape == (len(seq) - 1, 3)
     np.testing.assert_allclose(w[:, 0], rates["wx"], rtol=1e-6, atol=1e-9)
     assert head.rates(flows[0]).shape == (3,)
-    with pytest.raises(ValueError, match="128x96|96"):
-        head.rates(np.zeros((64, 64, 2), np.float32))
+    # A flow of another size is resized as predict and train do (issue 23; before: a ValueError):
+    # a constant field stays constant, its vectors scaled by the size ratio (2 and 1.5 here).
+    assert head.config["input"] == "paper" and head.config["flow"] == ""
+    small = np.full((64, 64, 2), (0.5, -0.25), np.float32)
+    np.testing.assert_allclose(head.rates(small), head.rates(np.full((96, 128, 2), (1.0, -0.375), np.float32)),
+                               rtol=1e-5, atol=1e-7)
+
+
+def with_metadata(source, target, key, value):
+    """A copy of a safetensors file with one more __metadata__ entry (the format: an 8-byte
+    little-endian header length, the JSON header, the data)."""
+    data = source.read_bytes()
+    n = int.from_bytes(data[:8], "little")
+    header = json.loads(data[8:8 + n])
+    header.setdefault("__metadata__", {})[key] = value
+    text = json.dumps(header).encode()
+    target.write_bytes(len(text).to_bytes(8, "little") + text + data[8 + n:])
+
+
+def test_a_head_of_normalized_input_needs_camera_and_interval(cli, tmp_path):
+    # Issue 23: the head's metadata says its input is the flow per second over the focal lengths;
+    # rates() then divides as predict and train do, and refuses to guess dt or the camera.
+    paper_file, normalized_file = tmp_path / "paper.safetensors", tmp_path / "normalized.safetensors"
+    cli("weights", "--synthetic", "InertialNetHead", "--size", "32x24", "-o", paper_file)
+    with_metadata(paper_file, normalized_file, "inertialnet.head_input", '{"convention":"normalized","flow":"dis"}')
+    paper = inertialnet.InertialNetHead.load(paper_file)
+    normalized = inertialnet.InertialNetHead.load(normalized_file)
+    assert (normalized.config["input"], normalized.config["flow"]) == ("normalized", "dis")
+    camera = inertialnet.Camera(64, 48, 40.0, 30.0, 31.5, 23.5)
+    flow = np.full((48, 64, 2), (2.0, -1.2), np.float32)  # pixels at 64x48, 0.05 s apart
+    # At 32x24 the vectors halve and so do the focal lengths: u/(fx·dt) = 2/(40·0.05) = 1.
+    want = paper.rates(np.full((24, 32, 2), (1.0, -0.8), np.float32))
+    np.testing.assert_allclose(normalized.rates(flow, camera=camera, dt=0.05), want, rtol=1e-5, atol=1e-7)
+    with pytest.raises(ValueError, match="trained on normalized input.*camera=.*dt="):
+        normalized.rates(flow)
+    with pytest.raises(ValueError, match="trained on normalized input"):
+        normalized.rates(flow, camera=camera)

@@ -13,6 +13,7 @@
 #include "inertialnet/io/calibration_file.hpp"
 #include "inertialnet/io/camera.hpp"
 #include "inertialnet/models/flow_consistency.hpp"
+#include "inertialnet/models/head_input.hpp"
 #include "inertialnet/runtime/device_selection.hpp"
 #include "inertialnet/runtime/error.hpp"
 
@@ -26,6 +27,12 @@ ModelKind flow_model_of(const WeightSet& weights, const std::string& requested) 
     if (kind != ModelKind::InertialNetHead) return kind;
   }
   return ModelKind::FlowNet2;
+}
+
+std::string join_paths(const std::vector<std::string>& paths) {
+  std::string text;
+  for (const auto& p : paths) text += (text.empty() ? "" : ", ") + p;
+  return text;
 }
 
 const char* kNoWeightsHelp =
@@ -156,7 +163,9 @@ CameraChoice choose_camera(const PredictSettings& s, FrameSource& source, std::v
                     own_name + " gives the camera (--calibration " + own_name + " --cx … replaces one value).");
   }
   if (!own) {
-    throw invalid_input("the geometric head needs the camera: " + source.description() + " has no " + own_name +
+    throw invalid_input(std::string(s.head == "inertialnet" || (s.head.empty() && !s.weights.empty()) ? "this InertialNet head (trained on normalized input)"
+                                                             : "the geometric head") +
+                        " needs the camera: " + source.description() + " has no " + own_name +
                         "; give --calibration FILE (EuRoC sensor.yaml, Kalibr camchain, OpenCV YAML/XML) or --fx "
                         "(and --fy --cx --cy)");
   }
@@ -196,6 +205,23 @@ Prediction::Prediction(const PredictSettings& s) : settings_(s) {
                                     "FlowNet2 and InertialNet head tensors (safetensors). ") + kNoWeightsHelp +
                         ". Without weights, predict runs DIS flow + the geometric head.");
   }
+  // A trained head says which flow it learned from and how its input is scaled (its metadata
+  // "inertialnet.head_input"; none: the paper's convention): that flow is the default, another one
+  // asked for explicitly is refused, since the head has never seen it.
+  if (processor_.inertialnet_head) {
+    const HeadInputInfo trained = read_head_input(s.weights);
+    processor_.head_input = trained.convention;
+    if (!trained.flow.empty()) {
+      const FlowMethod learned = parse_flow_method(trained.flow);
+      if (s.flow.empty()) {
+        processor_.flow = learned;
+      } else if (processor_.flow != learned) {
+        throw invalid_input("--flow " + s.flow + ": the InertialNet head in " + join_paths(s.weights) +
+                            " was trained on " + trained.flow + " flow (its metadata " + kMetadataHeadInput +
+                            "); leave --flow out or give --flow " + trained.flow);
+      }
+    }
+  }
   if (s.solver == "opengv") {
     processor_.geometric.solver = GeometricSolver::OpenGV;
   } else if (s.solver != "motion-field") {
@@ -213,7 +239,7 @@ Prediction::Prediction(const PredictSettings& s) : settings_(s) {
   processor_.flow_check_px = s.flow_check_px;
   source_ = open_frame_source(s.sequence, s.rate_hz > 0 ? std::optional<double>(s.rate_hz) : std::nullopt, s.camera, s.bag);
   notes_ = source_->notes();
-  if (processor_.geometric_head) {
+  if (processor_.geometric_head || (processor_.inertialnet_head && processor_.head_input == HeadInput::Normalized)) {
     const CameraChoice choice = choose_camera(s, *source_, notes_);
     processor_.camera = choice.camera;
     processor_.camera_to_body = choice.camera_to_body;

@@ -110,7 +110,20 @@ class RatesProcessor : public PairProcessor {
     std::size_t next = 0;
     if (head_) {
       EstimatorRates& answer = result.rates[next++];
-      const auto omega = head_->compute(q, flow, &stop).to_host(q);
+      // The head's input as training made it (models/head_input.hpp); the flow as is when that is it.
+      const HeadConfig& c = head_->config();
+      Tensor input = flow;
+      if (options_.head_input == HeadInput::Normalized || width != c.input_width || height != c.input_height) {
+        const std::vector<float> planes = flow.to_host(q);
+        std::int64_t dt_ns = 0;  // an interval beyond int64 is 0, which head_input() refuses
+        if (__builtin_sub_overflow(current.t_ns, previous.t_ns, &dt_ns)) dt_ns = 0;
+        const double dt = static_cast<double>(dt_ns) * 1e-9;
+        const double fx = options_.camera ? options_.camera->fx : 0.0, fy = options_.camera ? options_.camera->fy : 0.0;
+        input = Tensor::from_host(q, {1, 2, c.input_height, c.input_width},
+                                  head_input(planes.data(), width, height, static_cast<int>(c.input_width),
+                                             static_cast<int>(c.input_height), options_.head_input, dt, fx, fy));
+      }
+      const auto omega = head_->compute(q, input, &stop).to_host(q);
       if (std::isfinite(omega[0]) && std::isfinite(omega[1]) && std::isfinite(omega[2])) {
         answer.w = {omega[0], omega[1], omega[2]};
       } else {
@@ -240,6 +253,11 @@ FlowMethod parse_flow_method(const std::string& text) {
 ProcessorFactory rates_processor(const std::map<const Device*, const WeightSet*>& weights,
                                  const RatesProcessorOptions& options) {
   if (!options.inertialnet_head && !options.geometric_head) throw invalid_input("no head selected: nothing to predict");
+  if (options.inertialnet_head && options.head_input == HeadInput::Normalized && !options.camera) {
+    throw invalid_input("this InertialNet head was trained on normalized input (flow per second over the focal "
+                        "lengths): it needs the camera intrinsics (a EuRoC sequence's cam0/sensor.yaml, or "
+                        "--calibration FILE, or --fx --fy --cx --cy)");
+  }
   if (options.geometric_head && !options.camera) {
     throw invalid_input("the geometric head needs the camera intrinsics (a EuRoC sequence's cam0/sensor.yaml, or "
                         "--fx --fy --cx --cy)");

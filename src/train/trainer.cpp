@@ -17,6 +17,7 @@
 #include "inertialnet/ops/optimizer_step.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/train/flip_augmentation.hpp"
+#include "inertialnet/train/rotation_augmentation.hpp"
 #include "runtime/hash.hpp"
 
 namespace inertialnet {
@@ -95,6 +96,25 @@ Vec3 spread(const std::vector<Vec3>& v) {
   return {std::sqrt(var[0]), std::sqrt(var[1]), std::sqrt(var[2])};
 }
 
+// cov(p, t) / var(t) per axis (0 where the target does not vary).
+Vec3 gain_of(const std::vector<Vec3>& p, const std::vector<Vec3>& t) {
+  Vec3 mp{}, mt{}, cov{}, var{};
+  const double n = static_cast<double>(t.size());
+  for (std::size_t i = 0; i < t.size(); ++i)
+    for (int a = 0; a < 3; ++a) {
+      mp[a] += p[i][a] / n;
+      mt[a] += t[i][a] / n;
+    }
+  for (std::size_t i = 0; i < t.size(); ++i)
+    for (int a = 0; a < 3; ++a) {
+      cov[a] += (p[i][a] - mp[a]) * (t[i][a] - mt[a]);
+      var[a] += (t[i][a] - mt[a]) * (t[i][a] - mt[a]);
+    }
+  Vec3 g{};
+  for (int a = 0; a < 3; ++a) g[a] = var[a] > 0 ? cov[a] / var[a] : 0.0;
+  return g;
+}
+
 }  // namespace
 
 std::string to_string(OptimizerKind kind) { return kind == OptimizerKind::Adam ? "adam" : "sgd"; }
@@ -132,6 +152,11 @@ Trainer::Trainer(Device& device, const TrainerOptions& options)
   }
   if (!(options.momentum >= 0.0f) || !std::isfinite(options.momentum)) {
     throw invalid_input("training: the SGD momentum must be a finite number ≥ 0, got " + number(options.momentum));
+  }
+  if (!std::isfinite(options.rotation_augmentation_deg_s) || options.rotation_augmentation_deg_s < 0 ||
+      options.rotation_augmentation_deg_s > 1000) {
+    throw invalid_input("training: the rotation augmentation's largest rate must be from 0 to 1000 deg/s, got " +
+                        number(options.rotation_augmentation_deg_s));
   }
   // torch.nn's defaults for Conv2d and Linear: weights and biases uniform in ±1/sqrt(fan-in).
   for (const auto& spec : head_parameters(options_.head)) {
@@ -212,6 +237,7 @@ Evaluation Trainer::evaluate(const TrainingSet& set) {
   }
   const Vec3 sp = spread(e.predicted), st = spread(set.targets());
   for (int a = 0; a < 3; ++a) e.spread_ratio[a] = st[a] > 0 ? sp[a] / st[a] : 0.0;
+  e.gain = gain_of(e.predicted, set.targets());
   return e;
 }
 
@@ -224,6 +250,16 @@ bool Trainer::train(const TrainingSet& train_set, const TrainingSet& val_set, co
                         std::to_string(options_.head.input_width) + "x" + std::to_string(options_.head.input_height));
   }
   if (train_set.size() == 0) throw invalid_input("training: the training set has no samples");
+  const bool rotate = options_.rotation_augmentation_deg_s > 0;
+  if (rotate) {
+    for (std::size_t s = 0; s < train_set.size(); ++s) {
+      if (!train_set.has_camera(s)) {
+        throw invalid_input("training: rotation augmentation needs the camera of every training sequence; sample " +
+                            std::to_string(s) + " (frame at " + std::to_string(train_set.timestamp_ns(s)) +
+                            " ns) comes from a sequence without calibration");
+      }
+    }
+  }
   const std::size_t floats = train_set.flow_floats();
   const auto batch = static_cast<std::size_t>(options_.batch);
   const std::size_t batches = (train_set.size() + batch - 1) / batch;
@@ -234,6 +270,8 @@ bool Trainer::train(const TrainingSet& train_set, const TrainingSet& val_set, co
     const double lr = lr_for(epoch);
     const auto order = shuffled(train_set.size(), options_.seed, epoch);
     SplitMix64 flips(options_.seed ^ 0xF11F5ull, static_cast<std::uint64_t>(epoch));  // this epoch's flips
+    SplitMix64 turns(options_.seed ^ 0x2071A7Eull, static_cast<std::uint64_t>(epoch));  // and rotations
+    const double max_turn = options_.rotation_augmentation_deg_s / kDegreesPerRadian;
     double loss_sum = 0;
     for (std::size_t b = 0; b < batches; ++b) {
       if (callbacks.stop && callbacks.stop->load()) return false;
@@ -248,6 +286,13 @@ bool Trainer::train(const TrainingSet& train_set, const TrainingSet& val_set, co
           const auto flip = static_cast<Flip>(flips.next() & 3u);
           flip_flow(flows.data() + i * floats, train_set.width(), train_set.height(), flip);
           t = flip_body_rates(t, train_set.camera_to_body(s), flip);
+        }
+        if (rotate) {
+          const Vec3 omega{turns.uniform(-max_turn, max_turn), turns.uniform(-max_turn, max_turn),
+                           turns.uniform(-max_turn, max_turn)};
+          add_rotation_flow(flows.data() + i * floats, train_set.camera(s), train_set.input(), omega,
+                            train_set.interval_s(s));
+          t = t + mul(train_set.camera_to_body(s), omega);
         }
         for (int a = 0; a < 3; ++a) targets[3 * i + static_cast<std::size_t>(a)] = static_cast<float>(t[a]);
       }
@@ -303,6 +348,7 @@ bool Trainer::train(const TrainingSet& train_set, const TrainingSet& val_set, co
     r.val_rmse_deg_s = e.rmse_deg_s;
     r.zero_rmse_deg_s = e.zero_rmse_deg_s;
     r.spread_ratio = e.spread_ratio;
+    r.gain = e.gain;
     r.collapsed = *std::min_element(e.spread_ratio.begin(), e.spread_ratio.end()) < kCollapseRatio;
     r.best = best_rmse_ < 0 || mean_rmse(e.rmse_deg_s) < best_rmse_;
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -8,9 +8,6 @@
 #include <memory>
 #include <sstream>
 
-#include <opencv2/core.hpp>
-#include <opencv2/imgproc.hpp>
-
 #include "core/float16.hpp"
 #include "inertialnet/io/bag.hpp"
 #include "inertialnet/io/euroc.hpp"
@@ -20,6 +17,7 @@
 #include "inertialnet/models/flownet.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/runtime/log.hpp"
+#include "inertialnet/train/rotation_augmentation.hpp"
 #include "runtime/atomic_file.hpp"
 #include "runtime/hash.hpp"
 
@@ -29,27 +27,14 @@ namespace {
 
 constexpr char kCacheMagic[8] = {'I', 'N', 'F', 'L', 'O', 'W', '1', '6'};
 
-// Planar [2, h, w] flow at the head's size: bilinear, vectors scaled by the size ratio.
-std::vector<float> resize_flow(const std::vector<float>& flow, int w, int h, int out_w, int out_h) {
-  if (w == out_w && h == out_h) return flow;
-  std::vector<float> out(2 * static_cast<std::size_t>(out_w) * static_cast<std::size_t>(out_h));
-  const double scale[2] = {static_cast<double>(out_w) / w, static_cast<double>(out_h) / h};
-  for (int c = 0; c < 2; ++c) {
-    const cv::Mat in(h, w, CV_32FC1, const_cast<float*>(flow.data()) + static_cast<std::size_t>(c) * w * h);
-    cv::Mat resized(out_h, out_w, CV_32FC1, out.data() + static_cast<std::size_t>(c) * out_w * out_h);
-    // INTER_AREA averages when shrinking (no aliasing of fine flow detail), bilinear otherwise.
-    cv::resize(in, resized, resized.size(), 0, 0, out_w < w ? cv::INTER_AREA : cv::INTER_LINEAR);
-    resized *= scale[c];
-  }
-  return out;
-}
-
 // Everything the cached flows depend on, so that a changed input is a different file, never a
 // stale one: the sequence's folder, every frame's file (name, size, modification time) and
 // timestamp, the flow method with its settings (the FlowNet2 family member and the weights'
-// identity; DIS at its one preset), the resizing, and the head's size. Version 2 of the key
+// identity; DIS at its one preset), the resizing, the head's size, and for the normalized input
+// the focal lengths (the frame intervals are in the timestamps). Version 2 of the key
 // (version 1 named frames by count and first/last timestamp only: editing an image kept the key).
-std::string cache_key(const std::filesystem::path& root, const EurocSequence& sequence, const TrainingSetOptions& o) {
+std::string cache_key(const std::filesystem::path& root, const EurocSequence& sequence, const TrainingSetOptions& o,
+                      const std::optional<CameraIntrinsics>& camera) {
   std::ostringstream key;
   std::error_code ec;
   const auto canonical = std::filesystem::weakly_canonical(root, ec);
@@ -62,6 +47,10 @@ std::string cache_key(const std::filesystem::path& root, const EurocSequence& se
   }
   key << '|' << o.weights_id << "|resize:area-or-bilinear|" << o.width << 'x' << o.height << '|'
       << sequence.frames.size() << '|' << o.bag_input.bag.image;  // a bag's frames: its file and topic
+  // The paper's input keeps its keys of before (their caches stay valid).
+  if (o.input == HeadInput::Normalized) {
+    key << "|input:normalized:" << std::setprecision(17) << camera->fx << ':' << camera->fy;
+  }
   for (const auto& frame : sequence.frames) {
     std::error_code size_error, time_error;
     const auto size = std::filesystem::file_size(frame.path, size_error);
@@ -147,12 +136,13 @@ TrainingSet::TrainingSet(const TrainingSetOptions& options) : options_(options) 
 }
 
 std::vector<std::uint16_t> TrainingSet::pair_flows(const EurocSequence& sequence, const std::filesystem::path& root,
+                                                   const std::optional<CameraIntrinsics>& camera,
                                                    const FlowProgress& progress) {
   const std::size_t pairs = sequence.frames.size() - 1;
   const std::size_t floats = pairs * flow_floats();
   std::filesystem::path cache;
   if (!options_.cache_dir.empty()) {
-    cache = options_.cache_dir / cache_key(root, sequence, options_);
+    cache = options_.cache_dir / cache_key(root, sequence, options_, camera);
     std::string problem;
     auto cached = read_cache(cache, floats, problem);
     if (!cached.empty()) {
@@ -203,7 +193,15 @@ std::vector<std::uint16_t> TrainingSet::pair_flows(const EurocSequence& sequence
       flow = flownet->compute(*queue, Tensor::from_host(*queue, shape, previous.data), Tensor::from_host(*queue, shape, current.data))
                  .to_host(*queue);
     }
-    const auto resized = resize_flow(flow, current.width, current.height, options_.width, options_.height);
+    if (camera && (camera->width != current.width || camera->height != current.height)) {
+      throw invalid_input(sequence.name + ": the camera calibration is " + std::to_string(camera->width) + "x" +
+                          std::to_string(camera->height) + " but " + sequence.frames[k].path.string() + " is " +
+                          std::to_string(current.width) + "x" + std::to_string(current.height));
+    }
+    // predict turns its flows into the head's input with the same call (pipeline/rates_processor.cpp).
+    const double dt = static_cast<double>(sequence.frames[k].t_ns - sequence.frames[k - 1].t_ns) * 1e-9;
+    const auto resized = head_input(flow.data(), current.width, current.height, options_.width, options_.height,
+                                    options_.input, dt, camera ? camera->fx : 0.0, camera ? camera->fy : 0.0);
     std::uint16_t* dst = out.data() + (k - 1) * flow_floats();
     for (std::size_t i = 0; i < resized.size(); ++i) dst[i] = detail::float_to_half(resized[i]);
     // A non-finite flow (or one beyond float16's range) would turn every loss it enters into NaN.
@@ -262,7 +260,22 @@ std::size_t TrainingSet::add_sequence(const std::filesystem::path& root, const F
     const Mat3 r = imu_to_camera_rotation(sequence);  // R_CS: IMU → camera; its transpose back
     camera_to_body = {r[0], r[3], r[6], r[1], r[4], r[7], r[2], r[5], r[8]};
   }
-  const auto flows = pair_flows(sequence, root, progress);
+  std::optional<CameraIntrinsics> camera;
+  if (sequence.camera) {
+    try {
+      camera = CameraIntrinsics::from_calibration(*sequence.camera);
+    } catch (const Error& e) {
+      if (e.kind() != ErrorKind::InvalidInput || options_.input == HeadInput::Normalized) {
+        throw invalid_input(root.string() + ": its camera calibration: " + e.what());
+      }
+    }
+  }
+  if (options_.input == HeadInput::Normalized && !camera) {
+    throw invalid_input(root.string() + " has no camera calibration (cam0/sensor.yaml, a bag's CameraInfo): the "
+                        "normalized head input divides the flow by the focal lengths; give a calibrated sequence "
+                        "or train with --head-input paper");
+  }
+  const auto flows = pair_flows(sequence, root, camera, progress);
   const auto corrected = truth.corrected();
   std::size_t added = 0;
   for (std::size_t j = 0; j < truth.frame_index.size(); ++j) {
@@ -273,6 +286,8 @@ std::size_t TrainingSet::add_sequence(const std::filesystem::path& root, const F
     targets_.push_back(corrected[j]);
     t_ns_.push_back(truth.t_ns[j]);
     camera_to_body_.push_back(camera_to_body);
+    interval_s_.push_back(static_cast<double>(sequence.frames[k].t_ns - sequence.frames[k - 1].t_ns) * 1e-9);
+    cameras_.push_back(camera ? camera_at_size(*camera, options_.width, options_.height) : CameraIntrinsics{});
     ++added;
   }
   sequences_.push_back(sequence.name.empty() ? root.filename().string() : sequence.name);

@@ -172,8 +172,33 @@ expect_match("c: flows cached in")
 expect_no_match("c: flows read from the cache")
 
 run(0 ${CLI} predict b --weights head.safetensors --flow dis -o rates.csv)
-run(2 ${CLI} predict big --weights head.safetensors --flow dis -o rates.csv)
-expect_match("built for 64×48 flow")
+# Issue 23: the head's metadata says how it was trained (normalized input, DIS flow): predict
+# needs no --flow, turns the flow of frames of another size into the head's input as train did
+# (before: "built for 64×48 flow", exit 2), and refuses a flow the head never saw.
+run(0 ${CLI} weights --info head.safetensors)
+expect_match("inertialnet.head_input = \\{\"convention\":\"normalized\",\"flow\":\"dis\"\\}")
+run(0 ${CLI} predict big --weights head.safetensors -o rates_big.csv)
+expect_match("DIS flow \\+ InertialNet head")
+run(2 ${CLI} predict big --weights head.safetensors --flow flownet2 -o rates_big.csv)
+expect_match("inertialnet: error: --flow flownet2: the InertialNet head in head.safetensors was trained on dis flow")
+# Its input is divided by the focal lengths: an image folder without a calibration is refused
+# (exit 2) before any flow, and with --fx it runs.
+run(2 ${CLI} predict b/mav0/cam0/data --weights head.safetensors -o rates_folder.csv)
+expect_match("this InertialNet head \\(trained on normalized input\\) needs the camera")
+run(0 ${CLI} predict b/mav0/cam0/data --weights head.safetensors --fx 40 -o rates_folder.csv)
+# A head without that metadata (converted, or trained before it) is the paper's: pixel flow,
+# resized the same way; a normalized one needs the camera.
+run(0 ${CLI} weights --synthetic InertialNetHead --size 64x48 -o paper_head.safetensors)
+run(0 ${CLI} predict big --weights paper_head.safetensors --flow dis -o rates_paper.csv)
+run(0 ${CLI} train --train a --val b --head-size 64x48 --head-input paper --epochs 1 --augment-rotation 30
+    --dropout 0 -o paper_trained.safetensors --cache cache)
+run(0 ${CLI} weights --info paper_trained.safetensors)
+expect_match("\"convention\":\"paper\"")
+expect_match("\"augment_rotation_deg_s\":30")
+run(2 ${CLI} train --train a --val b --head-size 64x48 --head-input pixels -o x.safetensors)
+expect_match("unknown head input 'pixels'; expected normalized or paper")
+run(2 ${CLI} train --train a --val b --head-size 64x48 --augment-rotation -5 -o x.safetensors)
+expect_match("the rotation augmentation's largest rate must be from 0 to 1000 deg/s, got -5")
 
 # FlowNet flows (FlowNet2-C with synthetic weights, the lightest family member): the flow method
 # and the weights' identity key the cache apart from DIS's.

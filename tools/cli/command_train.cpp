@@ -26,6 +26,7 @@
 #include "inertialnet/eval/plots.hpp"
 #include "inertialnet/io/camera_imu.hpp"
 #include "inertialnet/eval/time_offset.hpp"
+#include "inertialnet/models/head_input.hpp"
 #include "inertialnet/models/weights.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/runtime/program_cache.hpp"
@@ -40,8 +41,13 @@ namespace {
 
 struct TrainCliOptions {
   std::vector<std::string> train, val, weights;
-  std::string flow = "dis", optimizer = "sgd", schedule = "constant", head_size = "752x480", target = "spline";
+  std::string flow = "dis", optimizer = "sgd", schedule = "constant", head_size = "752x480", target = "mean";
   std::string out, log, plot, cache, time_offset;
+  std::string head_input = "normalized";  // --head-input (models/head_input.hpp)
+  double augment_rotation = 0;            // --augment-rotation, deg/s
+  // --dropout before fc1, training only. 0, not the paper's 0.3: dropout acts as a ridge penalty on
+  // fc1 and pulls predictions towards the mean (docs/training.md, "Regression towards the mean").
+  double dropout = 0;
   BagTopics bag;          // --image-topic, --imu-topic, --camera-info-topic: every ROS bag's
   std::string T_cam_imu;  // --T-cam-imu: a ROS bag's IMU-camera rotation
   int epochs = 20, batch = 10;
@@ -132,12 +138,21 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
       ->capture_default_str()
       ->type_name("UINT");
   app.add_option("--head-size", o->head_size, "the head's flow size WxH (flows are resized to it)")->capture_default_str();
-  app.add_option("--target", o->target, "spline (the paper's) or mean")->capture_default_str();
+  app.add_option("--target", o->target, "mean (the gyro over each pair's interval, what its flow measures) or spline (the paper's: at the second frame)")->capture_default_str();
   app.add_option("--time-offset", o->time_offset,
                  "camera-IMU time offset in seconds (t_imu = t_cam + offset) of every sequence: the targets are the "
                  "gyro at the shifted times (as eval --time-offset; estimate it with calibrate-time)");
   app.add_option("-o,--output", o->out, "the best head (safetensors)")->required();
   app.add_flag("--augment-flips", o->augment_flips, "mirror training flows at random, with the matching sign changes of the rates");
+  app.add_option("--head-input", o->head_input,
+                 "normalized (flow per second in normalised camera coordinates: any camera, frame rate and size) "
+                 "or paper (pixels at the head's size, the paper's)")
+      ->capture_default_str();
+  app.add_option("--dropout", o->dropout, "dropout before fc1 during training (the paper's: 0.3)")->capture_default_str();
+  app.add_option("--augment-rotation", o->augment_rotation,
+                 "add to each training flow the exact flow of a random rotation up to this many deg/s per axis, and "
+                 "its rate to the target (0: off)")
+      ->capture_default_str();
   app.add_flag("--resume", o->resume, "continue from <stem>.state.safetensors beside -o");
   app.add_option("--log", o->log, "per-epoch CSV");
   app.add_option("--plot", o->plot, "loss curves (PNG)");
@@ -149,6 +164,7 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
     TrainerOptions options;
     options.head.input_width = width;
     options.head.input_height = height;
+    options.head.dropout = o->dropout;
     options.optimizer = parse_optimizer(o->optimizer);
     options.schedule = parse_lr_schedule(o->schedule);
     options.lr = o->lr;
@@ -158,12 +174,14 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
     options.batch = o->batch;
     options.seed = parse_seed(o->seed);
     options.flip_augmentation = o->augment_flips;
+    options.rotation_augmentation_deg_s = o->augment_rotation;
     options.head.validate();
 
     TrainingSetOptions set_options;
     set_options.width = static_cast<int>(width);
     set_options.height = static_cast<int>(height);
     set_options.flow = parse_flow_method(o->flow);
+    set_options.input = parse_head_input(o->head_input);
     set_options.target = parse_sync_target(o->target);
     if (!o->time_offset.empty()) set_options.time_offset_s = parse_seconds(o->time_offset, "--time-offset");
     set_options.bag_input.bag = o->bag;
@@ -256,6 +274,9 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
       j["batch"] = options.batch;
       j["seed"] = options.seed;
       j["augment_flips"] = options.flip_augmentation;
+      j["augment_rotation_deg_s"] = options.rotation_augmentation_deg_s;
+      j["dropout"] = options.head.dropout;
+      j["head_input"] = to_string(set_options.input);
       j["flow"] = to_string(set_options.flow);
       j["input_size"] = std::to_string(options.head.input_width) + "x" + std::to_string(options.head.input_height);
       j["target"] = to_string(set_options.target);
@@ -267,7 +288,10 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
       j["val_rmse_deg_s"] = nlohmann::json::parse(vec3_json(r.val_rmse_deg_s));
       j["zero_rmse_deg_s"] = nlohmann::json::parse(vec3_json(r.zero_rmse_deg_s));
       j["spread_ratio"] = nlohmann::json::parse(vec3_json(r.spread_ratio));
-      return std::map<std::string, std::string>{{"inertialnet.training", j.dump()}};
+      j["gain"] = nlohmann::json::parse(vec3_json(r.gain));
+      // What predict reads to feed the head as it was trained (models/head_input.hpp).
+      const std::string input = head_input_to_json({set_options.input, to_string(set_options.flow)});
+      return std::map<std::string, std::string>{{"inertialnet.training", j.dump()}, {kMetadataHeadInput, input}};
     };
 
     Progress* bar = nullptr;
@@ -286,10 +310,11 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
       char line[512];
       std::snprintf(line, sizeof line,
                     "epoch %d/%d  lr %.3g  train %.5g  val %.5g  RMSE %.2f %.2f %.2f deg/s (zero %.2f %.2f %.2f)  "
-                    "spread %.2f %.2f %.2f  %.1f s%s",
+                    "spread %.2f %.2f %.2f  gain %.2f %.2f %.2f  %.1f s%s",
                     r.epoch, r.epochs, r.lr, r.train_loss, r.val_loss, r.val_rmse_deg_s[0], r.val_rmse_deg_s[1],
                     r.val_rmse_deg_s[2], r.zero_rmse_deg_s[0], r.zero_rmse_deg_s[1], r.zero_rmse_deg_s[2],
-                    r.spread_ratio[0], r.spread_ratio[1], r.spread_ratio[2], r.seconds, r.best ? "  best" : "");
+                    r.spread_ratio[0], r.spread_ratio[1], r.spread_ratio[2], r.gain[0], r.gain[1], r.gain[2], r.seconds,
+                    r.best ? "  best" : "");
       info(line);
       if (r.collapsed) {
         char ratio[16];

@@ -14,6 +14,7 @@
 
 #include "inertialnet/io/camera.hpp"
 #include "inertialnet/models/geometric_head.hpp"
+#include "inertialnet/models/head_input.hpp"
 #include "inertialnet/models/parameters.hpp"
 #include "inertialnet/models/weights.hpp"
 #include "inertialnet/pipeline/pipeline.hpp"
@@ -50,6 +51,11 @@ struct RatesProcessorOptions {
   // each of its points back (include/inertialnet/models/lk_flow.hpp) with the same setting; with
   // LK the geometric head's sample stride is lk_grid_stride(width), not geometric.stride.
   double flow_check_px = 0.5;
+  // The InertialNet head's input convention (models/head_input.hpp, from its metadata): its flow is
+  // turned into the head's input by the same head_input() as in training — resized to the head's
+  // size whatever the frames' size, and with the normalized convention divided by the pair's
+  // interval and the focal lengths of `camera` (then required).
+  HeadInput head_input = HeadInput::Paper;
 };
 
 // Each lane gets its own queue and model instances. `weights` holds one set per device, loaded

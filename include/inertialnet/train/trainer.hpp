@@ -53,6 +53,11 @@ struct TrainerOptions {
   // Each training sample mirrored at random (none, horizontal, vertical, both; from the seed)
   // with its target's signs changed to match (train/flip_augmentation.hpp).
   bool flip_augmentation = false;
+  // Rotation augmentation (train/rotation_augmentation.hpp): each training sample's second frame
+  // turned further by a random rotation, ω uniform in ±this many deg/s on every camera axis (from
+  // the seed), its exact flow added and R_BC·ω added to the target. 0: off. Needs the sets'
+  // cameras (a calibrated sequence).
+  double rotation_augmentation_deg_s = 0;
 };
 
 struct EpochReport {
@@ -64,6 +69,7 @@ struct EpochReport {
   Vec3 val_rmse_deg_s{};         // per axis
   Vec3 zero_rmse_deg_s{};        // the zero predictor's, per axis
   Vec3 spread_ratio{};           // std(prediction) / std(target), per axis
+  Vec3 gain{};                   // slope of prediction on target, cov(p, t) / var(t), per axis
   bool collapsed = false;        // some axis's spread ratio below kCollapseRatio
   bool best = false;             // the best mean validation RMSE so far
   double seconds = 0;
@@ -84,6 +90,9 @@ struct Evaluation {
   std::vector<Vec3> predicted;
   double loss = 0;
   Vec3 rmse_deg_s{}, zero_rmse_deg_s{}, spread_ratio{};
+  // Least-squares slope of the prediction on the target per axis: 1 for an unbiased head, below 1
+  // for one that shrinks towards the mean (regression to the mean).
+  Vec3 gain{};
 };
 
 class Trainer {

@@ -1,0 +1,139 @@
+// SPDX-License-Identifier: Apache-2.0
+// Issue 23's acceptance: a head trained at 320×180 runs with predict on 1280×720 frames and gives
+// the rates it gives on the training set's flows of those frames (the same DIS flow turned into
+// the head's input by the same head_input(): resized, divided by the interval and the focal
+// lengths). The only difference allowed is the training set's float16 storage of its flows.
+// And a DIS-trained head needs no flow option: its metadata says dis; flownet2 asked for is refused.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "inertialnet/models/head_input.hpp"
+#include "inertialnet/models/inertialnet_head.hpp"
+#include "inertialnet/models/weights.hpp"
+#include "inertialnet/pipeline/predict.hpp"
+#include "inertialnet/runtime/error.hpp"
+#include "inertialnet/synth/synthetic_sequence.hpp"
+#include "inertialnet/train/trainer.hpp"
+#include "inertialnet/train/training_set.hpp"
+#include "support/testing.hpp"
+
+namespace inertialnet {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr int kHeadWidth = 320, kHeadHeight = 180;
+
+struct Fixture {
+  fs::path root, sequence, head;
+};
+
+// A 1280×720 sequence of 5 frames and a head trained on it for one epoch at 320×180 (normalized
+// input, DIS flow), saved with the metadata train writes.
+const Fixture& fixture() {
+  static const Fixture f = [] {
+    Fixture out;
+    out.root = testing::temporary_directory("head_input_predict");
+    out.sequence = out.root / "hd";
+    SynthOptions s;
+    s.frames = 5;
+    s.width = 1280;
+    s.height = 720;
+    s.motion = SynthOptions::General;
+    s.seed = 23;
+    write_synthetic_sequence(out.sequence, s);
+    TrainingSetOptions o;
+    o.width = kHeadWidth;
+    o.height = kHeadHeight;
+    o.flow = FlowMethod::DIS;
+    o.input = HeadInput::Normalized;
+    TrainingSet set(o);
+    set.add_sequence(out.sequence);
+    TrainerOptions t;
+    t.head.input_width = kHeadWidth;
+    t.head.input_height = kHeadHeight;
+    t.optimizer = OptimizerKind::Adam;
+    t.lr = 1e-3f;
+    t.epochs = 1;
+    t.batch = 2;
+    Trainer trainer(testing::test_device(), t);
+    EXPECT_TRUE(trainer.train(set, set, {}));
+    out.head = out.root / "head.safetensors";
+    trainer.save_head(out.head, {{kMetadataHeadInput, head_input_to_json({HeadInput::Normalized, "dis"})}});
+    return out;
+  }();
+  return f;
+}
+
+TEST(HeadInputPredict, AHeadOf320x180GivesOn1280x720FramesTheRatesOfTheTrainingSetsFlows) {
+  const Fixture& f = fixture();
+  PredictSettings settings;
+  settings.sequence = f.sequence;
+  settings.weights = {f.head.string()};  // no flow given: the head's metadata says dis
+  Prediction prediction(settings);
+  EXPECT_EQ(prediction.processor().flow, FlowMethod::DIS);
+  EXPECT_EQ(prediction.processor().head_input, HeadInput::Normalized);
+  std::vector<PairResult> results;
+  prediction.run([&](const PairResult& r) { results.push_back(r); });
+  ASSERT_EQ(results.size(), 4u);
+
+  // The training set's flows of the same frames, through the same head.
+  TrainingSetOptions o;
+  o.width = kHeadWidth;
+  o.height = kHeadHeight;
+  o.flow = FlowMethod::DIS;
+  o.input = HeadInput::Normalized;
+  TrainingSet set(o);
+  set.add_sequence(f.sequence);
+  const WeightSet weights = WeightSet::load(testing::test_device(), {f.head.string()});
+  InertialNetHead head(testing::test_device(), weights);
+  Queue& queue = testing::test_queue();
+  std::vector<float> flow(set.flow_floats());
+  std::size_t compared = 0;
+  double largest = 0;
+  for (std::size_t i = 0; i < set.size(); ++i) {
+    const auto r = std::find_if(results.begin(), results.end(), [&](const PairResult& p) { return p.t1_ns == set.timestamp_ns(i); });
+    ASSERT_NE(r, results.end());
+    ASSERT_TRUE(r->rates.front().ok());
+    set.flow(i, flow.data());
+    const auto omega =
+        head.compute(queue, Tensor::from_host(queue, {1, 2, kHeadHeight, kHeadWidth}, flow)).to_host(queue);
+    for (int a = 0; a < 3; ++a) {
+      const double want = omega[static_cast<std::size_t>(a)], got = r->rates.front().w[static_cast<std::size_t>(a)];
+      largest = std::max(largest, std::abs(want));
+      // The set stores its flows as float16 (11 significant bits a value); through the head's
+      // sums that left differences of at most 4e-6 rad/s on rates up to 1.2 rad/s: 5e-5 relative
+      // and 1e-5 rad/s bound it, far below any resize or scaling difference (a pixel flow at the
+      // wrong scale would be off by the size ratio, 4×).
+      EXPECT_NEAR(got, want, 5e-5 * std::abs(want) + 1e-5) << "pair at " << r->t1_ns << " axis " << a;
+    }
+    ++compared;
+  }
+  EXPECT_EQ(compared, 4u);
+  EXPECT_GT(largest, 1e-3);  // the head answers something, not zeros on both sides
+}
+
+TEST(HeadInputPredict, AnotherFlowThanTheHeadWasTrainedOnIsRefusedNamingIt) {
+  const Fixture& f = fixture();
+  PredictSettings settings;
+  settings.sequence = f.sequence;
+  settings.weights = {f.head.string()};
+  settings.flow = "flownet2";
+  try {
+    Prediction prediction(settings);
+    FAIL() << "flownet2 flow was accepted for a DIS-trained head";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::InvalidInput);
+    EXPECT_NE(std::string(e.what()).find("was trained on dis flow"), std::string::npos) << e.what();
+  }
+  settings.flow = "dis";  // the same as the metadata: fine
+  EXPECT_NO_THROW(Prediction{settings});
+}
+
+}  // namespace
+}  // namespace inertialnet
