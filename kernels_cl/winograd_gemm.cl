@@ -45,13 +45,7 @@ __kernel void winograd_gemm(__global const float* restrict u, const int u_offset
   for (int e = 0; e < ELEMENTS; ++e) {
     __global const float* ap = u + u_offset + (size_t)(e * panels + panel) * channels * MR;
     __global const float* bp = v + v_offset + (size_t)e * v_element_floats + (size_t)column_panel * channels * 32;
-    EACH_ROW(DECLARE)
-    for (int q = 0; q < channels; ++q) {
-      const float16 b_lo = vload16(0, bp), b_hi = vload16(1, bp);
-      EACH_ROW(ACCUMULATE)
-      ap += MR;
-      bp += 32;
-    }
+    TILE_PRODUCT(ap, bp, channels)
     EACH_ROW(PARK)
   }
   for (int r = 0; r < MR; ++r) {
