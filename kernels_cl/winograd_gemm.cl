@@ -48,18 +48,24 @@ __kernel void winograd_gemm(__global const float* restrict u, const int u_offset
     TILE_PRODUCT(ap, bp, channels)
     EACH_ROW(PARK)
   }
-  for (int r = 0; r < MR; ++r) {
-    const int o = row0 + r;
-    if (o >= out_channels) break;
+  for (int part = 0; part < 2; ++part) {
+    const int lane0 = col0 + 16 * part;  // the first of these 16 tiles in the range
+    if (lane0 >= count) break;
+    const int lanes = min(16, count - lane0);
+    // The 16 tiles side by side in one tile row, wholly inside the output: each of their 4 pixel
+    // rows is 64 consecutive floats, stored as 4 vectors instead of 64 scattered floats.
+    const int tile0 = first + lane0;
+    const int ty = tile0 / tiles_w, tx = tile0 - ty * tiles_w;
+    const bool whole = lanes == 16 && tx + 16 <= tiles_w && 4 * (tx + 16) <= out_w && 4 * ty + 4 <= out_h;
+    for (int r = 0; r < MR; ++r) {
+      const int o = row0 + r;
+      if (o >= out_channels) break;
 #if HAS_BIAS
-    const float b = bias[bias_offset + o];
+      const float b = bias[bias_offset + o];
 #else
-    const float b = 0.0f;
+      const float b = 0.0f;
 #endif
-    __global float* plane = out + out_offset + (size_t)o * out_h * out_w;
-    for (int part = 0; part < 2; ++part) {
-      const int lane0 = col0 + 16 * part;  // the first of these 16 tiles in the range
-      if (lane0 >= count) break;
+      __global float* plane = out + out_offset + (size_t)o * out_h * out_w;
       float16 a[4][6];  // Aᵀ m, per tile lane
       for (int q = 0; q < 6; ++q) {
         float16 col[6], y[4];
@@ -68,17 +74,32 @@ __kernel void winograd_gemm(__global const float* restrict u, const int u_offset
         for (int i = 0; i < 4; ++i) a[i][q] = y[i];
       }
       for (int i = 0; i < 4; ++i) {
-        float16 y[4];  // (Aᵀ m) A: row i of every tile
+        float16 y[4];  // (Aᵀ m) A: row i of every tile, pixel q of tile j in lane j of y[q]
         transform_at16(a[i], y);
-        float row[4][16];
-        for (int q = 0; q < 4; ++q) vstore16(ACTIVATE(y[q] + b), 0, row[q]);
-        const int lanes = min(16, count - lane0);
-        for (int j = 0; j < lanes; ++j) {
-          const int tile = first + lane0 + j;
-          const int y0 = 4 * (tile / tiles_w) + i, x0 = 4 * (tile % tiles_w);
-          if (y0 >= out_h) continue;
-          __global float* dst = plane + y0 * out_w + x0;
-          for (int q = 0; q < 4 && x0 + q < out_w; ++q) dst[q] = row[q][j];
+        for (int q = 0; q < 4; ++q) y[q] = ACTIVATE(y[q] + b);
+        if (whole) {
+          // Interleave to pixel order 4·j + q: pairs (q0, q1) and (q2, q3), then pairs of pairs.
+          const float16 lo01 = shuffle2(y[0], y[1], (uint16)(0, 16, 1, 17, 2, 18, 3, 19, 4, 20, 5, 21, 6, 22, 7, 23));
+          const float16 hi01 = shuffle2(y[0], y[1], (uint16)(8, 24, 9, 25, 10, 26, 11, 27, 12, 28, 13, 29, 14, 30, 15, 31));
+          const float16 lo23 = shuffle2(y[2], y[3], (uint16)(0, 16, 1, 17, 2, 18, 3, 19, 4, 20, 5, 21, 6, 22, 7, 23));
+          const float16 hi23 = shuffle2(y[2], y[3], (uint16)(8, 24, 9, 25, 10, 26, 11, 27, 12, 28, 13, 29, 14, 30, 15, 31));
+          const uint16 first_half = (uint16)(0, 1, 16, 17, 2, 3, 18, 19, 4, 5, 20, 21, 6, 7, 22, 23);
+          const uint16 second_half = (uint16)(8, 9, 24, 25, 10, 11, 26, 27, 12, 13, 28, 29, 14, 15, 30, 31);
+          __global float* dst = plane + (4 * ty + i) * out_w + 4 * tx;
+          vstore16(shuffle2(lo01, lo23, first_half), 0, dst);
+          vstore16(shuffle2(lo01, lo23, second_half), 1, dst);
+          vstore16(shuffle2(hi01, hi23, first_half), 2, dst);
+          vstore16(shuffle2(hi01, hi23, second_half), 3, dst);
+        } else {
+          float row[4][16];
+          for (int q = 0; q < 4; ++q) vstore16(y[q], 0, row[q]);
+          for (int j = 0; j < lanes; ++j) {
+            const int tile = tile0 + j;
+            const int y0 = 4 * (tile / tiles_w) + i, x0 = 4 * (tile % tiles_w);
+            if (y0 >= out_h) continue;
+            __global float* dst = plane + y0 * out_w + x0;
+            for (int q = 0; q < 4 && x0 + q < out_w; ++q) dst[q] = row[q][j];
+          }
         }
       }
     }

@@ -100,6 +100,16 @@ TEST(Winograd, OddSizesBatchThree) {
   expect_winograd_matches({"even_38x22", 33, 33, 38, 22, 1, 1, true, leaky}, {3});
 }
 
+TEST(Winograd, RowsOfSixteenWholeTilesStoreAsVectors) {
+  // Widths with 16 whole tiles side by side (out_w a multiple of 64) take winograd_gemm.cl's
+  // vector store; a partial bottom tile row, a row that ends mid-group (80 = 64 + 16) and tile
+  // ranges that start mid-row take the per-pixel one, in the same call.
+  const auto leaky = ActivationSpec::leaky_relu(0.1f);
+  expect_winograd_matches({"wide_128x9", 32, 24, 9, 128, 1, 1, true, leaky}, {2});
+  expect_winograd_matches({"wide_80x14", 33, 16, 14, 80, 1, 1, false, ActivationSpec::relu()}, {1});
+  expect_winograd_matches({"wide_ranges", 32, 16, 16, 80, 1, 1, true, leaky}, {1, 0, 0, 0, 0, 36 * 32 * 40});
+}
+
 TEST(Winograd, OtherPaddings) {
   expect_winograd_matches({"pad0", 36, 20, 37, 23, 1, 0, true, ActivationSpec::relu()}, {3});
   expect_winograd_matches({"pad2", 36, 20, 17, 13, 1, 2, false, ActivationSpec::none()}, {2});
