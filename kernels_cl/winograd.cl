@@ -17,7 +17,7 @@
 #define TILE 4    // output pixels per tile side
 #define WINDOW 6  // input pixels per tile side
 
-// The 1-D transforms, applied to columns and then to rows (Aᵀ: kernels_cl/winograd_gemm.cl).
+// The 1-D weight transform, applied to columns and then to rows.
 inline void transform_g(const float g0, const float g1, const float g2, float* u) {  // u = G g (6 from 3)
   u[0] = 0.25f * g0;
   u[1] = -(g0 + g1 + g2) / 6.0f;
@@ -25,15 +25,6 @@ inline void transform_g(const float g0, const float g1, const float g2, float* u
   u[3] = g0 / 24.0f + g1 / 12.0f + g2 / 6.0f;
   u[4] = g0 / 24.0f - g1 / 12.0f + g2 / 6.0f;
   u[5] = g2;
-}
-
-inline void transform_bt(const float* d, float* v) {  // v = Bᵀ d (6 from 6)
-  v[0] = 4.0f * d[0] - 5.0f * d[2] + d[4];
-  v[1] = -4.0f * (d[1] + d[2]) + d[3] + d[4];
-  v[2] = 4.0f * (d[1] - d[2]) - d[3] + d[4];
-  v[3] = -2.0f * (d[1] - d[3]) - d[2] + d[4];
-  v[4] = 2.0f * (d[1] - d[3]) - d[2] + d[4];
-  v[5] = 4.0f * d[1] - 5.0f * d[3] + d[5];
 }
 
 // U[e][o][c] = (G g Gᵀ)[e] for weights g = w[o][c] (3×3), stored as 36 matrices
@@ -63,42 +54,86 @@ __kernel void winograd_weights(__global const float* restrict w, const int w_off
   }
 }
 
-// V = Bᵀ d B of the 6×6 input window of tiles [first, first + count) of one sample, channel c,
-// written as 36 matrices [channels × count] packed in panels of 32 columns (gemm_packed.cl's B
-// layout), matrix e at e·element_floats. Work-item (t, c) for t < the padded tile count: tiles
-// past `count` are written as zeros, so every panel is whole.
+// v = Bᵀ d for 16 tiles at once (one float16 lane per tile).
+inline void transform_bt16(const float16* d, float16* v) {
+  v[0] = 4.0f * d[0] - 5.0f * d[2] + d[4];
+  v[1] = -4.0f * (d[1] + d[2]) + d[3] + d[4];
+  v[2] = 4.0f * (d[1] - d[2]) - d[3] + d[4];
+  v[3] = -2.0f * (d[1] - d[3]) - d[2] + d[4];
+  v[4] = 2.0f * (d[1] - d[3]) - d[2] + d[4];
+  v[5] = 4.0f * d[1] - 5.0f * d[3] + d[5];
+}
+
+// Lanes j = 0..15 of a 64-float row held in a, b, c, d (16 floats each): element 4·j + q.
+inline float16 every_fourth(const float16 a, const float16 b, const float16 c, const float16 d, const uint q) {
+  const uint16 pick = (uint16)(0, 4, 8, 12, 16, 20, 24, 28, 0, 4, 8, 12, 16, 20, 24, 28) + q;
+  return shuffle2(shuffle2(a, b, pick), shuffle2(c, d, pick),
+                  (uint16)(0, 1, 2, 3, 4, 5, 6, 7, 16, 17, 18, 19, 20, 21, 22, 23));
+}
+
+// V = Bᵀ d B of the 6×6 input windows of tiles [first, first + count) of one sample, written as
+// 36 matrices [channels × count] packed in panels of 32 columns (gemm_packed.cl's B layout),
+// matrix e = 6·i + k at e·element_floats. Work-item (g, c) takes the 16 tiles from 16·g of the
+// range in channel c, one float16 lane per tile, and writes 16 consecutive floats of each matrix;
+// tiles past `count` are zeros, so every panel is whole. When the 16 tiles lie side by side in
+// one tile row, each window row is one stretch of 68 input floats, read as vectors and split into
+// the 6 columns by shuffles; otherwise every lane reads its own window.
+// Launch (ceil(count / 32) · 2, channels) work-items in work-groups of one.
 __kernel void winograd_input(__global const float* restrict in, const int in_offset, __global float* restrict v,
                              const int v_offset, const int channels, const int height, const int width,
                              const int tiles_w, const int first, const int count, const int element_floats) {
-  const int t = get_global_id(0), c = get_global_id(1);
-  float d[WINDOW][WINDOW];
-  if (t < count) {
-    const int tile = first + t;
-    const int y0 = TILE * (tile / tiles_w) - PAD, x0 = TILE * (tile % tiles_w) - PAD;
-    __global const float* plane = in + in_offset + (size_t)c * height * width;
-    for (int r = 0; r < WINDOW; ++r) {
-      const int y = y0 + r;
-      const bool row_in = y >= 0 && y < height;
-      for (int q = 0; q < WINDOW; ++q) {
-        const int x = x0 + q;
-        d[r][q] = row_in && x >= 0 && x < width ? plane[y * width + x] : 0.0f;
-      }
-    }
-  } else {
-    for (int r = 0; r < WINDOW; ++r)
-      for (int q = 0; q < WINDOW; ++q) d[r][q] = 0.0f;
-  }
-  float b[WINDOW][WINDOW];  // Bᵀ d: column q of d gives column q of b
-  for (int q = 0; q < WINDOW; ++q) {
-    float col[WINDOW], out[WINDOW];
-    for (int r = 0; r < WINDOW; ++r) col[r] = d[r][q];
-    transform_bt(col, out);
-    for (int r = 0; r < WINDOW; ++r) b[r][q] = out[r];
-  }
-  __global float* out = v + v_offset + (size_t)(t / 32) * channels * 32 + (size_t)c * 32 + (t % 32);
+  const int g = get_global_id(0), c = get_global_id(1);
+  const int lane0 = 16 * g;  // the first tile of this work-item within the range
+  const int lanes = clamp(count - lane0, 0, 16);
+  const int tile0 = first + lane0;
+  const int ty = tile0 / tiles_w, tx = tile0 - ty * tiles_w;
+  const bool whole = lanes == 16 && tx + 16 <= tiles_w;
+  __global const float* plane = in + in_offset + (size_t)c * height * width;
+  float16 e[WINDOW][WINDOW];  // d B: row r of every window
   for (int r = 0; r < WINDOW; ++r) {
-    float row[WINDOW];  // (Bᵀ d) B: row r
-    transform_bt(b[r], row);
-    for (int q = 0; q < WINDOW; ++q) out[(size_t)(WINDOW * r + q) * element_floats] = row[q];
+    float16 d[WINDOW];  // column q of window row r, per lane
+    if (whole) {
+      const int y = TILE * ty + r - PAD, x0 = TILE * tx - PAD;
+      float row[80];  // input columns x0 … x0 + 67 of row y (the rest unused), zeros outside the plane
+      if (y >= 0 && y < height && x0 >= 0 && x0 + 80 <= width) {
+        __global const float* src = plane + (size_t)y * width + x0;
+        for (int k = 0; k < 5; ++k) vstore16(vload16(k, src), k, row);
+      } else {
+        const bool row_in = y >= 0 && y < height;
+        for (int k = 0; k < 68; ++k) {
+          const int x = x0 + k;
+          row[k] = row_in && x >= 0 && x < width ? plane[(size_t)y * width + x] : 0.0f;
+        }
+      }
+      const float16 a = vload16(0, row), b = vload16(1, row), cc = vload16(2, row), dd = vload16(3, row);
+      const float16 a4 = vload16(0, row + 4), b4 = vload16(1, row + 4), c4 = vload16(2, row + 4),
+                    d4 = vload16(3, row + 4);
+      d[0] = every_fourth(a, b, cc, dd, 0);
+      d[1] = every_fourth(a, b, cc, dd, 1);
+      d[2] = every_fourth(a, b, cc, dd, 2);
+      d[3] = every_fourth(a, b, cc, dd, 3);
+      d[4] = every_fourth(a4, b4, c4, d4, 0);
+      d[5] = every_fourth(a4, b4, c4, d4, 1);
+    } else {
+      float window[WINDOW][16];
+      for (int j = 0; j < 16; ++j) {
+        const int tile = tile0 + j;
+        const int y = TILE * (tile / tiles_w) + r - PAD, x0 = TILE * (tile % tiles_w) - PAD;
+        const bool row_in = j < lanes && y >= 0 && y < height;
+        for (int q = 0; q < WINDOW; ++q) {
+          const int x = x0 + q;
+          window[q][j] = row_in && x >= 0 && x < width ? plane[(size_t)y * width + x] : 0.0f;
+        }
+      }
+      for (int q = 0; q < WINDOW; ++q) d[q] = vload16(0, window[q]);
+    }
+    transform_bt16(d, e[r]);
+  }
+  __global float* out = v + v_offset + (size_t)(lane0 / 32) * channels * 32 + (size_t)c * 32 + lane0 % 32;
+  for (int k = 0; k < WINDOW; ++k) {
+    float16 col[WINDOW], w[WINDOW];  // Bᵀ (d B): column k
+    for (int r = 0; r < WINDOW; ++r) col[r] = e[r][k];
+    transform_bt16(col, w);
+    for (int i = 0; i < WINDOW; ++i) vstore16(w[i], 0, out + (size_t)(WINDOW * i + k) * element_floats);
   }
 }

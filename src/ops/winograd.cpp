@@ -86,8 +86,8 @@ void conv2d_winograd(Queue& queue, const Tensor& input, const std::vector<Packed
       forward.set_args(in_n, v, checked_int(channels, "channels"), static_cast<int>(input.h()),
                        static_cast<int>(input.w()), checked_int(tiles_w, "tiles"), checked_int(first, "tile"),
                        checked_int(count, "tiles"), checked_int(count_floats, "panels"));
-      // Work-groups of 32 consecutive tiles: PoCL runs their work-items as vector lanes.
-      queue.launch(forward, Range(padded, channels), Range(kTileWidth, 1));
+      // 16 tiles per work-item, one per vector lane (kernels_cl/winograd.cl).
+      queue.launch(forward, Range(padded / 16, channels), Range(1, 1));
       // Without a bias the kernel never reads its bias argument; any valid buffer will do.
       product.set_args(u.data, v, checked_int(count_floats, "panels"), out_n, has_bias ? bias : v,
                        checked_int(out_channels, "channels"), checked_int(channels, "channels"),

@@ -101,13 +101,16 @@ TEST(Winograd, OddSizesBatchThree) {
 }
 
 TEST(Winograd, RowsOfSixteenWholeTilesStoreAsVectors) {
-  // Widths with 16 whole tiles side by side (out_w a multiple of 64) take winograd_gemm.cl's
-  // vector store; a partial bottom tile row, a row that ends mid-group (80 = 64 + 16) and tile
+  // Widths with 16 whole tiles side by side take winograd_gemm.cl's vector store (out_w a
+  // multiple of 64) and winograd.cl's vector loads; a partial bottom tile row, a row that ends mid-group (80 = 64 + 16) and tile
   // ranges that start mid-row take the per-pixel one, in the same call.
   const auto leaky = ActivationSpec::leaky_relu(0.1f);
   expect_winograd_matches({"wide_128x9", 32, 24, 9, 128, 1, 1, true, leaky}, {2});
   expect_winograd_matches({"wide_80x14", 33, 16, 14, 80, 1, 1, false, ActivationSpec::relu()}, {1});
   expect_winograd_matches({"wide_ranges", 32, 16, 16, 80, 1, 1, true, leaky}, {1, 0, 0, 0, 0, 36 * 32 * 40});
+  // 160 columns: the middle group of 16 tiles reads its window rows as whole vectors (80 input
+  // columns inside the plane), the outer ones pad with zeros.
+  expect_winograd_matches({"wide_160x7", 32, 16, 7, 160, 1, 1, true, leaky}, {2});
 }
 
 TEST(Winograd, OtherPaddings) {
