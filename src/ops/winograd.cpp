@@ -61,10 +61,12 @@ void conv2d_winograd(Queue& queue, const Tensor& input, const std::vector<Packed
   const std::size_t row_panels = u.panels() / kElements;
   const auto out_h = static_cast<std::size_t>(output.h()), out_w = static_cast<std::size_t>(output.w());
   const std::size_t tiles_w = (out_w + kTile - 1) / kTile, tiles = (out_h + kTile - 1) / kTile * tiles_w;
-  // A range of tiles at a time: its V (36 × ci floats a tile) within the column budget, whole
+  // A range of tiles at a time: its V (36 × ci floats a tile) within the packed budget, whole
   // panels. The products stay in the GEMM kernel's local memory (kernels_cl/winograd_gemm.cl).
   const std::size_t per_tile = kElements * channels;
-  std::size_t chunk = std::clamp<std::size_t>(column_budget(queue.device(), options.max_column_floats) / per_tile, 1, tiles);
+  std::size_t chunk = std::clamp<std::size_t>(packed_column_budget(queue.device(), options.max_column_floats) / per_tile, 1, tiles);
+  // Without a requested budget, at least one whole panel (the deepest layers' V exceeds it).
+  if (options.max_column_floats == 0) chunk = std::max(chunk, std::min(tiles, kTileWidth));
   if (chunk >= kTileWidth && chunk < tiles) chunk -= chunk % kTileWidth;
   const std::size_t element_floats = PackedPanels::floats(chunk, channels, static_cast<int>(kTileWidth));
   const Tensor v = Tensor::empty(queue, {static_cast<std::int64_t>(kElements * element_floats)});
