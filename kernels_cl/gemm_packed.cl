@@ -69,13 +69,7 @@ __kernel void gemm_packed(__global const float* restrict a_packed, const int a_o
   if (row0 >= m || col0 >= n) return;
   __global const float* ap = a_packed + a_offset + (size_t)panel * k * MR;
   __global const float* bp = b_packed + b_offset + (size_t)column_panel * k * 32;
-  EACH_ROW(DECLARE)
-  for (int q = 0; q < k; ++q) {
-    const float16 b_lo = vload16(0, bp), b_hi = vload16(1, bp);
-    EACH_ROW(ACCUMULATE)
-    ap += MR;
-    bp += 32;
-  }
+  TILE_PRODUCT(ap, bp, k)
   const int cols = min(32, n - col0);
   EACH_ROW(STORE)
 }

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
-// The register tile of the packed-panel GEMM, shared by every kernel that runs its inner loop
-// (gemm_packed.cl, deconv_subpixel.cl) so that they differ only in how the tile is stored:
+// The register tile of the packed-panel GEMM and its loop over k, shared by every kernel that
+// runs it (gemm_packed.cl, deconv_subpixel.cl, winograd_gemm.cl) so that they differ only in
+// which panels they pair and how the tile is stored:
 // MR rows of A broadcast against 32 columns of B, 2·MR float16 accumulators (see gemm_packed.cl).
 // A header: included after common.cl, never built on its own. Build option: -DMR.
 
@@ -28,4 +29,15 @@
     const float16 a = (float16)(ap[r]);    \
     lo##r = fma(a, b_lo, lo##r);           \
     hi##r = fma(a, b_hi, hi##r);           \
+  }
+
+// The MR×32 tile of one A panel (ap: MR floats per k) times one B panel (bp: 32 floats per k)
+// over k, in accumulators lo0/hi0 … lo(MR−1)/hi(MR−1) declared here; advances ap and bp.
+#define TILE_PRODUCT(ap, bp, k)                                \
+  EACH_ROW(DECLARE)                                            \
+  for (int q_ = 0; q_ < (k); ++q_) {                           \
+    const float16 b_lo = vload16(0, bp), b_hi = vload16(1, bp); \
+    EACH_ROW(ACCUMULATE)                                       \
+    ap += MR;                                                  \
+    bp += 32;                                                  \
   }

@@ -1,112 +1,139 @@
 // SPDX-License-Identifier: Apache-2.0
-// Winograd F(2×2, 3×3) for 3×3 stride-1 convolutions on CPU devices (src/ops/winograd.cpp):
-// Y = Aᵀ [ (G g Gᵀ) ⊙ (Bᵀ d Bᵀᵀ) ] A per 2×2 output tile, with the 16 element-wise products summed
-// over input channels as 16 packed GEMMs (kernels_cl/gemm_packed.cl). Transforms (Lavin & Gray):
-//   G  = [1 0 0; ½ ½ ½; ½ −½ ½; 0 0 1]
-//   Bᵀ = [1 0 −1 0; 0 1 1 0; 0 −1 1 0; 0 1 0 −1]
-//   Aᵀ = [1 1 1 0; 0 1 −1 −1]
-// Element e = 4·row + column of a 4×4 transform is GEMM number e.
+// Winograd F(4×4, 3×3) for 3×3 stride-1 convolutions on CPU devices (src/ops/winograd.cpp):
+// Y = Aᵀ [ (G g Gᵀ) ⊙ (Bᵀ d B) ] A per 4×4 output tile (6×6 input window), with the 36
+// element-wise products summed over input channels by kernels_cl/winograd_gemm.cl (the packed
+// GEMM's register tile, with the output transform applied to the products in local memory).
+// Transforms (Lavin & Gray, interpolation points 0, ±1, ±2, ∞):
+//   G  = [¼ 0 0; −⅙ −⅙ −⅙; −⅙ ⅙ −⅙; 1/24 1/12 ⅙; 1/24 −1/12 ⅙; 0 0 1]
+//   Bᵀ = [4 0 −5 0 1 0; 0 −4 −4 1 1 0; 0 4 −4 −1 1 0; 0 −2 −1 2 1 0; 0 2 −1 −2 1 0; 0 4 0 −5 0 1]
+//   Aᵀ = [1 1 1 1 1 0; 0 1 −1 2 −2 0; 0 1 1 4 4 0; 0 1 −1 8 −8 1]
+// Element e = 6·row + column of a 6×6 transform is GEMM number e.
 //
-// Build options: -DPAD (zeros on every side), -DHAS_BIAS, -DACTIVATION, -DNEGATIVE_SLOPE.
+// Build option: -DPAD (zeros on every side).
 
 #include "common.cl"
 
-// U[e][o][c] = (G g Gᵀ)[e] for weights g = w[o][c] (3×3): one work-item per (o, c).
+#define ELEMENTS 36
+#define TILE 4    // output pixels per tile side
+#define WINDOW 6  // input pixels per tile side
+
+// The 1-D weight transform, applied to columns and then to rows.
+inline void transform_g(const float g0, const float g1, const float g2, float* u) {  // u = G g (6 from 3)
+  u[0] = 0.25f * g0;
+  u[1] = -(g0 + g1 + g2) / 6.0f;
+  u[2] = -(g0 - g1 + g2) / 6.0f;
+  u[3] = g0 / 24.0f + g1 / 12.0f + g2 / 6.0f;
+  u[4] = g0 / 24.0f - g1 / 12.0f + g2 / 6.0f;
+  u[5] = g2;
+}
+
+// U[e][o][c] = (G g Gᵀ)[e] for weights g = w[o][c] (3×3), stored as 36 matrices
+// [padded_rows × ci] (e at e·padded_rows·ci): one work-item per (o, c) for o < padded_rows; rows
+// from `rows` (co) on are zeros, so that every element's matrix fills whole MR-row panels.
 __kernel void winograd_weights(__global const float* restrict w, const int w_offset, __global float* restrict u,
-                               const int u_offset, const int pairs) {
+                               const int u_offset, const int rows, const int padded_rows, const int channels) {
   const int i = get_global_id(0);
+  const int pairs = padded_rows * channels;
   if (i >= pairs) return;
-  __global const float* g = w + w_offset + (size_t)i * 9;
-  float t[4][3];  // G g
-  for (int j = 0; j < 3; ++j) {
-    const float g0 = g[j], g1 = g[3 + j], g2 = g[6 + j];
-    t[0][j] = g0;
-    t[1][j] = 0.5f * (g0 + g1 + g2);
-    t[2][j] = 0.5f * (g0 - g1 + g2);
-    t[3][j] = g2;
-  }
   __global float* out = u + u_offset + i;
-  for (int r = 0; r < 4; ++r) {
-    out[(size_t)(4 * r + 0) * pairs] = t[r][0];
-    out[(size_t)(4 * r + 1) * pairs] = 0.5f * (t[r][0] + t[r][1] + t[r][2]);
-    out[(size_t)(4 * r + 2) * pairs] = 0.5f * (t[r][0] - t[r][1] + t[r][2]);
-    out[(size_t)(4 * r + 3) * pairs] = t[r][2];
+  if (i / channels >= rows) {
+    for (int e = 0; e < ELEMENTS; ++e) out[(size_t)e * pairs] = 0.0f;
+    return;
+  }
+  __global const float* g = w + w_offset + (size_t)i * 9;
+  float t[WINDOW][3];  // G g: column j of g gives column j of t
+  for (int j = 0; j < 3; ++j) {
+    float col[WINDOW];
+    transform_g(g[j], g[3 + j], g[6 + j], col);
+    for (int r = 0; r < WINDOW; ++r) t[r][j] = col[r];
+  }
+  for (int r = 0; r < WINDOW; ++r) {
+    float row[WINDOW];  // (G g) Gᵀ: row r
+    transform_g(t[r][0], t[r][1], t[r][2], row);
+    for (int q = 0; q < WINDOW; ++q) out[(size_t)(WINDOW * r + q) * pairs] = row[q];
   }
 }
 
-// V = Bᵀ d B of the 4×4 input window of tiles [first, first + count) of one sample, channel c,
-// written as 16 matrices [channels × count] packed in panels of 32 columns (gemm_packed.cl's B
-// layout), matrix e at e·element_floats. Work-item (t, c) for t < the padded tile count: tiles
-// past `count` are written as zeros, so every panel is whole.
+// v = Bᵀ d for 16 tiles at once (one float16 lane per tile).
+inline void transform_bt16(const float16* d, float16* v) {
+  v[0] = 4.0f * d[0] - 5.0f * d[2] + d[4];
+  v[1] = -4.0f * (d[1] + d[2]) + d[3] + d[4];
+  v[2] = 4.0f * (d[1] - d[2]) - d[3] + d[4];
+  v[3] = -2.0f * (d[1] - d[3]) - d[2] + d[4];
+  v[4] = 2.0f * (d[1] - d[3]) - d[2] + d[4];
+  v[5] = 4.0f * d[1] - 5.0f * d[3] + d[5];
+}
+
+// Lanes j = 0..15 of a 64-float row held in a, b, c, d (16 floats each): element 4·j + q.
+inline float16 every_fourth(const float16 a, const float16 b, const float16 c, const float16 d, const uint q) {
+  const uint16 pick = (uint16)(0, 4, 8, 12, 16, 20, 24, 28, 0, 4, 8, 12, 16, 20, 24, 28) + q;
+  return shuffle2(shuffle2(a, b, pick), shuffle2(c, d, pick),
+                  (uint16)(0, 1, 2, 3, 4, 5, 6, 7, 16, 17, 18, 19, 20, 21, 22, 23));
+}
+
+// V = Bᵀ d B of the 6×6 input windows of tiles [first, first + count) of one sample, written as
+// 36 matrices [channels × count] packed in panels of 32 columns (gemm_packed.cl's B layout),
+// matrix e = 6·i + k at e·element_floats. Work-item (g, c) takes the 16 tiles from 16·g of the
+// range in channel c, one float16 lane per tile, and writes 16 consecutive floats of each matrix;
+// tiles past `count` are zeros, so every panel is whole. When the 16 tiles lie side by side in
+// one tile row, each window row is one stretch of 68 input floats, read as vectors and split into
+// the 6 columns by shuffles; otherwise every lane reads its own window.
+// Launch (ceil(count / 32) · 2, channels) work-items in work-groups of one.
 __kernel void winograd_input(__global const float* restrict in, const int in_offset, __global float* restrict v,
                              const int v_offset, const int channels, const int height, const int width,
                              const int tiles_w, const int first, const int count, const int element_floats) {
-  const int t = get_global_id(0), c = get_global_id(1);
-  float d[4][4];
-  if (t < count) {
-    const int tile = first + t;
-    const int y0 = 2 * (tile / tiles_w) - PAD, x0 = 2 * (tile % tiles_w) - PAD;
-    __global const float* plane = in + in_offset + (size_t)c * height * width;
-    for (int r = 0; r < 4; ++r) {
-      const int y = y0 + r;
-      const bool row_in = y >= 0 && y < height;
-      for (int q = 0; q < 4; ++q) {
-        const int x = x0 + q;
-        d[r][q] = row_in && x >= 0 && x < width ? plane[y * width + x] : 0.0f;
+  const int g = get_global_id(0), c = get_global_id(1);
+  const int lane0 = 16 * g;  // the first tile of this work-item within the range
+  const int lanes = clamp(count - lane0, 0, 16);
+  const int tile0 = first + lane0;
+  const int ty = tile0 / tiles_w, tx = tile0 - ty * tiles_w;
+  const bool whole = lanes == 16 && tx + 16 <= tiles_w;
+  __global const float* plane = in + in_offset + (size_t)c * height * width;
+  float16 e[WINDOW][WINDOW];  // d B: row r of every window
+  for (int r = 0; r < WINDOW; ++r) {
+    float16 d[WINDOW];  // column q of window row r, per lane
+    if (whole) {
+      const int y = TILE * ty + r - PAD, x0 = TILE * tx - PAD;
+      float row[80];  // input columns x0 … x0 + 67 of row y (the rest unused), zeros outside the plane
+      if (y >= 0 && y < height && x0 >= 0 && x0 + 80 <= width) {
+        __global const float* src = plane + (size_t)y * width + x0;
+        for (int k = 0; k < 5; ++k) vstore16(vload16(k, src), k, row);
+      } else {
+        const bool row_in = y >= 0 && y < height;
+        for (int k = 0; k < 68; ++k) {
+          const int x = x0 + k;
+          row[k] = row_in && x >= 0 && x < width ? plane[(size_t)y * width + x] : 0.0f;
+        }
       }
+      const float16 a = vload16(0, row), b = vload16(1, row), cc = vload16(2, row), dd = vload16(3, row);
+      const float16 a4 = vload16(0, row + 4), b4 = vload16(1, row + 4), c4 = vload16(2, row + 4),
+                    d4 = vload16(3, row + 4);
+      d[0] = every_fourth(a, b, cc, dd, 0);
+      d[1] = every_fourth(a, b, cc, dd, 1);
+      d[2] = every_fourth(a, b, cc, dd, 2);
+      d[3] = every_fourth(a, b, cc, dd, 3);
+      d[4] = every_fourth(a4, b4, c4, d4, 0);
+      d[5] = every_fourth(a4, b4, c4, d4, 1);
+    } else {
+      float window[WINDOW][16];
+      for (int j = 0; j < 16; ++j) {
+        const int tile = tile0 + j;
+        const int y = TILE * (tile / tiles_w) + r - PAD, x0 = TILE * (tile % tiles_w) - PAD;
+        const bool row_in = j < lanes && y >= 0 && y < height;
+        for (int q = 0; q < WINDOW; ++q) {
+          const int x = x0 + q;
+          window[q][j] = row_in && x >= 0 && x < width ? plane[(size_t)y * width + x] : 0.0f;
+        }
+      }
+      for (int q = 0; q < WINDOW; ++q) d[q] = vload16(0, window[q]);
     }
-  } else {
-    for (int r = 0; r < 4; ++r)
-      for (int q = 0; q < 4; ++q) d[r][q] = 0.0f;
+    transform_bt16(d, e[r]);
   }
-  float b[4][4];  // Bᵀ d
-  for (int q = 0; q < 4; ++q) {
-    b[0][q] = d[0][q] - d[2][q];
-    b[1][q] = d[1][q] + d[2][q];
-    b[2][q] = d[2][q] - d[1][q];
-    b[3][q] = d[1][q] - d[3][q];
-  }
-  __global float* out = v + v_offset + (size_t)(t / 32) * channels * 32 + (size_t)c * 32 + (t % 32);
-  for (int r = 0; r < 4; ++r) {
-    out[(size_t)(4 * r + 0) * element_floats] = b[r][0] - b[r][2];
-    out[(size_t)(4 * r + 1) * element_floats] = b[r][1] + b[r][2];
-    out[(size_t)(4 * r + 2) * element_floats] = b[r][2] - b[r][1];
-    out[(size_t)(4 * r + 3) * element_floats] = b[r][1] - b[r][3];
-  }
-}
-
-// Y = Aᵀ m A for tile t of the chunk and output channel o, m read from 16 matrices
-// [out_channels × count] (matrix e at e·out_channels·count), plus bias and activation, stored
-// into the output plane of one sample where the 2×2 tile lies inside it.
-__kernel void winograd_output(__global const float* restrict m, const int m_offset, __global float* restrict out,
-                              const int out_offset, __global const float* restrict bias, const int bias_offset,
-                              const int out_channels, const int out_h, const int out_w, const int tiles_w,
-                              const int first, const int count) {
-  const int t = get_global_id(0), o = get_global_id(1);
-  if (t >= count) return;
-  __global const float* src = m + m_offset + (size_t)o * count + t;
-  const size_t element = (size_t)out_channels * count;
-  float s[4][4];
-  for (int e = 0; e < 16; ++e) s[e / 4][e % 4] = src[e * element];
-  float a[2][4];  // Aᵀ m
-  for (int q = 0; q < 4; ++q) {
-    a[0][q] = s[0][q] + s[1][q] + s[2][q];
-    a[1][q] = s[1][q] - s[2][q] - s[3][q];
-  }
-#if HAS_BIAS
-  const float b = bias[bias_offset + o];
-#else
-  const float b = 0.0f;
-#endif
-  const int tile = first + t;
-  const int y0 = 2 * (tile / tiles_w), x0 = 2 * (tile % tiles_w);
-  __global float* plane = out + out_offset + (size_t)o * out_h * out_w;
-  for (int r = 0; r < 2; ++r) {
-    const int y = y0 + r;
-    if (y >= out_h) break;
-    const float y_0 = a[r][0] + a[r][1] + a[r][2] + b;
-    const float y_1 = a[r][1] - a[r][2] - a[r][3] + b;
-    plane[y * out_w + x0] = ACTIVATE(y_0);
-    if (x0 + 1 < out_w) plane[y * out_w + x0 + 1] = ACTIVATE(y_1);
+  __global float* out = v + v_offset + (size_t)(lane0 / 32) * channels * 32 + (size_t)c * 32 + lane0 % 32;
+  for (int k = 0; k < WINDOW; ++k) {
+    float16 col[WINDOW], w[WINDOW];  // Bᵀ (d B): column k
+    for (int r = 0; r < WINDOW; ++r) col[r] = e[r][k];
+    transform_bt16(col, w);
+    for (int i = 0; i < WINDOW; ++i) vstore16(w[i], 0, out + (size_t)(WINDOW * i + k) * element_floats);
   }
 }

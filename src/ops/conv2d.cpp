@@ -29,7 +29,10 @@ void conv2d_packed(Queue& queue, const Tensor& input, const Tensor& weight, cons
   const auto out_h = static_cast<int>(output.h()), out_w = static_cast<int>(output.w());
   const std::size_t pixels = static_cast<std::size_t>(out_h) * static_cast<std::size_t>(out_w);
   // Whole panels per range, so only the last range of a sample has a partial panel.
-  std::size_t chunk = std::clamp<std::size_t>(detail::column_budget(queue.device(), options.max_column_floats) / reduction, 1, pixels);
+  std::size_t chunk =
+      std::clamp<std::size_t>(detail::packed_column_budget(queue.device(), options.max_column_floats) / reduction, 1, pixels);
+  // Without a requested budget, at least one whole panel (the deepest layers' K exceeds it).
+  if (options.max_column_floats == 0) chunk = std::max(chunk, std::min(pixels, kPackedColumns));
   if (chunk >= kPackedColumns && chunk < pixels) chunk -= chunk % kPackedColumns;
   const Tensor columns = Tensor::empty(queue, {static_cast<std::int64_t>(PackedPanels::floats(chunk, reduction, static_cast<int>(kPackedColumns)))});
   const Im2colGeometry geometry{static_cast<int>(weight.dim(2)), static_cast<int>(weight.dim(3)), options.stride,

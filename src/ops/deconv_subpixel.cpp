@@ -50,7 +50,7 @@ void conv_transpose2d_subpixel(Queue& queue, const Tensor& input, const PackedPa
   const std::size_t windows = static_cast<std::size_t>(height + 1) * static_cast<std::size_t>(width + 1);
   const std::size_t depth = weights.depth;
   // The B panels of a block of windows stay within the column budget; whole panels, at least one.
-  const std::size_t budget = column_budget(queue.device(), options.max_column_floats);
+  const std::size_t budget = packed_column_budget(queue.device(), options.max_column_floats);
   const std::size_t block =
       std::min(windows, std::max(kPackedColumns, budget / depth / kPackedColumns * kPackedColumns));
   const Tensor panels = Tensor::empty(

@@ -12,7 +12,8 @@ namespace inertialnet::detail {
 
 namespace {
 
-constexpr std::size_t kElements = 16;  // a 4×4 transform: one GEMM per element
+constexpr std::size_t kElements = kWinogradElements;  // a 6×6 transform: one GEMM per element
+constexpr std::size_t kTile = 4;                      // output pixels per tile side
 constexpr std::size_t kTileWidth = kPackedColumns;
 
 int checked_int(std::size_t value, const char* what) {
@@ -35,40 +36,48 @@ std::vector<PackedPanels> winograd_weights(Queue& queue, const Tensor& weight, D
                         to_string(weight.shape()));
   }
   const auto co = static_cast<std::size_t>(weight.dim(0)), ci = static_cast<std::size_t>(weight.dim(1));
-  const std::size_t pairs = co * ci;
+  // Each element's matrix is padded to whole MR-row panels, so that the 36 of them pack as one
+  // matrix of 36·padded rows whose panels never straddle two elements.
+  const auto rows = static_cast<std::size_t>(packed_gemm_tile_rows(co, 0, packed_gemm_setting(queue.device(), "MR")));
+  const std::size_t padded = (co + rows - 1) / rows * rows;
+  const std::size_t pairs = padded * ci;
   const Tensor u = Tensor::empty(queue, {static_cast<std::int64_t>(kElements * pairs)});
   Kernel& kernel = queue.kernel("winograd", "winograd_weights", KernelDefines().add("PAD", 1));
-  kernel.set_args(weight, u, checked_int(pairs, "weights"));
+  kernel.set_args(weight, u, checked_int(co, "channels"), checked_int(padded, "channels"), checked_int(ci, "channels"));
   queue.launch(kernel, Range(pairs), Range(1));
   std::vector<PackedPanels> packed;
-  packed.reserve(kElements);
-  for (std::size_t e = 0; e < kElements; ++e) {
-    packed.push_back(pack_a(queue, Transpose::No, co, ci, MatrixView::of(u, ci, e * pairs), 0, long_lived));
-  }
+  packed.push_back(pack_a(queue, Transpose::No, kElements * padded, ci, MatrixView::of(u, ci), static_cast<int>(rows),
+                          long_lived));
   return packed;
 }
 
 void conv2d_winograd(Queue& queue, const Tensor& input, const std::vector<PackedPanels>& weights, const Tensor& bias,
                      const Tensor& output, const Conv2dOptions& options) {
-  if (weights.size() != kElements) throw invalid_input("winograd: expected 16 transformed weight matrices");
-  const std::size_t channels = weights[0].depth, out_channels = weights[0].lines;
+  if (weights.size() != 1 || weights[0].lines % (kElements * static_cast<std::size_t>(weights[0].width)) != 0) {
+    throw invalid_input("winograd: expected the 36 transformed weight matrices packed as one");
+  }
+  const PackedPanels& u = weights[0];
+  const std::size_t channels = u.depth, out_channels = static_cast<std::size_t>(output.c());
+  const std::size_t row_panels = u.panels() / kElements;
   const auto out_h = static_cast<std::size_t>(output.h()), out_w = static_cast<std::size_t>(output.w());
-  const std::size_t tiles_w = (out_w + 1) / 2, tiles = (out_h + 1) / 2 * tiles_w;
-  // A range of tiles at a time: its V and M (16 × ci, 16 × co floats a tile) within the column
-  // budget, whole panels. (Ranges sized for the last-level cache, 8 MiB, measured slower at
-  // 512×384 on this 2-core machine: more launches, and the GEMMs' B panels are reused anyway.)
-  const std::size_t per_tile = kElements * std::max(channels, out_channels);
-  std::size_t chunk = std::clamp<std::size_t>(column_budget(queue.device(), options.max_column_floats) / per_tile, 1, tiles);
+  const std::size_t tiles_w = (out_w + kTile - 1) / kTile, tiles = (out_h + kTile - 1) / kTile * tiles_w;
+  // A range of tiles at a time: its V (36 × ci floats a tile) within the packed budget, whole
+  // panels. The products stay in the GEMM kernel's local memory (kernels_cl/winograd_gemm.cl).
+  const std::size_t per_tile = kElements * channels;
+  std::size_t chunk = std::clamp<std::size_t>(packed_column_budget(queue.device(), options.max_column_floats) / per_tile, 1, tiles);
+  // Without a requested budget, at least one whole panel (the deepest layers' V exceeds it).
+  if (options.max_column_floats == 0) chunk = std::max(chunk, std::min(tiles, kTileWidth));
   if (chunk >= kTileWidth && chunk < tiles) chunk -= chunk % kTileWidth;
   const std::size_t element_floats = PackedPanels::floats(chunk, channels, static_cast<int>(kTileWidth));
   const Tensor v = Tensor::empty(queue, {static_cast<std::int64_t>(kElements * element_floats)});
-  const Tensor m = Tensor::empty(queue, {static_cast<std::int64_t>(kElements * out_channels * chunk)});
 
   const bool has_bias = bias.defined();
   Kernel& forward = queue.kernel("winograd", "winograd_input", KernelDefines().add("PAD", options.padding));
-  Kernel& backward = queue.kernel(
-      "winograd", "winograd_output",
-      KernelDefines().add("PAD", options.padding).add("HAS_BIAS", has_bias).add(activation_defines(options.activation)));
+  Kernel& product = queue.kernel("winograd_gemm", "winograd_gemm",
+                                 KernelDefines()
+                                     .add("MR", u.width)
+                                     .add("HAS_BIAS", has_bias)
+                                     .add(activation_defines(options.activation)));
   for (std::int64_t n = 0; n < input.n(); ++n) {
     const Tensor in_n = input.sample(n);
     const Tensor out_n = output.sample(n);
@@ -79,21 +88,14 @@ void conv2d_winograd(Queue& queue, const Tensor& input, const std::vector<Packed
       forward.set_args(in_n, v, checked_int(channels, "channels"), static_cast<int>(input.h()),
                        static_cast<int>(input.w()), checked_int(tiles_w, "tiles"), checked_int(first, "tile"),
                        checked_int(count, "tiles"), checked_int(count_floats, "panels"));
-      // Work-groups of 32 consecutive tiles: PoCL runs their work-items as vector lanes.
-      queue.launch(forward, Range(padded, channels), Range(kTileWidth, 1));
-      for (std::size_t e = 0; e < kElements; ++e) {
-        PackedPanels b;
-        b.lines = count;
-        b.depth = channels;
-        b.width = static_cast<int>(kTileWidth);
-        b.data = v.region(e * count_floats, {static_cast<std::int64_t>(count_floats)});
-        gemm_packed(queue, weights[e], b, MatrixView::of(m, count, e * out_channels * count));
-      }
+      // 16 tiles per work-item, one per vector lane (kernels_cl/winograd.cl).
+      queue.launch(forward, Range(padded / 16, channels), Range(1, 1));
       // Without a bias the kernel never reads its bias argument; any valid buffer will do.
-      backward.set_args(m, out_n, has_bias ? bias : m, checked_int(out_channels, "channels"),
-                        static_cast<int>(out_h), static_cast<int>(out_w), checked_int(tiles_w, "tiles"),
-                        checked_int(first, "tile"), checked_int(count, "tiles"));
-      queue.launch(backward, Range(padded, out_channels), Range(kTileWidth, 1));
+      product.set_args(u.data, v, checked_int(count_floats, "panels"), out_n, has_bias ? bias : v,
+                       checked_int(out_channels, "channels"), checked_int(channels, "channels"),
+                       static_cast<int>(out_h), static_cast<int>(out_w), checked_int(tiles_w, "tiles"),
+                       checked_int(first, "tile"), checked_int(count, "tiles"));
+      queue.launch(product, Range(row_panels, padded / kTileWidth), Range(1, 1));
     }
   }
 }

@@ -4,7 +4,7 @@
 // with a direct convolution for layers of very few output channels and a GEMV for
 // one-sample fully connected layers).
 //
-// `Winograd` is the packed backend with Winograd F(2×2, 3×3) for the 3×3 stride-1 convolutions
+// `Winograd` is the packed backend with Winograd F(4×4, 3×3) for the 3×3 stride-1 convolutions
 // of at least 16 output and 32 input channels (src/ops/winograd.hpp); every other layer runs as
 // on `Packed`.
 //

@@ -8,7 +8,7 @@
 // device's weights), not per graph: pipeline lanes do not duplicate them. Layers with very few
 // output channels (predict_flow*) run a direct convolution and need no packing; fully connected
 // layers read their weights in place (GEMV). On the winograd plan, the 3×3 stride-1 layers keep
-// their 16 Winograd-transformed weight matrices packed instead (src/ops/winograd.hpp).
+// their 36 Winograd-transformed weight matrices, packed as one, instead (src/ops/winograd.hpp).
 //
 // Under $INERTIALNET_PLAN=auto the backend of a layer comes from timing: the layer runs on its
 // real shape with the weights prepared for each candidate of gemm_candidates() (one warm-up,
@@ -33,7 +33,7 @@
 namespace inertialnet {
 
 // A layer's weights as its backend reads them. `packed` is defined only where the layer runs
-// the packed GEMM on im2col panels, `winograd` (16 matrices) only where it runs Winograd;
+// the packed GEMM on im2col panels, `winograd` (the 36 matrices packed as one) only where it runs Winograd;
 // `subpixel` (the [4·co × 4·ci] phase weights) only where a 4×4 / stride 2 / padding 1
 // transposed convolution runs the sub-pixel form; everything else reads the original weight tensor.
 struct GemmWeights {

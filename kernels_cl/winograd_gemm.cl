@@ -1,0 +1,107 @@
+// SPDX-License-Identifier: Apache-2.0
+// The 36 products of Winograd F(4×4, 3×3) and its output transform in one kernel
+// (src/ops/winograd.cpp; the transforms are those of kernels_cl/winograd.cl). One work-item takes
+// MR output channels and 32 tiles: for each element e it runs the packed GEMM's register tile
+// (packed_tile.cl) over the ci input channels, U_e's A panel against V_e's B panel, and parks the
+// MR×32 product in local memory (36·MR·32 floats: 36 KiB at MR = 8, reused by every work-group
+// a thread runs, so it stays in the core's cache); then Y = Aᵀ m A, bias and activation go from
+// there straight into the output. The 36 products never reach global memory.
+//
+// U: the 36 matrices [co_pad × ci] (co_pad = co rounded up to MR) packed as one matrix of
+// 36·co_pad rows in MR-row panels: element e's panel p is panel e·(co_pad / MR) + p.
+// V: 36 matrices [ci × count] in panels of 32 columns, matrix e at e·v_element_floats.
+// Launch (co_pad / MR, ceil(count / 32)) work-items in work-groups of one.
+//
+// Build options: -DMR, -DHAS_BIAS, -DACTIVATION, -DNEGATIVE_SLOPE.
+
+#include "common.cl"
+
+#include "packed_tile.cl"
+
+#define ELEMENTS 36
+
+// y = Aᵀ m for 16 tiles at once (one float16 lane per tile).
+inline void transform_at16(const float16* m, float16* y) {
+  const float16 p12 = m[1] + m[2], m12 = m[1] - m[2], p34 = m[3] + m[4], m34 = m[3] - m[4];
+  y[0] = m[0] + p12 + p34;
+  y[1] = m12 + 2.0f * m34;
+  y[2] = p12 + 4.0f * p34;
+  y[3] = m12 + 8.0f * m34 + m[5];
+}
+
+#define PARK(r)                                                  \
+  vstore16(lo##r, 0, scratch + (e * MR + r) * 32);               \
+  vstore16(hi##r, 0, scratch + (e * MR + r) * 32 + 16);
+
+__kernel void winograd_gemm(__global const float* restrict u, const int u_offset, __global const float* restrict v,
+                            const int v_offset, const int v_element_floats, __global float* restrict out,
+                            const int out_offset, __global const float* restrict bias, const int bias_offset,
+                            const int out_channels, const int channels, const int out_h, const int out_w,
+                            const int tiles_w, const int first, const int count) {
+  __local float scratch[ELEMENTS * MR * 32];
+  const int panel = get_global_id(0), column_panel = get_global_id(1);
+  const int panels = get_global_size(0);  // A panels per element
+  const int row0 = panel * MR, col0 = column_panel * 32;
+  for (int e = 0; e < ELEMENTS; ++e) {
+    __global const float* ap = u + u_offset + (size_t)(e * panels + panel) * channels * MR;
+    __global const float* bp = v + v_offset + (size_t)e * v_element_floats + (size_t)column_panel * channels * 32;
+    TILE_PRODUCT(ap, bp, channels)
+    EACH_ROW(PARK)
+  }
+  for (int part = 0; part < 2; ++part) {
+    const int lane0 = col0 + 16 * part;  // the first of these 16 tiles in the range
+    if (lane0 >= count) break;
+    const int lanes = min(16, count - lane0);
+    // The 16 tiles side by side in one tile row, wholly inside the output: each of their 4 pixel
+    // rows is 64 consecutive floats, stored as 4 vectors instead of 64 scattered floats.
+    const int tile0 = first + lane0;
+    const int ty = tile0 / tiles_w, tx = tile0 - ty * tiles_w;
+    const bool whole = lanes == 16 && tx + 16 <= tiles_w && 4 * (tx + 16) <= out_w && 4 * ty + 4 <= out_h;
+    for (int r = 0; r < MR; ++r) {
+      const int o = row0 + r;
+      if (o >= out_channels) break;
+#if HAS_BIAS
+      const float b = bias[bias_offset + o];
+#else
+      const float b = 0.0f;
+#endif
+      __global float* plane = out + out_offset + (size_t)o * out_h * out_w;
+      float16 a[4][6];  // Aᵀ m, per tile lane
+      for (int q = 0; q < 6; ++q) {
+        float16 col[6], y[4];
+        for (int i = 0; i < 6; ++i) col[i] = vload16(0, scratch + ((6 * i + q) * MR + r) * 32 + 16 * part);
+        transform_at16(col, y);
+        for (int i = 0; i < 4; ++i) a[i][q] = y[i];
+      }
+      for (int i = 0; i < 4; ++i) {
+        float16 y[4];  // (Aᵀ m) A: row i of every tile, pixel q of tile j in lane j of y[q]
+        transform_at16(a[i], y);
+        for (int q = 0; q < 4; ++q) y[q] = ACTIVATE(y[q] + b);
+        if (whole) {
+          // Interleave to pixel order 4·j + q: pairs (q0, q1) and (q2, q3), then pairs of pairs.
+          const float16 lo01 = shuffle2(y[0], y[1], (uint16)(0, 16, 1, 17, 2, 18, 3, 19, 4, 20, 5, 21, 6, 22, 7, 23));
+          const float16 hi01 = shuffle2(y[0], y[1], (uint16)(8, 24, 9, 25, 10, 26, 11, 27, 12, 28, 13, 29, 14, 30, 15, 31));
+          const float16 lo23 = shuffle2(y[2], y[3], (uint16)(0, 16, 1, 17, 2, 18, 3, 19, 4, 20, 5, 21, 6, 22, 7, 23));
+          const float16 hi23 = shuffle2(y[2], y[3], (uint16)(8, 24, 9, 25, 10, 26, 11, 27, 12, 28, 13, 29, 14, 30, 15, 31));
+          const uint16 first_half = (uint16)(0, 1, 16, 17, 2, 3, 18, 19, 4, 5, 20, 21, 6, 7, 22, 23);
+          const uint16 second_half = (uint16)(8, 9, 24, 25, 10, 11, 26, 27, 12, 13, 28, 29, 14, 15, 30, 31);
+          __global float* dst = plane + (4 * ty + i) * out_w + 4 * tx;
+          vstore16(shuffle2(lo01, lo23, first_half), 0, dst);
+          vstore16(shuffle2(lo01, lo23, second_half), 1, dst);
+          vstore16(shuffle2(hi01, hi23, first_half), 2, dst);
+          vstore16(shuffle2(hi01, hi23, second_half), 3, dst);
+        } else {
+          float row[4][16];
+          for (int q = 0; q < 4; ++q) vstore16(y[q], 0, row[q]);
+          for (int j = 0; j < lanes; ++j) {
+            const int tile = tile0 + j;
+            const int y0 = 4 * (tile / tiles_w) + i, x0 = 4 * (tile % tiles_w);
+            if (y0 >= out_h) continue;
+            __global float* dst = plane + y0 * out_w + x0;
+            for (int q = 0; q < 4 && x0 + q < out_w; ++q) dst[q] = row[q][j];
+          }
+        }
+      }
+    }
+  }
+}
