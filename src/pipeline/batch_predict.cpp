@@ -245,3 +245,72 @@ RatesFileResult predict_rates_file(const PredictSettings& settings, const fs::pa
 }
 
 }  // namespace inertialnet
+
+namespace inertialnet {
+
+std::vector<std::pair<fs::path, fs::path>> pair_rates_with_sequences(const std::vector<fs::path>& rates,
+                                                                     const std::vector<fs::path>& sequences) {
+  std::vector<fs::path> files;
+  std::error_code ec;
+  for (const auto& r : rates) {
+    if (!fs::is_directory(r, ec)) {
+      files.push_back(r);
+      continue;
+    }
+    std::vector<fs::path> in_folder;
+    for (const auto& entry : fs::directory_iterator(r, ec)) {
+      if (entry.path().extension() == ".csv" && entry.is_regular_file(ec)) in_folder.push_back(entry.path());
+    }
+    if (ec) throw invalid_input("Cannot list " + r.string() + ": " + ec.message() + ".");
+    if (in_folder.empty()) throw invalid_input(r.string() + " holds no rates file (*.csv).");
+    std::sort(in_folder.begin(), in_folder.end());
+    files.insert(files.end(), in_folder.begin(), in_folder.end());
+  }
+  if (files.empty()) throw invalid_input("no rates file given.");
+  std::vector<std::pair<fs::path, fs::path>> pairs;
+  if (sequences.empty()) {
+    for (const auto& file : files) {
+      std::string where;
+      for (const auto& [key, value] : read_rates_provenance(file)) {
+        if (key == "sequence") where = value;
+      }
+      if (where.empty()) {
+        throw invalid_input(file.string() + ": its sidecar does not name its sequence (only `predict SEQ... -o "
+                            "FOLDER` records it); give the sequences with --seq.");
+      }
+      pairs.emplace_back(file, where);
+    }
+    return pairs;
+  }
+  std::map<std::string, fs::path> by_name;
+  for (const auto& sequence : sequences) {
+    const std::string stem = fs::path(batch_rates_name(sequence)).stem().string();
+    const auto [it, fresh] = by_name.emplace(stem, sequence);
+    if (!fresh) {
+      throw invalid_input("--seq " + it->second.string() + " and " + sequence.string() + " have the same name " + stem +
+                          "; their rates files could not be told apart.");
+    }
+  }
+  std::map<std::string, fs::path> used;
+  for (const auto& file : files) {
+    const std::string stem = file.stem().string();
+    const auto it = by_name.find(stem);
+    if (it == by_name.end()) {
+      std::string names;
+      for (const auto& entry : by_name) names += (names.empty() ? "" : ", ") + entry.first;
+      throw invalid_input(file.string() + ": no --seq is named " + stem + " (the sequences are " + names + ").");
+    }
+    if (!used.emplace(stem, file).second) {
+      throw invalid_input(used[stem].string() + " and " + file.string() + " are both rates of " + stem + ".");
+    }
+    pairs.emplace_back(file, it->second);
+  }
+  for (const auto& [name, sequence] : by_name) {
+    if (!used.count(name)) {
+      throw invalid_input("--seq " + sequence.string() + ": no rates file " + name + ".csv among the rates given.");
+    }
+  }
+  return pairs;
+}
+
+}  // namespace inertialnet

@@ -422,7 +422,7 @@ int predict_batch(const PredictOptions& options, const GlobalOptions& global) {
 
 Command register_predict(CLI::App& app, const GlobalOptions& global) {
   auto o = std::make_shared<PredictOptions>();
-  app.add_option("sequence", o->sequences,
+  auto* sequence_option = app.add_option("sequence", o->sequences,
                  "EuRoC folder, image folder, video, ROS bag, or a live source: /dev/videoN, camera:N, gst:PIPELINE "
                  "(ending in appsink) or capture:STRING (any OpenCV capture), read until Ctrl-C or its end; several "
                  "(or --manifest) make a batch: -o FOLDER gets one rates file per sequence");
@@ -483,12 +483,15 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
                  "a batch's sequences from this file, one path a line (relative ones to its folder; '#' comments); "
                  "with -o FOLDER")
       ->check(CLI::ExistingFile);
+  // The sequence is required unless a manifest lists them (CLI11's own message and exit 2).
+  app.callback([sequence_option, o] {
+    if (!*sequence_option && o->manifest.empty()) throw CLI::RequiredError("sequence");
+  });
   return [o, &global]() {
     // Several sequences, a manifest, or -o FOLDER/: a batch, one rates file per sequence.
     const bool batch = o->sequences.size() > 1 || !o->manifest.empty() ||
                        (!o->output.empty() && o->output.back() == '/');
     if (batch) return predict_batch(*o, global);
-    if (o->sequences.empty()) throw CLI::RequiredError("sequence");
     o->sequence = o->sequences.empty() ? std::string() : o->sequences.front();
     return predict_one(*o, global, nullptr);
   };

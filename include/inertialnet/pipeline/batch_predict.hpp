@@ -71,4 +71,11 @@ RatesFileResult predict_rates_file(const PredictSettings& settings, const std::f
                                    const Provenance& provenance, const PipelineOptions& options = {},
                                    const std::function<void(std::size_t done, std::size_t total)>& progress = {});
 
+// Rates files paired with their sequences by name: `rates` lists files or folders (a folder gives
+// its *.csv), each file's stem is the sequence's name (batch_rates_name); with
+// `sequences` empty each file's sidecar's provenance names its sequence. invalid_input for a rates
+// file without a sequence, a sequence without a rates file, or no rates file at all.
+std::vector<std::pair<std::filesystem::path, std::filesystem::path>> pair_rates_with_sequences(
+    const std::vector<std::filesystem::path>& rates, const std::vector<std::filesystem::path>& sequences);
+
 }  // namespace inertialnet
