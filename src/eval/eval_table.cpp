@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "inertialnet/eval/metrics.hpp"
+#include "inertialnet/eval/plots.hpp"
 
 namespace inertialnet {
 
@@ -134,6 +135,38 @@ std::string EvalTable::json() const {
   for (const auto& r : rows) j["sequences"].push_back(row_json(r, false));
   j["total"] = row_json(total, true);
   return j.dump(2) + "\n";
+}
+
+EvalTable evaluate_table(const std::vector<std::pair<std::filesystem::path, std::filesystem::path>>& pairs,
+                         EvalOptions options, const std::filesystem::path& plot_folder,
+                         const std::function<void(const EvalReport&)>& check,
+                         const std::function<void(const std::string&)>& warn) {
+  std::vector<EvalTableRow> rows;
+  for (const auto& pair : pairs) {
+    const std::string name = pair.first.stem().string();
+    if (!plot_folder.empty()) options.plot = plot_folder / (name + ".png");
+    const EvalReport report = evaluate(pair.first, pair.second, options);
+    if (check) check(report);
+    if (warn) {
+      for (const auto& w : report.warnings) warn(name + ": " + w);
+    }
+    rows.push_back(eval_table_row(report, name));
+  }
+  EvalTable table = eval_table(std::move(rows));
+  if (!plot_folder.empty()) {
+    std::vector<std::string> names;
+    std::vector<Vec3> rmse, zero;
+    for (const auto& r : table.rows) {
+      names.push_back(r.name);
+      rmse.push_back(r.rmse_deg_s);
+      zero.push_back(r.zero_rmse_deg_s);
+    }
+    char total[96];
+    std::snprintf(total, sizeof total, " (pooled RMSE %.2f / %.2f / %.2f deg/s)", table.total.rmse_deg_s[0],
+                  table.total.rmse_deg_s[1], table.total.rmse_deg_s[2]);
+    plot_rmse_bars(plot_folder / "summary.png", names, rmse, zero, "RMSE per sequence" + std::string(total));
+  }
+  return table;
 }
 
 }  // namespace inertialnet

@@ -13,7 +13,6 @@
 #include "input_options.hpp"
 #include "inertialnet/eval/eval_table.hpp"
 #include "inertialnet/eval/evaluate.hpp"
-#include "inertialnet/eval/plots.hpp"
 #include "inertialnet/pipeline/batch_predict.hpp"
 #include "inertialnet/io/rates_csv.hpp"
 #include "inertialnet/runtime/error.hpp"
@@ -66,30 +65,11 @@ int eval_batch(const EvalCliOptions& o, EvalOptions options) {
     prepare_output_folder(o.plot, "--plot");
   }
   if (!o.head.empty()) options.head_suffix = "_" + o.head;
-  std::vector<EvalTableRow> rows;
-  for (const auto& pair : pairs) {
-    const std::string name = pair.first.stem().string();
-    if (!o.plot.empty()) options.plot = fs::path(o.plot) / (name + ".png");
-    const EvalReport report = evaluate(pair.first, pair.second, options);
-    refuse_unreliable_offset(report);
-    for (const auto& w : report.warnings) warning(name + ": " + w);
-    rows.push_back(eval_table_row(report, name));
-  }
-  const EvalTable table = eval_table(std::move(rows));
+  const EvalTable table = evaluate_table(pairs, options, o.plot, refuse_unreliable_offset,
+                                         [](const std::string& line) { warning(line); });
   if (!o.plot.empty()) {
-    std::vector<std::string> names;
-    std::vector<Vec3> rmse, zero;
-    for (const auto& r : table.rows) {
-      names.push_back(r.name);
-      rmse.push_back(r.rmse_deg_s);
-      zero.push_back(r.zero_rmse_deg_s);
-    }
-    const fs::path summary = fs::path(o.plot) / "summary.png";
-    char total[96];
-    std::snprintf(total, sizeof total, " (pooled RMSE %.2f / %.2f / %.2f deg/s)", table.total.rmse_deg_s[0],
-                  table.total.rmse_deg_s[1], table.total.rmse_deg_s[2]);
-    plot_rmse_bars(summary, names, rmse, zero, "RMSE per sequence" + std::string(total));
-    info("plots: " + std::to_string(names.size()) + " sequences and " + summary.string());
+    info("plots: " + std::to_string(table.rows.size()) + " sequences and " +
+         (fs::path(o.plot) / "summary.png").string());
   }
   if (o.json) {
     std::cout << table.json();

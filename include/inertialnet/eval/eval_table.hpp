@@ -12,6 +12,8 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <functional>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -49,5 +51,14 @@ struct EvalTable {
 EvalTableRow eval_table_row(const EvalReport& report, const std::string& name);
 // The rows and their pooled total.
 EvalTable eval_table(std::vector<EvalTableRow> rows);
+
+// Each (rates file, sequence) evaluated with `options` (its plot, when `plot_folder` is given,
+// <folder>/<name>.png with its histogram beside it, then <folder>/summary.png: plot_rmse_bars),
+// the rows named by the rates files' stems. `check` sees each report first (the CLI refuses an
+// unreliable --time-offset auto there); `warn` gets each report's warnings, prefixed by the name.
+EvalTable evaluate_table(const std::vector<std::pair<std::filesystem::path, std::filesystem::path>>& pairs,
+                         EvalOptions options, const std::filesystem::path& plot_folder = {},
+                         const std::function<void(const EvalReport&)>& check = {},
+                         const std::function<void(const std::string&)>& warn = {});
 
 }  // namespace inertialnet
