@@ -390,18 +390,19 @@ int predict_batch(const PredictOptions& options, const GlobalOptions& global) {
     PredictOptions one = options;
     one.sequence = sequences[i].string();
     one.output = outputs[i].string();
-    const Provenance provenance = prediction_provenance(settings_of(one, global), one.max_pairs);
-    std::string why;
-    if (rates_file_current(outputs[i], provenance, &why)) {
-      info(tag + ": skipped (current): " + one.output);
-      ++skipped;
-      continue;
-    }
-    info(tag + ": computing (" + why + ")");
     const std::string stopped = "the batch stopped at " + name + " (" + std::to_string(i + 1) + " of " +
                                 std::to_string(sequences.size()) + "); rerun the same command to resume it";
     int rc = 0;
     try {
+      // A sequence that cannot be read stops the batch here too, named.
+      const Provenance provenance = prediction_provenance(settings_of(one, global), one.max_pairs);
+      std::string why;
+      if (rates_file_current(outputs[i], provenance, &why)) {
+        info(tag + ": skipped (current): " + one.output);
+        ++skipped;
+        continue;
+      }
+      info(tag + ": computing (" + why + ")");
       rc = predict_one(one, global, &provenance);
     } catch (const Error&) {
       std::cerr << "inertialnet: " << stopped << "\n";  // then the error itself, from main
