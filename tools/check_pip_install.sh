@@ -10,7 +10,9 @@ venv=build/pip-install-venv
 rm -rf "$venv"
 python3 -m venv "$venv"
 start=$(date +%s)
-"$venv/bin/python" -m pip install -q --disable-pip-version-check ".[test]"
+# With the [ray] extra, so that inertialnet.batch's Ray test runs here too (it is skipped only
+# outside CI when ray is missing).
+"$venv/bin/python" -m pip install -q --disable-pip-version-check ".[test,ray]"
 echo "check_pip_install: pip install . took $(( $(date +%s) - start )) s"
 # From outside the source tree, so that `import inertialnet` finds the installed package.
 cd "$venv"

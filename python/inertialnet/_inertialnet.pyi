@@ -114,6 +114,18 @@ def _write_rates_csv(path: _Path, columns: list[str], t: npt.ArrayLike, values: 
 def _read_rates_csv(path: _Path) -> tuple[list[str], npt.NDArray[np.int64], npt.NDArray[np.float64], list[str],
                                           list[list[str]], list[tuple[str, str]]]: ...
 
+# The native halves of inertialnet.batch (batch.py): the CLI's batch files, names and table.
+def _predict_rates_file(rates: _Path, skip_current: bool, sequence: _Path, weights: list[str], model: str, flow: str,
+                        head: str, solver: str, fx: Optional[float], fy: Optional[float], cx: Optional[float],
+                        cy: Optional[float], rate_hz: float, device: str, keep_flow: bool, max_pairs: SupportsIndex,
+                        lanes: int, decode_threads: int, flow_check: float,
+                        progress: Optional[Callable[[int, int], object]], time_offset: Optional[float],
+                        readout_time: float, camera: str, calibration: str, calibration_camera: str,
+                        image_topic: str, camera_info_topic: str) -> dict[str, Union[str, int]]: ...
+def _batch_rates_paths(sequences: list[_Path], folder: _Path) -> list[str]: ...
+def _read_batch_manifest(manifest: _Path) -> list[str]: ...
+def _eval_table(rates: list[_Path], sequences: list[_Path], format: str, plot: _Path, target: str, head: str) -> str: ...
+
 # python/src/stream_bindings.cpp: what inertialnet.stream() returns (streaming.py has the arguments).
 class _Stream:
     def __init__(self, sequence: str, weights: list[str], model: str, flow: str, head: str, solver: str,

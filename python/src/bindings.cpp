@@ -36,6 +36,8 @@
 
 #include "inertialnet/inertialnet.hpp"
 #include "inertialnet/io/calibration_file.hpp"
+#include "inertialnet/eval/eval_table.hpp"
+#include "inertialnet/pipeline/batch_predict.hpp"
 
 namespace py = pybind11;
 using namespace inertialnet;
@@ -1037,6 +1039,126 @@ py::tuple read_rates(const std::filesystem::path& path) {
 
 }  // namespace
 
+// The settings of predict() from its arguments, checked as the CLI checks its options (predict and
+// the batch's _predict_rates_file share them).
+PredictSettings python_predict_settings(const std::filesystem::path& sequence, const std::vector<std::string>& weights, const std::string& model,
+                                        const std::string& flow, const std::string& head, const std::string& solver, const py::object& fx,
+                                        const py::object& fy, const py::object& cx, const py::object& cy, double rate_hz, const std::string& device,
+                                        bool keep_flow, const py::object& max_pairs, int lanes, int decode_threads, double flow_check,
+                                        const py::object& progress, const py::object& time_offset, double readout_time, const std::string& camera,
+                                        const std::string& calibration, const std::string& calibration_camera, const std::string& image_topic,
+                                        const std::string& camera_info_topic) {
+  // The CLI's checks of --max-pairs, --rate, --fx, --fy: a value they refuse is a ValueError
+  // here, not ignored (a negative rate or focal length was taken as "not given").
+  const std::int64_t pairs = integer_of(max_pairs, "max_pairs");
+  if (pairs < 0) {
+    throw invalid_input("max_pairs must be a count of pairs (0 for all), got " + std::to_string(pairs));
+  }
+  rate_of(rate_hz);
+  // None: not given. fx, fy: 0 is "not given" too (never a focal length); cx, cy: any
+  // coordinate within 1e6 pixels, 0 included (a principal point at the corner), as
+  // --cx and --cy take it.
+  const auto focal = [](const py::object& value, const char* name, const char* zero_means) {
+    return value.is_none() ? std::optional<double>()
+                           : std::optional<double>(zero_or_positive(value.cast<double>(), name, "pixels", zero_means));
+  };
+  const auto coordinate = [](const py::object& value, const char* name) {
+    if (value.is_none()) return std::optional<double>();
+    const double x = value.cast<double>();
+    if (!(std::abs(x) <= 1e6)) {
+      throw invalid_input(std::string(name) + " must be a finite pixel coordinate within 1e+06 of the origin, got " +
+                          got(x));
+    }
+    return std::optional<double>(x);
+  };
+  const auto given_fx = focal(fx, "fx", "the calibration's focal length");
+  const auto given_fy = focal(fy, "fy", "fx");
+  const auto given_cx = coordinate(cx, "cx"), given_cy = coordinate(cy, "cy");
+  if (!progress.is_none() && !PyCallable_Check(progress.ptr())) {
+    throw py::type_error("progress must be a callable taking (done, total), or None, not " +
+                         type_name(progress));
+  }
+  PredictSettings s;
+  s.sequence = existing_sequence(sequence);
+  // Stated in the rates' metadata for evaluate(), as predict --time-offset/--readout-time
+  // state them in the CSV; the Prediction checks their ranges.
+  if (!time_offset.is_none()) s.time_offset_s = time_offset.cast<double>();
+  s.readout_time_s = readout_time;
+  s.camera = camera;
+  s.weights = weights;
+  s.model = model;
+  s.flow = flow;
+  s.head = head;
+  s.solver = solver;
+  s.fx = given_fx;
+  s.fy = given_fy;
+  s.cx = given_cx;
+  s.cy = given_cy;
+  s.calibration = calibration.empty() ? std::filesystem::path() : existing(calibration, "the calibration file");
+  s.calibration_camera = calibration_camera;
+  s.bag.image = image_topic;
+  s.bag.camera_info = camera_info_topic;
+  s.rate_hz = rate_hz;
+  s.device = device;
+  s.keep_flow = keep_flow;
+  s.flow_check_px = flow_check;
+  if (lanes < 1 || decode_threads < 1) throw invalid_input("lanes and decode_threads must be at least 1");
+  return s;
+}
+
+// Batches (inertialnet.batch, one Ray task per sequence): one sequence into its rates file as
+// `inertialnet predict SEQ... -o FOLDER` writes it, byte for byte, with the same provenance, and
+// skipped by the same rule when that file is complete and current (pipeline/batch_predict.hpp).
+py::dict predict_rates_file_of(const std::filesystem::path& rates, bool skip_current, const PredictSettings& settings,
+                               std::size_t max_pairs, int lanes, int decode_threads, const py::object& progress) {
+  const Provenance provenance = prediction_provenance(settings, max_pairs);
+  py::dict out;
+  std::string why;
+  if (skip_current && rates_file_current(rates, provenance, &why)) {
+    out["status"] = "skipped";
+    out["reason"] = "current";
+    out["pairs"] = 0;
+    out["unanswered"] = "";
+    return out;
+  }
+  ProgressReport report(progress);
+  RatesFileResult result;
+  run_interruptibly([&](const std::atomic<bool>& stop) {
+    PipelineOptions options;
+    options.lanes_per_device = lanes;
+    options.decode_threads = decode_threads;
+    options.max_pairs = max_pairs;
+    options.cancel = &stop;
+    result = predict_rates_file(settings, rates, provenance, options, [&](std::size_t done, std::size_t total) {
+      if (done == 1) report.start(total);
+      report.pair_done();
+    });
+  }, [&] { report.report(); });
+  report.report();
+  out["status"] = "computed";
+  out["reason"] = why;
+  out["pairs"] = result.pairs;
+  out["unanswered"] = result.tally.summary();
+  return out;
+}
+
+// The batch's table (eval_table.hpp) as `inertialnet eval RATES... --seq SEQ...` prints it.
+std::string eval_table_of(const std::vector<std::filesystem::path>& rates, const std::vector<std::filesystem::path>& sequences,
+                          const std::string& format, const std::filesystem::path& plot, const std::string& target,
+                          const std::string& head) {
+  EvalOptions options;
+  options.choose_target = target.empty();
+  options.sync.target = parse_sync_target(target.empty() ? "spline" : target);
+  if (!head.empty()) options.head_suffix = "_" + head;
+  const auto pairs = pair_rates_with_sequences(rates, sequences);
+  if (!plot.empty()) std::filesystem::create_directories(plot);
+  const EvalTable table = evaluate_table(pairs, options, plot);
+  if (format == "csv") return table.csv();
+  if (format == "json") return table.json();
+  if (format != "text") throw invalid_input("format must be text, csv or json, not " + format);
+  return table.text();
+}
+
 PYBIND11_MODULE(_inertialnet, m) {
   void register_stream(py::module_&); register_stream(m);  // stream(): python/src/stream_bindings.cpp
   m.doc() = "InertialNet-CL: FlowNet2 optical flow and angular-rate heads on OpenCL (native module)";
@@ -1184,64 +1306,34 @@ PYBIND11_MODULE(_inertialnet, m) {
            const py::object& progress, const py::object& time_offset, double readout_time, const std::string& camera,
            const std::string& calibration, const std::string& calibration_camera, const std::string& image_topic,
            const std::string& camera_info_topic) {
-          // The CLI's checks of --max-pairs, --rate, --fx, --fy: a value they refuse is a ValueError
-          // here, not ignored (a negative rate or focal length was taken as "not given").
-          const std::int64_t pairs = integer_of(max_pairs, "max_pairs");
-          if (pairs < 0) {
-            throw invalid_input("max_pairs must be a count of pairs (0 for all), got " + std::to_string(pairs));
-          }
-          rate_of(rate_hz);
-          // None: not given. fx, fy: 0 is "not given" too (never a focal length); cx, cy: any
-          // coordinate within 1e6 pixels, 0 included (a principal point at the corner), as
-          // --cx and --cy take it.
-          const auto focal = [](const py::object& value, const char* name, const char* zero_means) {
-            return value.is_none() ? std::optional<double>()
-                                   : std::optional<double>(zero_or_positive(value.cast<double>(), name, "pixels", zero_means));
-          };
-          const auto coordinate = [](const py::object& value, const char* name) {
-            if (value.is_none()) return std::optional<double>();
-            const double x = value.cast<double>();
-            if (!(std::abs(x) <= 1e6)) {
-              throw invalid_input(std::string(name) + " must be a finite pixel coordinate within 1e+06 of the origin, got " +
-                                  got(x));
-            }
-            return std::optional<double>(x);
-          };
-          const auto given_fx = focal(fx, "fx", "the calibration's focal length");
-          const auto given_fy = focal(fy, "fy", "fx");
-          const auto given_cx = coordinate(cx, "cx"), given_cy = coordinate(cy, "cy");
-          if (!progress.is_none() && !PyCallable_Check(progress.ptr())) {
-            throw py::type_error("progress must be a callable taking (done, total), or None, not " +
-                                 type_name(progress));
-          }
-          PredictSettings s;
-          s.sequence = existing_sequence(sequence);
-          // Stated in the rates' metadata for evaluate(), as predict --time-offset/--readout-time
-          // state them in the CSV; the Prediction checks their ranges.
-          if (!time_offset.is_none()) s.time_offset_s = time_offset.cast<double>();
-          s.readout_time_s = readout_time;
-          s.camera = camera;
-          s.weights = weights;
-          s.model = model;
-          s.flow = flow;
-          s.head = head;
-          s.solver = solver;
-          s.fx = given_fx;
-          s.fy = given_fy;
-          s.cx = given_cx;
-          s.cy = given_cy;
-          s.calibration = calibration.empty() ? std::filesystem::path() : existing(calibration, "the calibration file");
-          s.calibration_camera = calibration_camera;
-          s.bag.image = image_topic;
-          s.bag.camera_info = camera_info_topic;
-          s.rate_hz = rate_hz;
-          s.device = device;
-          s.keep_flow = keep_flow;
-          s.flow_check_px = flow_check;
-          if (lanes < 1 || decode_threads < 1) throw invalid_input("lanes and decode_threads must be at least 1");
-          return predict(s, static_cast<std::size_t>(pairs), lanes, decode_threads, progress);
+          const PredictSettings s = python_predict_settings(sequence, weights, model, flow, head, solver, fx, fy, cx, cy, rate_hz, device, keep_flow, max_pairs, lanes, decode_threads, flow_check, progress, time_offset, readout_time, camera, calibration, calibration_camera, image_topic, camera_info_topic);
+          return predict(s, static_cast<std::size_t>(integer_of(max_pairs, "max_pairs")), lanes, decode_threads, progress);
         });
   m.def("_evaluate_json", &evaluate_json);
+  // Batches (inertialnet/batch.py).
+  m.def("_predict_rates_file",
+        [](const std::filesystem::path& rates, bool skip_current, const std::filesystem::path& sequence, const std::vector<std::string>& weights, const std::string& model,
+           const std::string& flow, const std::string& head, const std::string& solver, const py::object& fx,
+           const py::object& fy, const py::object& cx, const py::object& cy, double rate_hz, const std::string& device,
+           bool keep_flow, const py::object& max_pairs, int lanes, int decode_threads, double flow_check,
+           const py::object& progress, const py::object& time_offset, double readout_time, const std::string& camera,
+           const std::string& calibration, const std::string& calibration_camera, const std::string& image_topic,
+           const std::string& camera_info_topic) {
+          const PredictSettings s = python_predict_settings(sequence, weights, model, flow, head, solver, fx, fy, cx, cy, rate_hz, device, keep_flow, max_pairs, lanes, decode_threads, flow_check, progress, time_offset, readout_time, camera, calibration, calibration_camera, image_topic, camera_info_topic);
+          return predict_rates_file_of(rates, skip_current, s, static_cast<std::size_t>(integer_of(max_pairs, "max_pairs")),
+                                       lanes, decode_threads, progress);
+        });
+  m.def("_batch_rates_paths", [](const std::vector<std::filesystem::path>& sequences, const std::filesystem::path& folder) {
+    std::vector<std::string> paths;
+    for (const auto& p : batch_rates_paths(sequences, folder)) paths.push_back(p.string());
+    return paths;
+  });
+  m.def("_read_batch_manifest", [](const std::filesystem::path& manifest) {
+    std::vector<std::string> paths;
+    for (const auto& p : read_batch_manifest(manifest)) paths.push_back(p.string());
+    return paths;
+  });
+  m.def("_eval_table", &eval_table_of);
   m.def("_write_rates_csv",
         [](const std::filesystem::path& path, const std::vector<std::string>& columns, const py::array& t,
            const py::array& values, const std::vector<std::string>& status_names,

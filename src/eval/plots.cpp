@@ -293,4 +293,46 @@ void plot_loss_curves(const std::filesystem::path& png, const std::vector<double
   write_png(png, img);
 }
 
+void plot_rmse_bars(const std::filesystem::path& png, const std::vector<std::string>& names,
+                    const std::vector<Vec3>& rmse, const std::vector<Vec3>& zero_rmse, const std::string& title,
+                    const PlotStyle& style) {
+  check_size(style);
+  if (names.empty() || rmse.size() != names.size() || zero_rmse.size() != names.size()) {
+    throw invalid_input("RMSE plot: " + std::to_string(names.size()) + " sequences, " + std::to_string(rmse.size()) +
+                        " RMSE and " + std::to_string(zero_rmse.size()) + " zero-predictor RMSE; expected equal, "
+                        "non-zero counts.");
+  }
+  cv::Mat img(style.height, style.width, CV_8UC3, kWhite);
+  draw_title(img, title);
+  const int left = 100, right = 25, top = 55, bottom = 90, gap = 55;
+  const int panel_h = (style.height - top - bottom - 2 * gap) / 3;
+  const double n = static_cast<double>(names.size());
+  const cv::Scalar zero_grey(200, 200, 200);
+  static const char* axes[3] = {"wx", "wy", "wz"};
+  for (int k = 0; k < 3; ++k) {
+    double hi = 0;
+    for (std::size_t i = 0; i < names.size(); ++i) hi = std::max({hi, rmse[i][k], zero_rmse[i][k]});
+    Panel p{cv::Rect(left, top + k * (panel_h + gap), style.width - left - right, panel_h), 0, n, 0,
+            hi > 0 ? hi * 1.1 : 1.0};
+    // Sequence names label the bars (below the last panel), not numeric ticks.
+    draw_axes(img, p, "", std::string("RMSE ") + axes[k] + " [deg/s]", "", false);
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      const double x = static_cast<double>(i);
+      const cv::Rect zero_bar(cv::Point(p.px(x + 0.15), p.py(zero_rmse[i][k])), cv::Point(p.px(x + 0.85), p.py(0)));
+      cv::rectangle(img, zero_bar, zero_grey, cv::FILLED);
+      const cv::Rect bar(cv::Point(p.px(x + 0.3), p.py(rmse[i][k])), cv::Point(p.px(x + 0.7), p.py(0)));
+      cv::rectangle(img, bar, kBar, cv::FILLED);
+      cv::rectangle(img, bar, cv::Scalar(120, 80, 30), 1);
+      if (k == 2) {
+        const cv::Size ts = text_size(names[i], kTickScale);
+        put(img, names[i], {p.px(x + 0.5) - ts.width / 2, p.area.y + p.area.height + 40 + ts.height}, kTickScale,
+            kBlack);
+      }
+    }
+    cv::rectangle(img, p.area, kAxisGrey, 1);
+    draw_legend(img, p.area, {{"prediction", kBar, 8}, {"zero predictor", zero_grey, 8}});
+  }
+  write_png(png, img);
+}
+
 }  // namespace inertialnet

@@ -667,7 +667,21 @@ const fs::path& RatesCsvWriter::journal() const { return out_->journal; }
 bool RatesCsvWriter::has_sidecar() const { return !out_->in_place; }
 
 void RatesCsvWriter::close() {
-  if (out_) out_->close(rates_sidecar_text(metadata_, rows_, out_->hash));
+  if (!out_) return;
+  std::string sidecar = rates_sidecar_text(metadata_, rows_, out_->hash);
+  if (!block_name_.empty()) {
+    nlohmann::ordered_json doc = nlohmann::ordered_json::parse(sidecar);
+    doc[block_name_] = nlohmann::ordered_json::object();
+    for (const auto& [key, value] : block_) doc[block_name_][key] = value;
+    sidecar = doc.dump(2) + "\n";
+  }
+  out_->close(sidecar);
+}
+
+void RatesCsvWriter::set_sidecar_block(const std::string& name,
+                                       const std::vector<std::pair<std::string, std::string>>& entries) {
+  block_name_ = name;
+  block_ = entries;
 }
 
 void RatesCsvWriter::write(const RatesRow& row) {

@@ -12,7 +12,9 @@
 #include "common.hpp"
 #include "console.hpp"
 #include "input_options.hpp"
+#include "inertialnet/eval/eval_table.hpp"
 #include "inertialnet/eval/evaluate.hpp"
+#include "inertialnet/pipeline/batch_predict.hpp"
 #include "inertialnet/io/rates_csv.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/runtime/excerpt.hpp"
@@ -21,12 +23,65 @@ namespace inertialnet::cli {
 
 namespace {
 struct EvalCliOptions {
-  std::string rates, sequence, plot, target, gyro_bias, head, time_offset, readout_time, rotation_correction;
+  std::string rates, sequence, plot, format = "text", target, gyro_bias, head, time_offset, readout_time, rotation_correction;
   double offset_range = 0.2;
   bool json = false, series = false, camera_frame = false;
   ImuCliOptions input;
   std::string calibration_from;  // calibrate --json's report (issue 22)
+  std::vector<std::string> more;  // the positionals after RATES: the sequence, or in a batch more rates
+  std::vector<std::string> seq;   // --seq: a batch's sequences
 };
+
+// --time-offset auto with an estimate that cannot be trusted: refused (exit 2), saying why.
+void refuse_unreliable_offset(const EvalReport& report) {
+  if (const auto& e = report.time_offset_estimate; e && (e->confidence() == "low" || e->confidence() == "none")) {
+    // An offset applied silently would be read as measured; metrics without it would not be
+    // what `auto` asked for. Refuse, say why and what to do instead.
+    char estimate[64];
+    std::snprintf(estimate, sizeof estimate, "%+.2f ms, confidence low", e->offset_s * 1e3);
+    throw invalid_input(std::string("--time-offset auto: the camera-IMU time offset") +
+                        (report.estimator.empty() ? "" : " of " + report.estimator) +
+                        (e->determined ? std::string(" estimated (") + estimate + ") is not reliable: "
+                                       : std::string(" is not determined: ")) +
+                        e->unreliable_reason() +
+                        "; not applying it. Give the offset instead (--time-offset 0, or a calibration's), or a "
+                        "wider --time-offset-range when the best alignment lies on its edge.");
+  }
+}
+
+// `eval RATES... --seq SEQ...` or `eval FOLDER`: every rates file against its sequence (paired by
+// name, pipeline/batch_predict.hpp), the per-sequence table with its pooled total (eval_table.hpp),
+// with --plot FOLDER one plot per sequence (<name>.png, <name>_hist.png) and summary.png.
+int eval_batch(const EvalCliOptions& o, EvalOptions options) {
+  namespace fs = std::filesystem;
+  std::vector<fs::path> rates = {o.rates};
+  rates.insert(rates.end(), o.more.begin(), o.more.end());
+  const std::vector<fs::path> sequences(o.seq.begin(), o.seq.end());
+  const auto pairs = pair_rates_with_sequences(rates, sequences);
+  if (!o.plot.empty()) {
+    std::error_code ec;
+    if (fs::exists(o.plot, ec) && !fs::is_directory(o.plot, ec)) {
+      throw invalid_input("--plot " + o.plot + ": it exists and is not a folder; a batch writes one plot per sequence "
+                          "and summary.png into a folder.");
+    }
+    prepare_output_folder(o.plot, "--plot");
+  }
+  if (!o.head.empty()) options.head_suffix = "_" + o.head;
+  const EvalTable table = evaluate_table(pairs, options, o.plot, refuse_unreliable_offset,
+                                         [](const std::string& line) { warning(line); });
+  if (!o.plot.empty()) {
+    info("plots: " + std::to_string(table.rows.size()) + " sequences and " +
+         (fs::path(o.plot) / "summary.png").string());
+  }
+  if (o.json) {
+    std::cout << table.json();
+  } else if (o.format == "csv") {
+    std::cout << table.csv();
+  } else {
+    std::cout << table.text();
+  }
+  return 0;
+}
 
 // --calibration-from FILE: the time offset and rotation correction of calibrate's (or
 // calibrate-time's) JSON report. Its offset holds for rates predicted with its
@@ -52,13 +107,24 @@ void apply_calibration_from(const EvalCliOptions& o, EvalOptions& options) {
 
 Command register_eval(CLI::App& app, const GlobalOptions&) {
   auto o = std::make_shared<EvalCliOptions>();
-  app.add_option("rates", o->rates, "rates CSV written by predict")->required()->check(CLI::ExistingFile);
-  app.add_option("sequence", o->sequence, "EuRoC sequence with mav0/imu0, an image folder or video with --imu, or a ROS bag")
+  app.add_option("rates", o->rates,
+                 "rates CSV written by predict; with --seq, or a folder of them, the first of a batch's rates")
       ->required()
       ->check(CLI::ExistingPath);
+  auto* sequence_option = app.add_option("sequence", o->more,
+                 "EuRoC sequence with mav0/imu0, an image folder or video with --imu, or a ROS bag; with --seq, more "
+                 "rates files or folders")
+      ->check(CLI::ExistingPath);
+  app.add_option("--seq", o->seq,
+                 "a batch: the sequences of the rates files, paired by name (SEQ's name = the rates file's stem); "
+                 "without it, `eval FOLDER` takes each sequence from its rates file's sidecar")
+      ->check(CLI::ExistingPath);
+  app.add_option("--format", o->format, "a batch's table: text or csv (--json for JSON)")
+      ->capture_default_str()
+      ->transform(choice("format", {"text", "csv"}));
   app.add_option("--plot", o->plot,
                  "write time-series plots to this PNG (and histograms beside it, *_hist.png; folders created as "
-                 "needed)");
+                 "needed); in a batch a folder: <name>.png per sequence and summary.png");
   app.add_option("--target", o->target,
                  "ground truth at each frame: spline (the paper) or mean (interval mean); default: the one that fits "
                  "the estimator the rates file states (mean for an inter-frame rotation), else spline")
@@ -84,8 +150,17 @@ Command register_eval(CLI::App& app, const GlobalOptions&) {
   add_imu_options(app, o->input);
   add_calibration_options(app, o->input.calibration);
   app.add_option("--head", o->head, "compare columns wx<_HEAD>…, e.g. --head geometric");
-  auto* json = app.add_flag("--json", o->json, "machine-readable report (schema inertialnet.eval/1, docs/cli.md)");
+  auto* json = app.add_flag("--json", o->json,
+                            "machine-readable report (schema inertialnet.eval/1; a batch's table inertialnet.eval_table/1; "
+                            "docs/cli.md)");
   app.add_flag("--series", o->series, "include the per-frame values in the --json report")->needs(json);
+  // The sequence is required unless it is a batch (--seq, or a folder of rates); CLI11's message, exit 2.
+  app.callback([sequence_option, o] {
+    std::error_code ec;
+    if (!*sequence_option && o->seq.empty() && !std::filesystem::is_directory(o->rates, ec)) {
+      throw CLI::RequiredError("sequence");
+    }
+  });
   return [o]() {
     EvalOptions options;
     options.choose_target = o->target.empty();
@@ -115,6 +190,16 @@ Command register_eval(CLI::App& app, const GlobalOptions&) {
       options.sync.gyro_bias = parse_vec3(o->gyro_bias, "--gyro-bias");
     }
     options.input = imu_sequence_options(o->input);
+    // Several rates files, --seq, or a folder of rates: a batch and its table.
+    std::error_code ec;
+    if (!o->seq.empty() || std::filesystem::is_directory(o->rates, ec)) return eval_batch(*o, options);
+    if (o->more.size() > 1) {
+      throw invalid_input("eval RATES SEQ takes one sequence; for several rates files give their sequences with --seq "
+                          "(a batch).");
+    }
+    if (o->format != "text") throw invalid_input("--format " + o->format + ": the table of a batch (with --seq); one "
+                                                 "sequence's report is text or --json.");
+    o->sequence = o->more.front();
     options.plot = o->plot;
     if (!o->plot.empty()) {
       // The plot and its histogram beside it never replace what eval reads.
@@ -146,19 +231,7 @@ Command register_eval(CLI::App& app, const GlobalOptions&) {
         options.plot = plot.parent_path() / (plot.stem().string() + suffixes[i] + plot.extension().string());
       }
       const EvalReport report = evaluate(o->rates, o->sequence, options);
-      if (const auto& e = report.time_offset_estimate; e && (e->confidence() == "low" || e->confidence() == "none")) {
-        // An offset applied silently would be read as measured; metrics without it would not be
-        // what `auto` asked for. Refuse, say why and what to do instead.
-        char estimate[64];
-        std::snprintf(estimate, sizeof estimate, "%+.2f ms, confidence low", e->offset_s * 1e3);
-        throw invalid_input(std::string("--time-offset auto: the camera-IMU time offset") +
-                            (report.estimator.empty() ? "" : " of " + report.estimator) +
-                            (e->determined ? std::string(" estimated (") + estimate + ") is not reliable: "
-                                           : std::string(" is not determined: ")) +
-                            e->unreliable_reason() +
-                            "; not applying it. Give the offset instead (--time-offset 0, or a calibration's), or a "
-                            "wider --time-offset-range when the best alignment lies on its edge.");
-      }
+      refuse_unreliable_offset(report);
       if (!o->json) {
         info("target " + to_string(report.target) +
              (o->target.empty() ? " (chosen for the estimator; --target spline|mean to change it)" : ""));

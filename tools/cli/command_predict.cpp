@@ -20,6 +20,7 @@
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/runtime/layer_profiler.hpp"
 #include "inertialnet/io/flow_io.hpp"
+#include "inertialnet/pipeline/batch_predict.hpp"
 #include "inertialnet/pipeline/pipeline.hpp"
 #include "inertialnet/pipeline/predict.hpp"
 #include "inertialnet/io/rates_csv.hpp"
@@ -57,6 +58,8 @@ void print_memory(const PipelineStats& stats) {
 
 struct PredictOptions {
   std::string sequence;
+  std::vector<std::string> sequences;  // the positional arguments; one is `sequence`
+  std::string manifest;                // --manifest: a batch's sequences, one a line
   std::vector<std::string> weights;
   std::string model;
   std::string flow;   // "" = flownet2 with weights, dis without
@@ -145,14 +148,288 @@ void append_row(RatesTable& table, const RatesLayout& layout, const RatesRow& ro
   }
 }
 
+// PredictSettings from the options (the profiler is the caller's).
+PredictSettings settings_of(const PredictOptions& options, const GlobalOptions& global) {
+  const PredictOptions* o = &options;
+  PredictSettings settings;
+  settings.sequence = o->sequence;
+  settings.weights = o->weights;
+  settings.model = o->model;
+  settings.flow = o->flow;
+  settings.head = o->head;
+  settings.solver = o->solver;
+  settings.fx = o->camera.fx;
+  settings.fy = o->camera.fy;
+  settings.cx = o->camera.cx;
+  settings.cy = o->camera.cy;
+  settings.calibration = o->camera.calibration.file;
+  settings.calibration_camera = o->camera.calibration.camera;
+  settings.rate_hz = o->rate_hz;
+  settings.camera = o->camera_name;
+  settings.bag = o->bag;
+  settings.flow_check_px = o->flow_check_px;
+  if (!o->readout_time.empty()) settings.readout_time_s = parse_seconds(o->readout_time, "--readout-time");
+  if (!o->time_offset.empty()) settings.time_offset_s = parse_seconds(o->time_offset, "--time-offset");
+  settings.device = global.device;
+  settings.no_cache = global.no_cache;
+  settings.keep_flow = !o->save_flow.empty();
+  return settings;
+}
+
+// One sequence: `predict SEQ [-o FILE]`; in a batch, `provenance` goes into the sidecar.
+int predict_one(const PredictOptions& given, const GlobalOptions& global, const Provenance* provenance) {
+  const PredictOptions* o = &given;
+  const bool have_weights = !o->weights.empty();
+  LayerProfiler profiler;  // declared before the devices, whose queues report to it
+  PredictSettings settings = settings_of(given, global);
+  if (o->profile) settings.profiler = &profiler;
+  check_predict_outputs(*o);  // before the weights load and any pair is computed
+  Prediction prediction(settings);
+  for (const auto& note : prediction.notes()) info("note: " + note);
+  if (const WeightSet* weights = prediction.weights()) warn_if_synthetic(*weights);
+  const RatesProcessorOptions& processor = prediction.processor();
+
+  const std::size_t pairs = prediction.pairs(o->max_pairs);
+  // A live source runs until Ctrl-C or its end; Ctrl-C is then its normal end, not an interruption.
+  const bool live = prediction.source().open_ended();
+  const auto& infos = prediction.device_infos();
+  if (!have_weights) {
+    info(std::string("no weights given: weight-free ") + (o->flow == "lk" ? "Lucas-Kanade" : "DIS") +
+         " optical flow + geometric head");
+  }
+  const std::string count = !live      ? std::to_string(pairs) + " pairs"
+                            : pairs > 0 ? "up to " + std::to_string(pairs) + " pairs"
+                                        : std::string("pairs until Ctrl-C or its end");
+  std::string summary = prediction.source().description() + ", " + count + ", " +
+                        prediction.method() + " on " + std::to_string(infos.size()) + " device" +
+                        (infos.size() > 1 ? "s" : "") + " (" + infos.front().name + (infos.size() > 1 ? ", …" : "") + ")";
+  if (processor.geometric_head) {
+    summary += std::string("; geometric rates in the ") +
+               (processor.camera_to_body ? "body (IMU) frame" : "camera frame");
+  }
+  info(summary);
+  // Timing keeps the first run's kernel compile (and each network's planning) out of its figures.
+  if (o->stats || o->profile) {
+    prediction.warm_up([](const DeviceInfo& device, double seconds) {
+      char text[32];
+      std::snprintf(text, sizeof text, "%.2f", seconds);
+      info("warm-up pair on " + device.name + ": " + text + " s (kernel compile and planning; not counted below)");
+    });
+    if (o->profile) profiler.collect();  // the warm-up pair is not one of the profiled ones
+  }
+
+  // Columns: wx,wy,wz,status for the first estimator; a second one adds its group
+  // wx_<name>,wy_<name>,wz_<name>,status_<name>. Every pair gets a row, answered or not.
+  const RatesLayout layout = prediction.layout();
+  std::unique_ptr<RatesCsvWriter> file_writer;
+  const auto metadata = prediction.csv_metadata();
+  const bool csv = o->format == "csv";
+  // --format gcsv|euroc-imu|tum: the rows as the CSV would hold them, converted at the end by
+  // the code `export` runs.
+  RatesTable collected;
+  collected.metadata = metadata;
+  collected.extra_names = layout.extra_names;
+  collected.extra.resize(layout.extra_names.size());
+  collected.status_names = {"status"};
+  collected.status_names.insert(collected.status_names.end(), layout.status_names.begin(), layout.status_names.end());
+  collected.statuses.resize(collected.status_names.size());
+  if (o->format == "euroc-imu" && collected.meta("frame").value_or("") != "body") {
+    // Said before any pair is computed: EuRoC's columns are the IMU frame (`export` would refuse).
+    throw invalid_input("--format euroc-imu: the rates of " + prediction.source().description() + " are in the " +
+                        collected.meta("frame").value_or("camera") + " frame (no camera-IMU rotation known), and "
+                        "EuRoC's columns are the IMU frame; give the calibration, or write the CSV (--format csv) and "
+                        "use `inertialnet export --format euroc-imu --allow-camera-frame`.");
+  }
+  if (csv && !o->output.empty()) file_writer = std::make_unique<RatesCsvWriter>(o->output, layout, metadata);
+  if (file_writer && provenance) file_writer->set_sidecar_block(kProvenanceBlock, *provenance);
+  if (csv && (!file_writer || !file_writer->has_sidecar())) {
+    // A stream has no sidecar: its metadata go to the standard error, in words.
+    std::string stated;
+    for (const auto& [key, value] : metadata) stated += (stated.empty() ? "" : ", ") + key + ": " + value;
+    info(std::string("note: the rates' metadata (a stream has no sidecar): schema: ") + kRatesSchema +
+         (stated.empty() ? "" : ", " + stated));
+  }
+  if (csv && !file_writer) std::cout << rates_csv_header(layout);
+
+  // A live run's rows are its progress (its length is unknown, so there is no bar to draw).
+  std::optional<Progress> progress;
+  if (!live) progress.emplace("predict", pairs);
+  std::size_t done = 0;
+  UnansweredTally tally;
+  auto sink = [&](const PairResult& r) {
+    const RatesRow row = rates_row(r);
+    if (!csv) {
+      append_row(collected, layout, row);
+    } else if (file_writer) {
+      file_writer->write(row);
+    } else {
+      std::cout << format_rates_row(layout, row);
+      flush_standard_output();  // a row at a time, so a closed pipe stops the run at once
+    }
+    tally.add(r);
+    for (const auto& line : unanswered_messages(r)) warning(line);
+    if (r.flow) save_flow(o->save_flow, o->flow_format, r.t1_ns, *r.flow);
+    ++done;
+    if (progress) progress->update(done);
+  };
+
+  PipelineOptions options;
+  options.lanes_per_device = o->lanes > 0 ? o->lanes : default_lanes_per_device(infos);
+  options.decode_threads = o->decode_threads;
+  options.max_pairs = o->max_pairs;
+  options.cancel = &interrupt_requested();
+  const PipelineStats stats = [&] {
+    const InterruptGuard guard;
+    try {
+      return prediction.run(sink, options);
+    } catch (const Error&) {
+      if (progress) progress->finish();
+      if (file_writer && file_writer->rows() > 0) {
+        info("the " + std::to_string(file_writer->rows()) + " rows computed before the error are in " +
+             file_writer->journal().string() + "; " + o->output + " is untouched");
+      }
+      throw;
+    }
+  }();
+  if (progress) progress->finish();  // the summary below starts on a line of its own
+
+  if (o->stats) {
+    std::cerr << "pairs: " << stats.pairs << " in " << stats.seconds << " s = " << stats.pairs_per_second()
+              << " pairs/s\n"
+              << "decode: " << stats.decode_seconds << " s (summed over threads)\n";
+    for (const auto& [stage, seconds] : stats.stage_seconds) {
+      std::cerr << stage << ": " << seconds << " s (summed over lanes), " << seconds / std::max<std::size_t>(stats.pairs, 1)
+                << " s per pair\n";
+    }
+    for (const auto& [device, count] : stats.pairs_per_device) std::cerr << device << ": " << count << " pairs\n";
+    print_memory(stats);
+  }
+  if (o->profile && stats.pairs > 0) {
+    // Lanes run side by side, so a layer's time includes the other lanes' load on the device.
+    std::vector<LayerTime> per_pair = total_by_layer(profiler.collect());
+    for (auto& l : per_pair) {
+      l.seconds /= static_cast<double>(stats.pairs);
+      l.layer.flops /= static_cast<double>(stats.pairs);
+    }
+    print_profile("per pair, mean over " + std::to_string(stats.pairs) + " pairs and " +
+                      std::to_string(options.lanes_per_device) + " lanes in flight per device, after a warm-up pair",
+                  per_pair);
+  }
+  // An interrupted run, or one in which no pair could be answered, leaves a complete output of
+  // an earlier run in place: its rows stay in the journal beside it.
+  if (stats.cancelled && live) {
+    info("stopped after " + std::to_string(stats.pairs) + " pairs (Ctrl-C)");
+  } else if (stats.cancelled) {
+    std::cerr << "inertialnet: interrupted after " << stats.pairs << " of " << pairs << " pairs; "
+              << (file_writer ? "the rows so far are in " + file_writer->journal().string() + " (" + o->output +
+                                    " is untouched)"
+                  : csv       ? std::string("the rates written so far are complete rows")
+                              : "nothing written (--format " + o->format + " is written when the run ends)")
+              << "\n";
+    return 1;
+  }
+  if (tally.pairs > 0 && tally.answered_by_none == tally.pairs) {
+    throw invalid_input("none of the " + std::to_string(tally.pairs) + " pairs of " + prediction.source().description() +
+                        " could be answered (" + tally.summary() + ")" +
+                        (file_writer ? "; their rows, with the reasons, are in " + file_writer->journal().string() +
+                                           " and " + o->output + " is untouched"
+                                     : std::string()) +
+                        ".");
+  }
+  if (file_writer) file_writer->close();  // a failed write or rename is exit 1, not a silent loss
+  if (!csv) {
+    // Pairs without an answer: left out of gcsv and euroc-imu, held over in tum (notes say so).
+    RatesExportSummary written;
+    if (o->output.empty()) {
+      std::cout << rates_export_text(collected, rates_export_format_from_string(o->format), {}, o->sequence, written);
+      flush_standard_output();
+    } else {
+      written = export_rates(collected, o->sequence, o->output, rates_export_format_from_string(o->format));
+    }
+    for (const std::string& note : written.notes) info("note: " + note);
+    if (!o->output.empty()) {
+      info("wrote " + std::to_string(written.rows_written) + " rows (" + o->format + ") to " + o->output);
+    }
+  }
+  if (!tally.summary().empty()) {
+    warning(tally.summary() + "; their rows say why (status column) and eval leaves them out");
+  }
+  return 0;
+}
+
+// `predict SEQ... -o FOLDER`: one rates file per sequence, FOLDER/<name>.csv (batch_predict.hpp),
+// each written as `predict SEQ -o FOLDER/<name>.csv` writes it, with what made it in its sidecar;
+// a sequence whose file is complete and current is skipped, so that a rerun resumes a batch that
+// stopped. The first sequence that fails stops the batch with its error (and exit code).
+int predict_batch(const PredictOptions& options, const GlobalOptions& global) {
+  namespace fs = std::filesystem;
+  std::vector<fs::path> sequences(options.sequences.begin(), options.sequences.end());
+  if (!options.manifest.empty()) {
+    for (const auto& s : read_batch_manifest(options.manifest)) sequences.push_back(s);
+  }
+  if (sequences.empty()) throw invalid_input("no sequence given: name them, or give --manifest FILE.");
+  if (options.output.empty()) {
+    throw invalid_input("a batch of " + std::to_string(sequences.size()) +
+                        " sequences writes one rates file each: give the folder with -o FOLDER.");
+  }
+  if (options.format != "csv") {
+    throw invalid_input("--format " + options.format + ": a batch writes rates CSVs (what resumes it); convert "
+                        "them afterwards with `inertialnet export`.");
+  }
+  if (!options.save_flow.empty()) {
+    throw invalid_input("--save-flow: give it to a single-sequence predict; a batch writes rates files only.");
+  }
+  const std::vector<fs::path> outputs = batch_rates_paths(sequences, options.output);
+  std::error_code ec;
+  if (fs::exists(options.output, ec) && !fs::is_directory(options.output, ec)) {
+    throw invalid_input("-o " + options.output + ": it exists and is not a folder; a batch writes one rates file per "
+                        "sequence into a folder.");
+  }
+  prepare_output_folder(options.output, "-o");
+  std::size_t computed = 0, skipped = 0;
+  for (std::size_t i = 0; i < sequences.size(); ++i) {
+    const std::string name = outputs[i].stem().string();
+    const std::string tag = "[" + std::to_string(i + 1) + "/" + std::to_string(sequences.size()) + "] " + name;
+    PredictOptions one = options;
+    one.sequence = sequences[i].string();
+    one.output = outputs[i].string();
+    const std::string stopped = "the batch stopped at " + name + " (" + std::to_string(i + 1) + " of " +
+                                std::to_string(sequences.size()) + "); rerun the same command to resume it";
+    int rc = 0;
+    try {
+      // A sequence that cannot be read stops the batch here too, named.
+      const Provenance provenance = prediction_provenance(settings_of(one, global), one.max_pairs);
+      std::string why;
+      if (rates_file_current(outputs[i], provenance, &why)) {
+        info(tag + ": skipped (current): " + one.output);
+        ++skipped;
+        continue;
+      }
+      info(tag + ": computing (" + why + ")");
+      rc = predict_one(one, global, &provenance);
+    } catch (const Error&) {
+      std::cerr << "inertialnet: " << stopped << "\n";  // then the error itself, from main
+      throw;
+    }
+    if (rc != 0) {
+      std::cerr << "inertialnet: " << stopped << "\n";
+      return rc;
+    }
+    ++computed;
+  }
+  info("batch: " + std::to_string(computed) + " computed, " + std::to_string(skipped) + " skipped (current); rates in " +
+       options.output);
+  return 0;
+}
+
 }  // namespace
 
 Command register_predict(CLI::App& app, const GlobalOptions& global) {
   auto o = std::make_shared<PredictOptions>();
-  app.add_option("sequence", o->sequence,
+  auto* sequence_option = app.add_option("sequence", o->sequences,
                  "EuRoC folder, image folder, video, ROS bag, or a live source: /dev/videoN, camera:N, gst:PIPELINE "
-                 "(ending in appsink) or capture:STRING (any OpenCV capture), read until Ctrl-C or its end")
-      ->required();
+                 "(ending in appsink) or capture:STRING (any OpenCV capture), read until Ctrl-C or its end; several "
+                 "(or --manifest) make a batch: -o FOLDER gets one rates file per sequence");
   app.add_option("-w,--weights", o->weights,
                  "weights (safetensors) holding FlowNet2 and/or the InertialNet head; repeat for several files");
   app.add_option("--model", o->model, "flow network (default FlowNet2)")->transform(choice("model", flow_model_names()));
@@ -208,203 +485,21 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
   app.add_flag("--stats", o->stats,
                "print time per stage and pairs per second (after one untimed warm-up pair that compiles the kernels)");
   app.add_flag("--profile", o->profile, "print the device time of every network layer per pair (profiling queues)");
+  app.add_option("--manifest", o->manifest,
+                 "a batch's sequences from this file, one path a line (relative ones to its folder; '#' comments); "
+                 "with -o FOLDER")
+      ->check(CLI::ExistingFile);
+  // The sequence is required unless a manifest lists them (CLI11's own message and exit 2).
+  app.callback([sequence_option, o] {
+    if (!*sequence_option && o->manifest.empty()) throw CLI::RequiredError("sequence");
+  });
   return [o, &global]() {
-    const bool have_weights = !o->weights.empty();
-    LayerProfiler profiler;  // declared before the devices, whose queues report to it
-    PredictSettings settings;
-    settings.sequence = o->sequence;
-    settings.weights = o->weights;
-    settings.model = o->model;
-    settings.flow = o->flow;
-    settings.head = o->head;
-    settings.solver = o->solver;
-    settings.fx = o->camera.fx;
-    settings.fy = o->camera.fy;
-    settings.cx = o->camera.cx;
-    settings.cy = o->camera.cy;
-    settings.calibration = o->camera.calibration.file;
-    settings.calibration_camera = o->camera.calibration.camera;
-    settings.rate_hz = o->rate_hz;
-    settings.camera = o->camera_name;
-    settings.bag = o->bag;
-    settings.flow_check_px = o->flow_check_px;
-    if (!o->readout_time.empty()) settings.readout_time_s = parse_seconds(o->readout_time, "--readout-time");
-    if (!o->time_offset.empty()) settings.time_offset_s = parse_seconds(o->time_offset, "--time-offset");
-    settings.device = global.device;
-    settings.no_cache = global.no_cache;
-    settings.keep_flow = !o->save_flow.empty();
-    if (o->profile) settings.profiler = &profiler;
-    check_predict_outputs(*o);  // before the weights load and any pair is computed
-    Prediction prediction(settings);
-    for (const auto& note : prediction.notes()) info("note: " + note);
-    if (const WeightSet* weights = prediction.weights()) warn_if_synthetic(*weights);
-    const RatesProcessorOptions& processor = prediction.processor();
-
-    const std::size_t pairs = prediction.pairs(o->max_pairs);
-    // A live source runs until Ctrl-C or its end; Ctrl-C is then its normal end, not an interruption.
-    const bool live = prediction.source().open_ended();
-    const auto& infos = prediction.device_infos();
-    if (!have_weights) {
-      info(std::string("no weights given: weight-free ") + (o->flow == "lk" ? "Lucas-Kanade" : "DIS") +
-           " optical flow + geometric head");
-    }
-    const std::string count = !live      ? std::to_string(pairs) + " pairs"
-                              : pairs > 0 ? "up to " + std::to_string(pairs) + " pairs"
-                                          : std::string("pairs until Ctrl-C or its end");
-    std::string summary = prediction.source().description() + ", " + count + ", " +
-                          prediction.method() + " on " + std::to_string(infos.size()) + " device" +
-                          (infos.size() > 1 ? "s" : "") + " (" + infos.front().name + (infos.size() > 1 ? ", …" : "") + ")";
-    if (processor.geometric_head) {
-      summary += std::string("; geometric rates in the ") +
-                 (processor.camera_to_body ? "body (IMU) frame" : "camera frame");
-    }
-    info(summary);
-    // Timing keeps the first run's kernel compile (and each network's planning) out of its figures.
-    if (o->stats || o->profile) {
-      prediction.warm_up([](const DeviceInfo& device, double seconds) {
-        char text[32];
-        std::snprintf(text, sizeof text, "%.2f", seconds);
-        info("warm-up pair on " + device.name + ": " + text + " s (kernel compile and planning; not counted below)");
-      });
-      if (o->profile) profiler.collect();  // the warm-up pair is not one of the profiled ones
-    }
-
-    // Columns: wx,wy,wz,status for the first estimator; a second one adds its group
-    // wx_<name>,wy_<name>,wz_<name>,status_<name>. Every pair gets a row, answered or not.
-    const RatesLayout layout = prediction.layout();
-    std::unique_ptr<RatesCsvWriter> file_writer;
-    const auto metadata = prediction.csv_metadata();
-    const bool csv = o->format == "csv";
-    // --format gcsv|euroc-imu|tum: the rows as the CSV would hold them, converted at the end by
-    // the code `export` runs.
-    RatesTable collected;
-    collected.metadata = metadata;
-    collected.extra_names = layout.extra_names;
-    collected.extra.resize(layout.extra_names.size());
-    collected.status_names = {"status"};
-    collected.status_names.insert(collected.status_names.end(), layout.status_names.begin(), layout.status_names.end());
-    collected.statuses.resize(collected.status_names.size());
-    if (o->format == "euroc-imu" && collected.meta("frame").value_or("") != "body") {
-      // Said before any pair is computed: EuRoC's columns are the IMU frame (`export` would refuse).
-      throw invalid_input("--format euroc-imu: the rates of " + prediction.source().description() + " are in the " +
-                          collected.meta("frame").value_or("camera") + " frame (no camera-IMU rotation known), and "
-                          "EuRoC's columns are the IMU frame; give the calibration, or write the CSV (--format csv) and "
-                          "use `inertialnet export --format euroc-imu --allow-camera-frame`.");
-    }
-    if (csv && !o->output.empty()) file_writer = std::make_unique<RatesCsvWriter>(o->output, layout, metadata);
-    if (csv && (!file_writer || !file_writer->has_sidecar())) {
-      // A stream has no sidecar: its metadata go to the standard error, in words.
-      std::string stated;
-      for (const auto& [key, value] : metadata) stated += (stated.empty() ? "" : ", ") + key + ": " + value;
-      info(std::string("note: the rates' metadata (a stream has no sidecar): schema: ") + kRatesSchema +
-           (stated.empty() ? "" : ", " + stated));
-    }
-    if (csv && !file_writer) std::cout << rates_csv_header(layout);
-
-    // A live run's rows are its progress (its length is unknown, so there is no bar to draw).
-    std::optional<Progress> progress;
-    if (!live) progress.emplace("predict", pairs);
-    std::size_t done = 0;
-    UnansweredTally tally;
-    auto sink = [&](const PairResult& r) {
-      const RatesRow row = rates_row(r);
-      if (!csv) {
-        append_row(collected, layout, row);
-      } else if (file_writer) {
-        file_writer->write(row);
-      } else {
-        std::cout << format_rates_row(layout, row);
-        flush_standard_output();  // a row at a time, so a closed pipe stops the run at once
-      }
-      tally.add(r);
-      for (const auto& line : unanswered_messages(r)) warning(line);
-      if (r.flow) save_flow(o->save_flow, o->flow_format, r.t1_ns, *r.flow);
-      ++done;
-      if (progress) progress->update(done);
-    };
-
-    PipelineOptions options;
-    options.lanes_per_device = o->lanes > 0 ? o->lanes : default_lanes_per_device(infos);
-    options.decode_threads = o->decode_threads;
-    options.max_pairs = o->max_pairs;
-    options.cancel = &interrupt_requested();
-    const PipelineStats stats = [&] {
-      const InterruptGuard guard;
-      try {
-        return prediction.run(sink, options);
-      } catch (const Error&) {
-        if (progress) progress->finish();
-        if (file_writer && file_writer->rows() > 0) {
-          info("the " + std::to_string(file_writer->rows()) + " rows computed before the error are in " +
-               file_writer->journal().string() + "; " + o->output + " is untouched");
-        }
-        throw;
-      }
-    }();
-    if (progress) progress->finish();  // the summary below starts on a line of its own
-
-    if (o->stats) {
-      std::cerr << "pairs: " << stats.pairs << " in " << stats.seconds << " s = " << stats.pairs_per_second()
-                << " pairs/s\n"
-                << "decode: " << stats.decode_seconds << " s (summed over threads)\n";
-      for (const auto& [stage, seconds] : stats.stage_seconds) {
-        std::cerr << stage << ": " << seconds << " s (summed over lanes), " << seconds / std::max<std::size_t>(stats.pairs, 1)
-                  << " s per pair\n";
-      }
-      for (const auto& [device, count] : stats.pairs_per_device) std::cerr << device << ": " << count << " pairs\n";
-      print_memory(stats);
-    }
-    if (o->profile && stats.pairs > 0) {
-      // Lanes run side by side, so a layer's time includes the other lanes' load on the device.
-      std::vector<LayerTime> per_pair = total_by_layer(profiler.collect());
-      for (auto& l : per_pair) {
-        l.seconds /= static_cast<double>(stats.pairs);
-        l.layer.flops /= static_cast<double>(stats.pairs);
-      }
-      print_profile("per pair, mean over " + std::to_string(stats.pairs) + " pairs and " +
-                        std::to_string(options.lanes_per_device) + " lanes in flight per device, after a warm-up pair",
-                    per_pair);
-    }
-    // An interrupted run, or one in which no pair could be answered, leaves a complete output of
-    // an earlier run in place: its rows stay in the journal beside it.
-    if (stats.cancelled && live) {
-      info("stopped after " + std::to_string(stats.pairs) + " pairs (Ctrl-C)");
-    } else if (stats.cancelled) {
-      std::cerr << "inertialnet: interrupted after " << stats.pairs << " of " << pairs << " pairs; "
-                << (file_writer ? "the rows so far are in " + file_writer->journal().string() + " (" + o->output +
-                                      " is untouched)"
-                    : csv       ? std::string("the rates written so far are complete rows")
-                                : "nothing written (--format " + o->format + " is written when the run ends)")
-                << "\n";
-      return 1;
-    }
-    if (tally.pairs > 0 && tally.answered_by_none == tally.pairs) {
-      throw invalid_input("none of the " + std::to_string(tally.pairs) + " pairs of " + prediction.source().description() +
-                          " could be answered (" + tally.summary() + ")" +
-                          (file_writer ? "; their rows, with the reasons, are in " + file_writer->journal().string() +
-                                             " and " + o->output + " is untouched"
-                                       : std::string()) +
-                          ".");
-    }
-    if (file_writer) file_writer->close();  // a failed write or rename is exit 1, not a silent loss
-    if (!csv) {
-      // Pairs without an answer: left out of gcsv and euroc-imu, held over in tum (notes say so).
-      RatesExportSummary written;
-      if (o->output.empty()) {
-        std::cout << rates_export_text(collected, rates_export_format_from_string(o->format), {}, o->sequence, written);
-        flush_standard_output();
-      } else {
-        written = export_rates(collected, o->sequence, o->output, rates_export_format_from_string(o->format));
-      }
-      for (const std::string& note : written.notes) info("note: " + note);
-      if (!o->output.empty()) {
-        info("wrote " + std::to_string(written.rows_written) + " rows (" + o->format + ") to " + o->output);
-      }
-    }
-    if (!tally.summary().empty()) {
-      warning(tally.summary() + "; their rows say why (status column) and eval leaves them out");
-    }
-    return 0;
+    // Several sequences, a manifest, or -o FOLDER/: a batch, one rates file per sequence.
+    const bool batch = o->sequences.size() > 1 || !o->manifest.empty() ||
+                       (!o->output.empty() && o->output.back() == '/');
+    if (batch) return predict_batch(*o, global);
+    o->sequence = o->sequences.empty() ? std::string() : o->sequences.front();
+    return predict_one(*o, global, nullptr);
   };
 }
 

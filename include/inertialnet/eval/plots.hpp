@@ -38,4 +38,11 @@ void plot_loss_curves(const std::filesystem::path& png, const std::vector<double
                       const std::vector<std::pair<std::string, std::vector<double>>>& series, const std::string& title,
                       const PlotStyle& style = {});
 
+// A batch's summary (the paper's Table 1 as a figure): three panels (wx, wy, wz), one bar per
+// sequence of its RMSE (deg/s), the zero predictor's RMSE as a grey bar behind it for scale.
+// `names`, `rmse_deg_s` and `zero_rmse_deg_s` have one entry per sequence.
+void plot_rmse_bars(const std::filesystem::path& png, const std::vector<std::string>& names,
+                    const std::vector<Vec3>& rmse_deg_s, const std::vector<Vec3>& zero_rmse_deg_s,
+                    const std::string& title, const PlotStyle& style = {});
+
 }  // namespace inertialnet

@@ -154,6 +154,10 @@ class RatesCsvWriter {
   const std::filesystem::path& journal() const;
   // Whether a sidecar carries the metadata (false for a FIFO or device written in place).
   bool has_sidecar() const;
+  // A block of the sidecar's own beside "metadata" (batch predict's "provenance": what made the
+  // rates, pipeline/batch_predict.hpp), written by close() with the rest of the sidecar, so that
+  // it only ever stands beside the complete CSV. Readers of the rates do not read it.
+  void set_sidecar_block(const std::string& name, const std::vector<std::pair<std::string, std::string>>& entries);
 
  private:
   std::filesystem::path path_;
@@ -161,6 +165,8 @@ class RatesCsvWriter {
   struct Stream;
   std::unique_ptr<Stream> out_;
   std::vector<std::pair<std::string, std::string>> metadata_;
+  std::string block_name_;                                   // set_sidecar_block
+  std::vector<std::pair<std::string, std::string>> block_;
   std::size_t rows_ = 0;
   std::int64_t last_t_ns_ = 0;
 };

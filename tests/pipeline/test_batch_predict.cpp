@@ -1,0 +1,38 @@
+// SPDX-License-Identifier: Apache-2.0
+// A batch's file names (pipeline/batch_predict.hpp): what `predict SEQ... -o FOLDER` and
+// inertialnet.batch call each sequence's rates file, and the batches they refuse.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "inertialnet/pipeline/batch_predict.hpp"
+#include "inertialnet/runtime/error.hpp"
+
+using namespace inertialnet;
+namespace fs = std::filesystem;
+
+TEST(BatchPredict, NamesASequenceByItsFolderOrFileStem) {
+  const fs::path root = fs::temp_directory_path() / "inertialnet_test_batch_names";
+  fs::remove_all(root);
+  fs::create_directories(root / "MH_01_easy" / "mav0");
+  EXPECT_EQ(batch_rates_name(root / "MH_01_easy"), "MH_01_easy.csv");
+  EXPECT_EQ(batch_rates_name((root / "MH_01_easy").string() + "/"), "MH_01_easy.csv");  // a glob's "data/*/"
+  EXPECT_EQ(batch_rates_name(root / "MH_01_easy" / "mav0"), "MH_01_easy.csv");           // the folder above mav0
+  EXPECT_EQ(batch_rates_name(root / "run1.bag"), "run1.csv");                              // a file: its stem
+  EXPECT_EQ(batch_rates_name("clip.tar.mp4"), "clip.tar.csv");
+  fs::remove_all(root);
+}
+
+TEST(BatchPredict, RefusesTwoSequencesOfOneNameAndLiveSources) {
+  try {
+    batch_rates_paths({"a/seq", "b/seq"}, "out");
+    FAIL() << "two sequences named seq were accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::InvalidInput);
+    EXPECT_NE(std::string(e.what()).find("would both write out/seq.csv"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(batch_rates_paths({"/dev/video0"}, "out"), Error);
+  const auto paths = batch_rates_paths({"a/s1", "b/s2"}, "out");
+  ASSERT_EQ(paths.size(), 2u);
+  EXPECT_EQ(paths[1], fs::path("out") / "s2.csv");
+}
