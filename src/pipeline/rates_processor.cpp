@@ -1,10 +1,13 @@
 // SPDX-License-Identifier: Apache-2.0
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <string>
 
+#include "inertialnet/core/constants.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/models/dis_flow.hpp"
 #include "inertialnet/models/flownet.hpp"
@@ -20,6 +23,24 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 Vec3 to_body(const std::optional<Mat3>& r, const Vec3& w) { return r ? mul(*r, w) : w; }
+
+// The per-axis standard deviations of a camera-frame covariance C after the rotation R (body
+// frame: diag(R·C·Rᵀ)); NaN when the covariance is not known.
+std::array<double, 3> axis_sigma(const std::optional<Mat3>& r, const RotationEstimate& e) {
+  if (!e.covariance_known) return {EstimatorRates::kUnknownSigma, EstimatorRates::kUnknownSigma, EstimatorRates::kUnknownSigma};
+  const Mat3& c = e.covariance;
+  std::array<double, 3> out{};
+  for (int i = 0; i < 3; ++i) {
+    double v = c[static_cast<std::size_t>(4 * i)];
+    if (r) {
+      v = 0;
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) v += (*r)[static_cast<std::size_t>(3 * i + a)] * c[static_cast<std::size_t>(3 * a + b)] * (*r)[static_cast<std::size_t>(3 * i + b)];
+    }
+    out[static_cast<std::size_t>(i)] = std::sqrt(std::max(0.0, v));
+  }
+  return out;
+}
 
 class RatesProcessor : public PairProcessor {
  public:
@@ -116,14 +137,29 @@ class RatesProcessor : public PairProcessor {
       try {
         const RotationEstimate estimate = geometric_->estimate(q, checked.defined() ? checked : flow, dt, &stop);
         const Vec3 w = to_body(options_.camera_to_body, estimate.omega);
+        const std::array<double, 3> sigma = axis_sigma(options_.camera_to_body, estimate);
+        const double largest = std::max({sigma[0], sigma[1], sigma[2]});
+        constexpr double kDeg = 180 / kPi;
         if (estimate.status != PairStatus::Ok) {
           answer.status = estimate.status;
           answer.reason = estimate.status_reason;
-        } else if (std::isfinite(w[0]) && std::isfinite(w[1]) && std::isfinite(w[2])) {
-          answer.w = {w[0], w[1], w[2]};
-        } else {
+        } else if (!(std::isfinite(w[0]) && std::isfinite(w[1]) && std::isfinite(w[2]))) {
           answer.status = PairStatus::NonFinite;
           answer.reason = "the geometric head's rates are not finite (NaN or infinity)";
+        } else if (options_.max_sigma_rad_s > 0 && largest > options_.max_sigma_rad_s) {
+          // Too uncertain to report (RatesProcessorOptions::max_sigma_rad_s); σ stays, for the user.
+          char text[200];
+          std::snprintf(text, sizeof text,
+                        "geometric head: the rates' standard deviation %.2f %.2f %.2f deg/s exceeds the limit %.2f deg/s "
+                        "(--max-sigma)",
+                        sigma[0] * kDeg, sigma[1] * kDeg, sigma[2] * kDeg,
+                        options_.max_sigma_rad_s * kDeg);
+          answer.status = PairStatus::Uncertain;
+          answer.reason = text;
+          answer.sigma = sigma;
+        } else {
+          answer.w = {w[0], w[1], w[2]};
+          answer.sigma = sigma;
         }
       } catch (const UnanswerablePair& e) {
         answer.status = e.status();
