@@ -65,7 +65,7 @@ def check_csv(path, rates):
         sidecar = json.load(f)
     with open(path, "rb") as f:
         data = f.read()
-    if sidecar.get("schema") != "inertialnet.rates/3" or sidecar.get("rows") != len(frame):
+    if sidecar.get("schema") != "inertialnet.rates/4" or sidecar.get("rows") != len(frame):
         fail(f"{path}.json: {sidecar}")
     if sidecar.get("fnv1a64") != fnv1a64(data):
         fail(f"{path}.json: fnv1a64 {sidecar.get('fnv1a64')}, the CSV's is {fnv1a64(data)}")
