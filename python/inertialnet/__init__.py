@@ -199,7 +199,7 @@ def predict(
     keep_flow: bool = False,
     flow_check: float = 0.5,
     progress: Optional[Callable[[int, int], object]] = None,
-    max_sigma: float = 5.0,
+    max_sigma: float = 10.0,
     smooth: str = "lag:2",
 ):
     """Angular rates of every frame pair of a sequence, as ``inertialnet predict`` computes them.
@@ -221,7 +221,7 @@ def predict(
     stated in the rates for :func:`evaluate`, the readout time also corrects the geometric head);
     ``flow_check`` is ``--flow-check`` (the DIS forward-backward check for the geometric head,
     pixels at 752 columns; 0: off). ``max_sigma`` is ``--max-sigma`` (deg/s: a geometric rate whose
-    standard deviation exceeds it on any axis gets the status ``"uncertain"``; 0: no limit) and
+    standard deviation along its least certain direction exceeds it gets the status ``"uncertain"``; 0: no limit) and
     ``smooth`` is ``--smooth`` (``"lag:2"``, the default: a fixed-lag smoother over the pairs using
     their σ; ``"off"``: the two-frame rates); ``rates.sigma`` holds each rate's σ. With ``keep_flow=True`` returns ``(rates, flows)``, flows a
     list of ``(H, W, 2)`` arrays (as computed, without the check's marks).

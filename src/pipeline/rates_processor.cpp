@@ -1,4 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
+#include <Eigen/Dense>
+
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -23,6 +25,15 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 Vec3 to_body(const std::optional<Mat3>& r, const Vec3& w) { return r ? mul(*r, w) : w; }
+
+// The standard deviation along the least certain direction of a covariance (its largest
+// eigenvalue's root).
+double least_certain_sigma(const Mat3& c) {
+  Eigen::Matrix3d m;
+  m << c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7], c[8];
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(m, Eigen::EigenvaluesOnly);
+  return std::sqrt(std::max(0.0, eig.eigenvalues()(2)));
+}
 
 // The per-axis standard deviations of a camera-frame covariance C after the rotation R (body
 // frame: diag(R·C·Rᵀ)); NaN when the covariance is not known.
@@ -138,7 +149,10 @@ class RatesProcessor : public PairProcessor {
         const RotationEstimate estimate = geometric_->estimate(q, checked.defined() ? checked : flow, dt, &stop);
         const Vec3 w = to_body(options_.camera_to_body, estimate.omega);
         const std::array<double, 3> sigma = axis_sigma(options_.camera_to_body, estimate);
-        const double largest = std::max({sigma[0], sigma[1], sigma[2]});
+        // The σ along the least certain direction (the covariance's largest eigenvalue): the same in
+        // the camera and the body frame, so that --max-sigma picks the same pairs in either.
+        const double largest = estimate.covariance_known ? least_certain_sigma(estimate.covariance)
+                                                         : EstimatorRates::kUnknownSigma;
         constexpr double kDeg = 180 / kPi;
         if (estimate.status != PairStatus::Ok) {
           answer.status = estimate.status;
@@ -150,9 +164,9 @@ class RatesProcessor : public PairProcessor {
           // Too uncertain to report (RatesProcessorOptions::max_sigma_rad_s); σ stays, for the user.
           char text[200];
           std::snprintf(text, sizeof text,
-                        "geometric head: the rates' standard deviation %.2f %.2f %.2f deg/s exceeds the limit %.2f deg/s "
-                        "(--max-sigma)",
-                        sigma[0] * kDeg, sigma[1] * kDeg, sigma[2] * kDeg,
+                        "geometric head: the rates' standard deviation %.2f %.2f %.2f deg/s (%.2f along the least certain "
+                        "axis) exceeds the limit %.2f deg/s (--max-sigma)",
+                        sigma[0] * kDeg, sigma[1] * kDeg, sigma[2] * kDeg, largest * kDeg,
                         options_.max_sigma_rad_s * kDeg);
           answer.status = PairStatus::Uncertain;
           answer.reason = text;

@@ -72,7 +72,7 @@ struct PredictOptions {
   BagTopics bag;                     // --image-topic, --camera-info-topic
   std::string time_offset, readout_time;
   double flow_check_px = 0.5;  // PredictSettings' default
-  double max_sigma_deg_s = 5.0;   // PredictSettings' default (issue 22)
+  double max_sigma_deg_s = 10.0;  // PredictSettings' default (issue 22)
   std::string smooth = "lag:2";   // PredictSettings' default (issue 22)
   int lanes = 0;  // 0: default_lanes_per_device()
   int decode_threads = 2;
@@ -196,8 +196,8 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::Range(0.0, 1e6));
   // Issue 22: confidence per pair and more than two frames.
   app.add_option("--max-sigma", o->max_sigma_deg_s,
-                 "geometric head: a pair whose rates' standard deviation exceeds this many deg/s on any axis gets the "
-                 "status uncertain instead of rates; 0: no limit")
+                 "geometric head: a pair whose rates' standard deviation exceeds this many deg/s (along the least "
+                 "certain axis) gets the status uncertain instead of rates; 0: no limit")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1e6));
   app.add_option("--smooth", o->smooth,

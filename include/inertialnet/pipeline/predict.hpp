@@ -54,7 +54,7 @@ struct PredictSettings {
   // Issue 22: the largest per-axis σ a geometric rate may have, deg/s (RatesProcessorOptions::
   // max_sigma_rad_s; 0: no limit), and the smoother over the pairs ("off", "lag:L"; rate_smoother.hpp):
   // lag 2 by default, the best of the synthetic conditions (docs/real_cameras.md, "More than two frames").
-  double max_sigma_deg_s = 5.0;
+  double max_sigma_deg_s = 10.0;
   std::string smooth = "lag:2";
   // Camera-IMU time offset (t_imu = t_cam + offset) stated in the CSV for eval; not applied here.
   std::optional<double> time_offset_s;

@@ -43,11 +43,12 @@ struct RatesProcessorOptions {
   // deg/s, for a second DIS pass; tighter was better still on synthetic frames but leaves out
   // up to a fifth of the field (docs/real_cameras.md, "Forward-backward flow check").
   double flow_check_px = 0.5;
-  // A geometric rate whose largest per-axis σ (EstimatorRates::sigma, the calibrated standard
-  // deviation) exceeds this many rad/s is not reported: the pair gets PairStatus::Uncertain
-  // (predict --max-sigma, in deg/s; docs/real_cameras.md, "Confidence per pair"). 0: no limit.
+  // A geometric rate whose σ along its least certain direction (the calibrated covariance's
+  // largest eigenvalue; at least every per-axis EstimatorRates::sigma, and the same in any frame)
+  // exceeds this many rad/s is not reported: the pair gets PairStatus::Uncertain (predict
+  // --max-sigma, in deg/s; docs/real_cameras.md, "Confidence per pair"). 0: no limit.
   double max_sigma_rad_s = kDefaultMaxSigmaRadS;
-  static constexpr double kDefaultMaxSigmaRadS = 0.0872664625997;  // 5 deg/s
+  static constexpr double kDefaultMaxSigmaRadS = 0.174532925199;  // 10 deg/s
 };
 
 // Each lane gets its own queue and model instances. `weights` holds one set per device, loaded
