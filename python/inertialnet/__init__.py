@@ -219,11 +219,14 @@ def predict(
     ``--camera-info-topic`` (None: a :class:`Sequence`'s own, else the bag's only image topic);
     ``time_offset`` and ``readout_time`` are ``--time-offset`` and ``--readout-time`` (seconds;
     stated in the rates for :func:`evaluate`, the readout time also corrects the geometric head);
-    ``flow_check`` is ``--flow-check`` (the DIS forward-backward check for the geometric head,
-    pixels at 752 columns; 0: off). ``max_sigma`` is ``--max-sigma`` (deg/s: a geometric rate whose
-    standard deviation along its least certain direction exceeds it gets the status ``"uncertain"``; 0: no limit) and
+    ``flow`` is ``--flow``: ``"flownet2"``, ``"dis"`` or ``"lk"`` (sparse Lucas–Kanade at the
+    geometric head's sample points, for the geometric head only; None: flownet2 with weights, dis
+    without). ``flow_check`` is ``--flow-check`` (the DIS or LK forward-backward check for the
+    geometric head, pixels at 752 columns; 0: off). ``max_sigma`` is ``--max-sigma`` (deg/s: a geometric rate whose standard deviation
+    along its least certain direction exceeds it gets the status ``"uncertain"``; 0: no limit) and
     ``smooth`` is ``--smooth`` (``"lag:2"``, the default: a fixed-lag smoother over the pairs using
-    their σ; ``"off"``: the two-frame rates); ``rates.sigma`` holds each rate's σ. With ``keep_flow=True`` returns ``(rates, flows)``, flows a
+    their σ; ``"off"``: the two-frame rates); ``rates.sigma`` holds each rate's σ. With
+    ``keep_flow=True`` returns ``(rates, flows)``, flows a
     list of ``(H, W, 2)`` arrays (as computed, without the check's marks).
 
     ``rate_hz``, ``fx`` and ``fy`` are 0 or None (not given) or what the CLI accepts for ``--rate``,

@@ -31,6 +31,19 @@ def test_predict_matches_the_cli(cli, sequence, tmp_path):
         assert [csv_text(v) for v in rates[name]] == [csv_text(v) for v in expected[:, i]]
 
 
+def test_predict_flow_lk_matches_the_cli(cli, sequence, tmp_path):
+    """flow="lk" is --flow lk: the same rates, to the digit, and not DIS's."""
+    header, expected = cli_rates(cli, sequence, tmp_path, "--flow", "lk")
+    rates = inertialnet.predict(sequence, flow="lk")
+    assert rates.columns == header and len(rates) == len(expected) == 4
+    for i, name in enumerate(header[1:4], start=1):
+        assert [csv_text(v) for v in rates[name]] == [csv_text(v) for v in expected[:, i]]
+    dis = inertialnet.predict(sequence)
+    assert not np.array_equal(dis.w, rates.w)
+    with pytest.raises(ValueError, match="expected flownet2, dis or lk"):
+        inertialnet.predict(sequence, flow="sparse")
+
+
 def test_dis_flow_and_geometric_head_step_by_step_match_the_cli(cli, sequence, tmp_path):
     _, expected = cli_rates(cli, sequence, tmp_path, "--smooth", "off")  # pair by pair: the two-frame rates
     seq = inertialnet.Sequence(sequence)

@@ -14,6 +14,7 @@
 #include "inertialnet/models/dis_flow.hpp"
 #include "inertialnet/models/flownet.hpp"
 #include "inertialnet/models/inertialnet_head.hpp"
+#include "inertialnet/models/lk_flow.hpp"
 #include "inertialnet/models/texture.hpp"
 #include "inertialnet/pipeline/rates_processor.hpp"
 #include "inertialnet/runtime/queue.hpp"
@@ -60,7 +61,15 @@ class RatesProcessor : public PairProcessor {
     if (options.flow == FlowMethod::FlowNet) flownet_ = std::make_unique<FlowNet>(device, options.flow_model, *weights);
     if (options.flow == FlowMethod::DIS) dis_ = std::make_unique<DisFlow>();
     if (options.inertialnet_head) head_ = std::make_unique<InertialNetHead>(device, *weights);
-    if (options.geometric_head) geometric_ = std::make_unique<GeometricHead>(device, *options.camera, options.geometric);
+    if (options.geometric_head) {
+      GeometricHeadOptions geometric = options.geometric;
+      // LK tracks the head's grid points and nothing else: its coarser grid is the head's.
+      if (options.flow == FlowMethod::LK) {
+        lk_ = std::make_unique<LkFlow>();
+        geometric.stride = lk_grid_stride(options.camera->width);
+      }
+      geometric_ = std::make_unique<GeometricHead>(device, *options.camera, geometric);
+    }
   }
 
   void process(const Frame& previous, const Frame& current, PairResult& result,
@@ -109,17 +118,23 @@ class RatesProcessor : public PairProcessor {
         std::copy(field.v.begin(), field.v.end(), data.begin() + static_cast<std::ptrdiff_t>(field.pixel_count()));
         return Tensor::from_host(q, {1, 2, height, width}, data);
       };
-      const FlowField field = dis_->compute(previous.image, current.image);
-      std::vector<float> planes(field.u);
-      planes.insert(planes.end(), field.v.begin(), field.v.end());
-      flow_problem = non_finite_flow(planes);
-      flow = upload(field);
-      // Only the geometric head's solvers skip unknown vectors; the learned head and the saved
-      // flow get the flow as computed (an unknown marker is no input for a network).
-      if (geometric_ && options_.flow_check_px > 0 && flow_problem.empty()) {
-        FlowField marked = field;
-        dis_->check(marked, previous.image, current.image, options_.flow_check_px);
-        checked = upload(marked);
+      if (lk_) {
+        // The check is part of the tracking (the same points, tracked back): the head and the
+        // saved flow get the field with its marks. Its values are finite by construction.
+        flow = upload(lk_->compute(previous.image, current.image, geometric_->options().stride, options_.flow_check_px));
+      } else {
+        const FlowField field = dis_->compute(previous.image, current.image);
+        std::vector<float> planes(field.u);
+        planes.insert(planes.end(), field.v.begin(), field.v.end());
+        flow_problem = non_finite_flow(planes);
+        flow = upload(field);
+        // Only the geometric head's solvers skip unknown vectors; the learned head and the saved
+        // flow get the flow as computed (an unknown marker is no input for a network).
+        if (geometric_ && options_.flow_check_px > 0 && flow_problem.empty()) {
+          FlowField marked = field;
+          dis_->check(marked, previous.image, current.image, options_.flow_check_px);
+          checked = upload(marked);
+        }
       }
     }
     t = lap(result, "flow", t);
@@ -229,12 +244,13 @@ class RatesProcessor : public PairProcessor {
     return "";
   }
 
-  // Frames too small for DIS are a property of the sequence, not of one pair: bad input.
+  // Frames too small for DIS or LK are a property of the sequence, not of one pair: bad input.
   void check_minimum_size(const Frame& f) const {
-    if (dis_ && (f.image.width < kDisMinimumSide || f.image.height < kDisMinimumSide)) {
+    const int minimum = dis_ ? kDisMinimumSide : kLkMinimumSide;
+    if ((dis_ || lk_) && (f.image.width < minimum || f.image.height < minimum)) {
       throw invalid_input(frame_name(f) + " is " + std::to_string(f.image.width) + "x" + std::to_string(f.image.height) +
-                          "; DIS optical flow needs frames of at least " + std::to_string(kDisMinimumSide) + "x" +
-                          std::to_string(kDisMinimumSide) + " pixels.");
+                          (dis_ ? "; DIS" : "; Lucas-Kanade") + " optical flow needs frames of at least " +
+                          std::to_string(minimum) + "x" + std::to_string(minimum) + " pixels.");
     }
   }
 
@@ -248,18 +264,27 @@ class RatesProcessor : public PairProcessor {
   std::unique_ptr<Queue> queue_;
   std::unique_ptr<FlowNet> flownet_;
   std::unique_ptr<DisFlow> dis_;
+  std::unique_ptr<LkFlow> lk_;
   std::unique_ptr<InertialNetHead> head_;
   std::unique_ptr<GeometricHead> geometric_;
 };
 
 }  // namespace
 
-std::string to_string(FlowMethod method) { return method == FlowMethod::DIS ? "dis" : "flownet2"; }
+std::string to_string(FlowMethod method) {
+  switch (method) {
+    case FlowMethod::DIS: return "dis";
+    case FlowMethod::LK: return "lk";
+    case FlowMethod::FlowNet: break;
+  }
+  return "flownet2";
+}
 
 FlowMethod parse_flow_method(const std::string& text) {
   if (text == "flownet2" || text == "flownet") return FlowMethod::FlowNet;
   if (text == "dis") return FlowMethod::DIS;
-  throw invalid_input("unknown flow method '" + text + "'; expected flownet2 or dis");
+  if (text == "lk") return FlowMethod::LK;
+  throw invalid_input("unknown flow method '" + text + "'; expected flownet2, dis or lk");
 }
 
 ProcessorFactory rates_processor(const std::map<const Device*, const WeightSet*>& weights,
@@ -268,6 +293,10 @@ ProcessorFactory rates_processor(const std::map<const Device*, const WeightSet*>
   if (options.geometric_head && !options.camera) {
     throw invalid_input("the geometric head needs the camera intrinsics (a EuRoC sequence's cam0/sensor.yaml, or "
                         "--fx --fy --cx --cy)");
+  }
+  if (options.flow == FlowMethod::LK && options.inertialnet_head) {
+    throw invalid_input("--flow lk tracks the geometric head's sample points only; the InertialNet head needs a dense "
+                        "flow field: use --flow flownet2 or dis with it");
   }
   const bool needs_weights = options.flow == FlowMethod::FlowNet || options.inertialnet_head;
   return [weights, options, needs_weights](Device& device, int) -> std::unique_ptr<PairProcessor> {

@@ -158,8 +158,10 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
   app.add_option("-w,--weights", o->weights,
                  "weights (safetensors) holding FlowNet2 and/or the InertialNet head; repeat for several files");
   app.add_option("--model", o->model, "flow network (default FlowNet2)")->transform(choice("model", flow_model_names()));
-  app.add_option("--flow", o->flow, "flownet2 (default with weights) or dis (OpenCV DIS; default without weights)")
-      ->transform(choice("flow method", {"flownet2", "dis"}));
+  app.add_option("--flow", o->flow,
+                 "flownet2 (default with weights), dis (OpenCV DIS; default without weights) or lk (sparse "
+                 "Lucas-Kanade at the geometric head's sample points; geometric head only)")
+      ->transform(choice("flow method", {"flownet2", "dis", "lk"}));
   app.add_option("--head", o->head, "inertialnet (default with weights), geometric (default without), or both")
       ->transform(choice("head", {"inertialnet", "geometric", "both"}));
   app.add_option("--solver", o->solver, "geometric head's solver")
@@ -190,7 +192,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
                  "and the motion's change across the rows, and the CSV states it for eval (rates belong to "
                  "mid-exposure)");
   app.add_option("--flow-check", o->flow_check_px,
-                 "DIS: also compute the backward flow and leave out vectors whose round trip misses by more than "
+                 "DIS and LK: also compute the backward flow and leave out vectors whose round trip misses by more than "
                  "this many pixels (at 752 columns, scaled with the width); 0: off")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1e6));
@@ -256,7 +258,10 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
     // A live source runs until Ctrl-C or its end; Ctrl-C is then its normal end, not an interruption.
     const bool live = prediction.source().open_ended();
     const auto& infos = prediction.device_infos();
-    if (!have_weights) info("no weights given: weight-free DIS optical flow + geometric head");
+    if (!have_weights) {
+      info(std::string("no weights given: weight-free ") + (o->flow == "lk" ? "Lucas-Kanade" : "DIS") +
+           " optical flow + geometric head");
+    }
     const std::string count = !live      ? std::to_string(pairs) + " pairs"
                               : pairs > 0 ? "up to " + std::to_string(pairs) + " pairs"
                                           : std::string("pairs until Ctrl-C or its end");
