@@ -202,6 +202,8 @@ def predict(
     keep_flow: bool = False,
     flow_check: float = 0.5,
     progress: Optional[Callable[[int, int], object]] = None,
+    max_sigma: float = 10.0,
+    smooth: str = "lag:2",
 ):
     """Angular rates of every frame pair of a sequence, as ``inertialnet predict`` computes them.
 
@@ -223,7 +225,11 @@ def predict(
     ``flow`` is ``--flow``: ``"flownet2"``, ``"dis"`` or ``"lk"`` (sparse Lucas–Kanade at the
     geometric head's sample points, for the geometric head only; None: flownet2 with weights, dis
     without). ``flow_check`` is ``--flow-check`` (the DIS or LK forward-backward check for the
-    geometric head, pixels at 752 columns; 0: off). With ``keep_flow=True`` returns ``(rates, flows)``, flows a
+    geometric head, pixels at 752 columns; 0: off). ``max_sigma`` is ``--max-sigma`` (deg/s: a geometric rate whose standard deviation
+    along its least certain direction exceeds it gets the status ``"uncertain"``; 0: no limit) and
+    ``smooth`` is ``--smooth`` (``"lag:2"``, the default: a fixed-lag smoother over the pairs using
+    their σ; ``"off"``: the two-frame rates); ``rates.sigma`` holds each rate's σ. With
+    ``keep_flow=True`` returns ``(rates, flows)``, flows a
     list of ``(H, W, 2)`` arrays (as computed, without the check's marks).
 
     ``rate_hz``, ``fx`` and ``fy`` are 0 or None (not given) or what the CLI accepts for ``--rate``,
@@ -240,13 +246,14 @@ def predict(
     image_topic = _image_topic_of(sequence, image_topic)
     if isinstance(weights, (str, os.PathLike)):
         weights = [weights]
-    columns, t_ns, values, flows, statuses, metadata = _native._predict(
+    columns, t_ns, values, flows, statuses, metadata, sigmas = _native._predict(
         os.fspath(sequence), [os.fspath(w) for w in weights], model or "", flow or "", head or "", solver,
         *(None if v is None else float(v) for v in (fx, fy, cx, cy)), float(rate_hz), _device_spec(device),
         keep_flow, max_pairs, int(lanes), int(decode_threads), float(flow_check), progress,
         None if time_offset is None else float(time_offset), float(readout_time), camera,
-        "" if calibration is None else os.fspath(calibration), calibration_camera, image_topic, camera_info_topic)
-    rates = _rates_of_predict(columns, t_ns, values, statuses, metadata)
+        "" if calibration is None else os.fspath(calibration), calibration_camera, image_topic, camera_info_topic,
+        float(max_sigma), str(smooth))
+    rates = _rates_of_predict(columns, t_ns, values, statuses, metadata, sigmas)
     return (rates, flows) if keep_flow else rates
 
 

@@ -101,8 +101,8 @@ def _predict(sequence: _Path, weights: list[str], model: str, flow: str, head: s
              device: str, keep_flow: bool, max_pairs: SupportsIndex, lanes: int, decode_threads: int,
              flow_check: float, progress: Optional[Callable[[int, int], object]], time_offset: Optional[float],
              readout_time: float, camera: str, calibration: str, calibration_camera: str, image_topic: str,
-             camera_info_topic: str) -> tuple[list[str], npt.NDArray[np.int64], npt.NDArray[np.float64], list[npt.NDArray[np.float32]],
-                        list[list[str]], list[tuple[str, str]]]: ...
+             camera_info_topic: str, max_sigma: float, smooth: str) -> tuple[list[str], npt.NDArray[np.int64], npt.NDArray[np.float64], list[npt.NDArray[np.float32]],
+                        list[list[str]], list[tuple[str, str]], npt.NDArray[np.float64]]: ...
 def _evaluate_json(rates: _Path, sequence: _Path, target: str, head: str, gyro_bias: Union[None, str, list[float]],
                    camera_frame: bool, plot: str, series: bool, time_offset: Union[None, float, str],
                    time_offset_range: float, readout_time: Optional[float], imu: str, imu_time_unit: str,
@@ -131,7 +131,7 @@ class _Stream:
     def __init__(self, sequence: str, weights: list[str], model: str, flow: str, head: str, solver: str,
                  fx: Optional[float], fy: Optional[float], cx: Optional[float], cy: Optional[float],
                  calibration: str, calibration_camera: str, camera: str, rate_hz: float, device: str,
-                 max_pairs: int, lanes: int, flow_check: float) -> None: ...
+                 max_pairs: int, lanes: int, flow_check: float, max_sigma: float, smooth: str) -> None: ...
     def __iter__(self) -> "_Stream": ...
     # (timestamp_ns, rates (3,) or (2, 3) rad/s, status or a tuple of statuses)
     def __next__(self) -> tuple[int, npt.NDArray[np.float64], Union[str, tuple[str, ...]]]: ...

@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
 """The rates of :func:`inertialnet.predict`: one row per frame pair, with what the rates CSV states.
 
-A :class:`Rates` is what ``inertialnet predict`` writes to its CSV (schema ``inertialnet.rates/3``,
+A :class:`Rates` is what ``inertialnet predict`` writes to its CSV (schema ``inertialnet.rates/4``,
 docs/data_conventions.md), in memory: the timestamps, each estimator's rates and status words, and
 the metadata of its sidecar (the frame of the rates, the estimator, the camera-IMU time offset and
 the readout time that predict was given). :func:`inertialnet.evaluate` reads that metadata exactly
@@ -68,6 +68,13 @@ class Rates:
         return np.stack([self._columns["wx"], self._columns["wy"], self._columns["wz"]], axis=1)
 
     @property
+    def sigma(self) -> np.ndarray:
+        """float64 ``(N, 3)`` rad/s: each rate's standard deviation (sigma_wx, sigma_wy, sigma_wz);
+        NaN where not known (the learned head, a schema-3 file, a pair without an answer)."""
+        names = ("sigma_wx", "sigma_wy", "sigma_wz")
+        return np.stack([self._columns.get(n, np.full(len(self._t), np.nan)) for n in names], axis=1)
+
+    @property
     def status(self) -> np.ndarray:
         return self._columns["status"]
 
@@ -107,7 +114,7 @@ class Rates:
     @property
     def heads(self) -> List[str]:
         """The estimators' column suffixes without ``_``: ``[""]``, or ``["", "geometric"]``."""
-        return [""] + [name[3:] for name in self._columns if name.startswith("wx_")]
+        return [""] + [name[3:] for name in self._columns if name.startswith("wx_")]  # not sigma_wx_…
 
     def head(self, name: str) -> "Rates":
         """The estimator whose columns end in ``_name`` (``"geometric"`` of ``head="both"``) as
@@ -117,7 +124,8 @@ class Rates:
         suffix = "_" + name
         if "wx" + suffix not in self._columns:
             raise ValueError(f"no estimator '{name}': the rates hold {', '.join(repr(h) for h in self.heads)}")
-        columns = {c: self._columns[c + suffix] for c in ("wx", "wy", "wz", "status") if c + suffix in self._columns}
+        columns = {c: self._columns[c + suffix] for c in ("wx", "wy", "wz", "status", "sigma_wx", "sigma_wy", "sigma_wz")
+                   if c + suffix in self._columns}
         metadata = {k: v for k, v in self.metadata.items() if not k.endswith(tuple("_" + h for h in self.heads[1:]))}
         for key in ("frame", "estimator"):
             # The CSV's rule: frame_<name> defaults to frame; an estimator is stated per group.
@@ -218,12 +226,15 @@ def read_rates(path: PathLike) -> Rates:
     return Rates(t, columns, dict(metadata))
 
 
-def _rates_of_predict(names: _Seq[str], t_ns, values, statuses, metadata: _Seq[Tuple[str, str]]) -> Rates:
+def _rates_of_predict(names: _Seq[str], t_ns, values, statuses, metadata: _Seq[Tuple[str, str]], sigmas=None) -> Rates:
     """predict()'s native result (estimator columns wx,wy,wz[,wx_geometric,…], status words rows ×
-    estimators, the metadata the CLI's CSV states) as Rates."""
+    estimators, the metadata the CLI's CSV states, each rate's σ) as Rates, in the CSV's column order."""
     columns: Dict[str, np.ndarray] = {}
     for e in range(len(names) // 3):
         for i in range(3 * e, 3 * e + 3):
             columns[names[i]] = values[:, i]
         columns["status" + names[3 * e][2:]] = np.asarray([row[e] for row in statuses], dtype=str).reshape(-1)
+        for i in range(3 * e, 3 * e + 3):
+            columns["sigma_" + names[i]] = (sigmas[:, i] if sigmas is not None
+                                            else np.full(len(columns[names[i]]), np.nan))
     return Rates(t_ns, columns, dict(metadata))

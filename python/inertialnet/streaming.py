@@ -35,6 +35,8 @@ def stream(
     max_pairs: int = 0,
     lanes: int = 2,
     flow_check: float = 0.5,
+    max_sigma: float = 10.0,
+    smooth: str = "lag:2",
 ) -> Iterator[Tuple[int, np.ndarray, Union[str, Tuple[str, ...]]]]:
     """Yields ``(timestamp_ns, rates, status)`` for each frame pair as soon as it is computed,
     in pair order: ``timestamp_ns`` the pair's second frame (int), ``rates`` float64 ``(3,)`` in
@@ -45,7 +47,9 @@ def stream(
     ``sequence`` is anything ``predict`` takes, or a live source: ``"/dev/video0"``,
     ``"camera:0"``, ``"gst:videotestsrc ! videoconvert ! appsink"`` (a GStreamer pipeline ending in
     appsink) or ``"capture:rtsp://…"`` (any OpenCV capture); a live source runs until it ends or
-    the loop stops. The other arguments are ``predict()``'s.
+    the loop stops. The other arguments are ``predict()``'s. With ``smooth="lag:L"`` (the default
+    ``"lag:2"``) each pair is yielded L pairs late (L frame intervals of latency; the last L when the
+    source ends); ``smooth="off"`` yields each pair's two-frame rates as soon as it is computed.
 
     Frames are read and pushed as the loop asks for pairs; several pairs are computed at once
     behind it, and a loop slower than the devices holds the reading back (bounded memory). Ctrl-C
@@ -60,4 +64,4 @@ def stream(
         os.fspath(sequence), [os.fspath(w) for w in weights], model or "", flow or "", head or "", solver,
         number(fx), number(fy), number(cx), number(cy), "" if calibration is None else os.fspath(calibration),
         calibration_camera, camera, float(rate_hz), "" if device is None else str(device), int(max_pairs),
-        int(lanes), float(flow_check))
+        int(lanes), float(flow_check), float(max_sigma), str(smooth))

@@ -829,6 +829,7 @@ py::tuple predict(const PredictSettings& settings, std::size_t max_pairs, int la
                   const py::object& progress) {
   std::vector<std::int64_t> t_ns;
   std::vector<double> values;
+  std::vector<double> sigmas;  // as values: each estimator's σ (NaN where not known)
   std::vector<FlowField> flows;
   std::vector<std::string> columns;
   std::vector<std::string> statuses;
@@ -849,6 +850,7 @@ py::tuple predict(const PredictSettings& settings, std::size_t max_pairs, int la
           t_ns.push_back(r.t1_ns);
           for (const EstimatorRates& answer : r.rates) {
             values.insert(values.end(), answer.w.begin(), answer.w.end());
+            sigmas.insert(sigmas.end(), answer.sigma.begin(), answer.sigma.end());
             statuses.emplace_back(to_string(answer.status));
           }
           if (r.flow) flows.push_back(*r.flow);
@@ -860,6 +862,8 @@ py::tuple predict(const PredictSettings& settings, std::size_t max_pairs, int la
   std::copy(t_ns.begin(), t_ns.end(), t.mutable_data());
   py::array_t<double> v({static_cast<py::ssize_t>(t_ns.size()), static_cast<py::ssize_t>(columns.size())});
   std::copy(values.begin(), values.end(), v.mutable_data());
+  py::array_t<double> sigma({static_cast<py::ssize_t>(t_ns.size()), static_cast<py::ssize_t>(columns.size())});
+  std::copy(sigmas.begin(), sigmas.end(), sigma.mutable_data());
   py::list flow_list;
   for (const auto& f : flows) flow_list.append(flow_to_array(f));
   py::list status_rows;
@@ -871,7 +875,7 @@ py::tuple predict(const PredictSettings& settings, std::size_t max_pairs, int la
   }
   // The metadata the rates CSV states (frame, estimator, time offset, readout time): the rates
   // carry it, so that evaluate() reads them as `inertialnet eval` reads the CLI's CSV.
-  return py::make_tuple(columns, t, v, flow_list, status_rows, metadata);
+  return py::make_tuple(columns, t, v, flow_list, status_rows, metadata, sigma);
 }
 
 // `inertialnet eval --json` with the CLI's options as arguments: time_offset is None (the rates
@@ -1047,7 +1051,7 @@ PredictSettings python_predict_settings(const std::filesystem::path& sequence, c
                                         bool keep_flow, const py::object& max_pairs, int lanes, int decode_threads, double flow_check,
                                         const py::object& progress, const py::object& time_offset, double readout_time, const std::string& camera,
                                         const std::string& calibration, const std::string& calibration_camera, const std::string& image_topic,
-                                        const std::string& camera_info_topic) {
+                                        const std::string& camera_info_topic, double max_sigma, const std::string& smooth) {
   // The CLI's checks of --max-pairs, --rate, --fx, --fy: a value they refuse is a ValueError
   // here, not ignored (a negative rate or focal length was taken as "not given").
   const std::int64_t pairs = integer_of(max_pairs, "max_pairs");
@@ -1102,6 +1106,8 @@ PredictSettings python_predict_settings(const std::filesystem::path& sequence, c
   s.device = device;
   s.keep_flow = keep_flow;
   s.flow_check_px = flow_check;
+  s.max_sigma_deg_s = max_sigma;  // predict --max-sigma, --smooth (issue 22)
+  s.smooth = smooth;
   if (lanes < 1 || decode_threads < 1) throw invalid_input("lanes and decode_threads must be at least 1");
   return s;
 }
@@ -1305,8 +1311,8 @@ PYBIND11_MODULE(_inertialnet, m) {
            bool keep_flow, const py::object& max_pairs, int lanes, int decode_threads, double flow_check,
            const py::object& progress, const py::object& time_offset, double readout_time, const std::string& camera,
            const std::string& calibration, const std::string& calibration_camera, const std::string& image_topic,
-           const std::string& camera_info_topic) {
-          const PredictSettings s = python_predict_settings(sequence, weights, model, flow, head, solver, fx, fy, cx, cy, rate_hz, device, keep_flow, max_pairs, lanes, decode_threads, flow_check, progress, time_offset, readout_time, camera, calibration, calibration_camera, image_topic, camera_info_topic);
+           const std::string& camera_info_topic, double max_sigma, const std::string& smooth) {
+          const PredictSettings s = python_predict_settings(sequence, weights, model, flow, head, solver, fx, fy, cx, cy, rate_hz, device, keep_flow, max_pairs, lanes, decode_threads, flow_check, progress, time_offset, readout_time, camera, calibration, calibration_camera, image_topic, camera_info_topic, max_sigma, smooth);
           return predict(s, static_cast<std::size_t>(integer_of(max_pairs, "max_pairs")), lanes, decode_threads, progress);
         });
   m.def("_evaluate_json", &evaluate_json);
@@ -1318,8 +1324,8 @@ PYBIND11_MODULE(_inertialnet, m) {
            bool keep_flow, const py::object& max_pairs, int lanes, int decode_threads, double flow_check,
            const py::object& progress, const py::object& time_offset, double readout_time, const std::string& camera,
            const std::string& calibration, const std::string& calibration_camera, const std::string& image_topic,
-           const std::string& camera_info_topic) {
-          const PredictSettings s = python_predict_settings(sequence, weights, model, flow, head, solver, fx, fy, cx, cy, rate_hz, device, keep_flow, max_pairs, lanes, decode_threads, flow_check, progress, time_offset, readout_time, camera, calibration, calibration_camera, image_topic, camera_info_topic);
+           const std::string& camera_info_topic, double max_sigma, const std::string& smooth) {
+          const PredictSettings s = python_predict_settings(sequence, weights, model, flow, head, solver, fx, fy, cx, cy, rate_hz, device, keep_flow, max_pairs, lanes, decode_threads, flow_check, progress, time_offset, readout_time, camera, calibration, calibration_camera, image_topic, camera_info_topic, max_sigma, smooth);
           return predict_rates_file_of(rates, skip_current, s, static_cast<std::size_t>(integer_of(max_pairs, "max_pairs")),
                                        lanes, decode_threads, progress);
         });

@@ -43,6 +43,10 @@ std::vector<std::string> all_columns(const RatesTable& t) {
 
 bool is_status_column(const std::string& name) { return name == "status" || name.rfind("status_", 0) == 0; }
 
+// A standard-deviation column (schema 4: sigma_wx<suffix>, …): empty (NaN) wherever σ is not
+// known, whatever the row's status; a σ of a pair that is not ok (uncertain) is kept.
+bool is_sigma_column(const std::string& name) { return name.rfind("sigma_", 0) == 0; }
+
 // The status column that speaks for a rates column: status<suffix> for w[xyz]<suffix>; "" for
 // columns of no group (a numeric column of the caller's own).
 std::string status_column_of(const std::string& name) {
@@ -67,7 +71,7 @@ int schema_version(const std::string& value, const fs::path& path) {
   const std::string prefix = "inertialnet.rates/";
   if (value.rfind(prefix, 0) == 0) {
     const std::string number = value.substr(prefix.size());
-    if (number == "1" || number == "2" || number == "3") return number[0] - '0';
+    if (number == "1" || number == "2" || number == "3" || number == "4") return number[0] - '0';
     if (!number.empty() && number.size() < 6 && number.find_first_not_of("0123456789") == std::string::npos) {
       throw invalid_input(path.string() + " is a rates file of schema " + value + ", newer than this version reads (" +
                           kRatesSchema + "); update inertialnet.");
@@ -123,7 +127,7 @@ void RatesTable::validate() const {
   }
   // A rate that is not a number belongs to a row whose estimator did not answer.
   const auto check_finite = [&](const std::string& name, std::size_t row, double v) {
-    if (std::isfinite(v)) return;
+    if (std::isfinite(v) || is_sigma_column(name)) return;
     const std::string status_name = status_column_of(name);
     for (std::size_t c = 0; c < status_names.size(); ++c) {
       if (status_names[c] == status_name && statuses[c][row] != "ok") return;
@@ -261,7 +265,7 @@ void read_sidecar(const fs::path& path, RatesTable& table) {
     throw wrong("expected a JSON object whose \"schema\" is \"" + std::string(kRatesSchema) + "\".");
   }
   const std::string schema = doc["schema"].get<std::string>();
-  if (schema_version(schema, sidecar) != 3) throw wrong("a sidecar is of schema " + std::string(kRatesSchema) + ", not " + schema + ".");
+  if (schema_version(schema, sidecar) < 3) throw wrong("a sidecar is of schema " + std::string(kRatesSchema) + ", not " + schema + ".");
   // rows and fnv1a64 tie the sidecar to its CSV (a journal's sidecar has neither: its CSV grows).
   const bool has_rows = doc.contains("rows"), has_hash = doc.contains("fnv1a64");
   if (has_rows != has_hash || (has_rows && (!doc["rows"].is_number_unsigned() || !doc["fnv1a64"].is_string()))) {
@@ -407,6 +411,8 @@ RatesTable read_rates_csv(const fs::path& path) {
     }
     // An empty cell is an unknown rate, allowed where the column's status says why.
     const auto value = [&](std::string_view field, const std::string& column, int status, bool rate) {
+      if (field.empty() && is_sigma_column(column)) return std::nan("");
+      if (is_sigma_column(column)) return csv::parse_double(field, path, ln, column);
       if (field.empty() && status >= 0 && !ok[static_cast<std::size_t>(status)]) return std::nan("");
       if (field.empty() && status >= 0) {
         throw invalid_input(path.string() + " line " + std::to_string(ln) + ": " + column + " is empty but " +
@@ -453,9 +459,12 @@ std::vector<std::string> RatesLayout::columns() const {
 RatesLayout rates_layout(const std::vector<std::string>& suffixes) {
   RatesLayout layout;
   for (const auto& suffix : suffixes) {
-    if (suffix.empty()) continue;  // wx,wy,wz,status are always there
-    for (const char* axis : kAxes) layout.extra_names.push_back(axis + suffix);
-    layout.status_names.push_back("status" + suffix);
+    if (!suffix.empty()) {  // wx,wy,wz,status are always there
+      for (const char* axis : kAxes) layout.extra_names.push_back(axis + suffix);
+      layout.status_names.push_back("status" + suffix);
+    }
+    // Schema 4: each group's standard deviations after its status.
+    for (const char* axis : kAxes) layout.extra_names.push_back(std::string("sigma_") + axis + suffix);
   }
   return layout;
 }
@@ -585,6 +594,15 @@ std::string format_rates_row(const RatesLayout& layout, const RatesRow& row) {
   char buf[48];
   std::string text = std::to_string(row.t_ns);
   const auto cell = [&](const std::string& column, double v) {
+    if (is_sigma_column(column)) {
+      if (!std::isfinite(v)) {
+        text += ",";  // σ not known
+        return;
+      }
+      std::snprintf(buf, sizeof buf, ",%.9g", v);
+      text += buf;
+      return;
+    }
     const std::string* status = status_of(column);
     if (status && *status != "ok") {
       text += ",";  // no answer: an empty cell, whatever was computed

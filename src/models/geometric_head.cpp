@@ -26,6 +26,7 @@
 #include "inertialnet/runtime/error.hpp"
 #include "models/motion_field_solver.hpp"
 #include "models/opengv_head.hpp"
+#include "models/rate_uncertainty.hpp"
 #include "models/rolling_shutter_solver.hpp"
 
 namespace inertialnet {
@@ -134,7 +135,9 @@ RotationEstimate assessed(RotationEstimate est, double inlier_threshold_px) {
 }  // namespace
 
 RotationEstimate GeometricHead::estimate(Queue& queue, const Tensor& flow, double dt, const std::atomic<bool>* stop) {
-  return assessed(solve(queue, flow, dt, stop), options_.inlier_threshold_px);
+  RotationEstimate est = solve(queue, flow, dt, stop);
+  detail::calibrate_covariance(est, camera_.mean_focal(), dt, options_);
+  return assessed(std::move(est), options_.inlier_threshold_px);
 }
 
 RotationEstimate GeometricHead::solve(Queue& queue, const Tensor& flow, double dt, const std::atomic<bool>* stop) {

@@ -91,6 +91,16 @@ void check_usable(const MotionFieldMoments& m) {
   }
 }
 
+// The raw covariance of a rotation-mode solve: s²·N⁻¹ with N = Σ w·AᵀA and s² = Σ w·e² over
+// the 2·Σw − 3 degrees of freedom of the weighted 2-D residuals.
+void set_rotation_covariance(RotationEstimate& e, const MotionFieldMoments& m) {
+  const double dof = 2 * m.weight_sum - 3;
+  const Eigen::Matrix3d inverse = symmetric(m.normal).inverse();
+  if (!(dof > 0) || !inverse.allFinite()) return;
+  e.raw_covariance = to_mat3(m.weighted_sq_residual / dof * inverse);
+  e.covariance_known = true;
+}
+
 void fill_diagnostics(RotationEstimate& e, const MotionFieldMoments& m, double to_norm) {
   e.samples = static_cast<int>(m.usable);
   e.inlier_fraction = m.usable > 0 ? m.inliers / m.usable : 0;
@@ -146,7 +156,9 @@ RotationEstimate solve_motion_field(const MomentsFunction& moments, double dt, d
     // Diagnostics at the final ω and σ.
     p.omega = omega;
     p.scale = sigma_final;
-    fill_diagnostics(est, moments(p), to_norm);
+    const MotionFieldMoments last = moments(p);
+    fill_diagnostics(est, last, to_norm);
+    set_rotation_covariance(est, last);
     est.iterations = passes + 1;
     return est;
   }
@@ -216,6 +228,12 @@ RotationEstimate solve_motion_field(const MomentsFunction& moments, double dt, d
   est.converged = best.converged;
   est.iterations = passes;
   fill_diagnostics(est, best.last, to_norm);
+  const Eigen::Matrix3d covariance = GeneralQuadratic(best.last).omega_covariance(best.t, best.last.weight_sum);
+  est.parallax = best.last.inliers > 0 ? std::sqrt(best.last.parallel_sq / best.last.inliers) : 0;
+  if (covariance.trace() > 0 && covariance.allFinite()) {
+    est.raw_covariance = to_mat3(covariance);
+    est.covariance_known = true;
+  }
   // Orient T so that the inliers' depths come out positive.
   est.translation_direction = to_vec3(best.last.parallel_sum < 0 ? Eigen::Vector3d(-best.t) : best.t);
   return est;

@@ -212,6 +212,30 @@ Fit fit_from(const std::vector<RowSample>& samples, RowMotion m, double sigma, i
   return fit;
 }
 
+// The raw covariance of the middle row's ω at `m`: Gauss-Newton over the 12 parameters with the
+// Tukey weights at the final σ, v's free scale held as in the fit, scaled by Σw·r² over the
+// Σw − 11 degrees of freedom. Zero when it is not defined.
+Eigen::Matrix3d row_covariance(const std::vector<RowSample>& samples, const RowMotion& m, double sigma) {
+  Mat12 h = Mat12::Zero();
+  double wsum = 0, wr2 = 0;
+  for (const RowSample& p : samples) {
+    Vec12 j;
+    const double r = residual(p, m, &j);
+    const double wt = tukey_weight(std::abs(r), sigma);
+    if (wt <= 0) continue;
+    h.selfadjointView<Eigen::Lower>().rankUpdate(j, wt);
+    wsum += wt;
+    wr2 += wt * r * r;
+  }
+  h = h.selfadjointView<Eigen::Lower>();
+  const double scale = h.diagonal().maxCoeff();
+  if (!(scale > 0) || !(wsum > 11)) return Eigen::Matrix3d::Zero();
+  h.block<3, 3>(6, 6) += scale * m.v * m.v.transpose();
+  const Eigen::Matrix3d c = h.inverse().topLeftCorner<3, 3>();
+  if (!c.allFinite()) return Eigen::Matrix3d::Zero();
+  return wr2 / (wsum - 11) * c;
+}
+
 }  // namespace
 
 std::string rolling_shutter_fallback_reason(const Vec3& start, double start_cost, const Vec3& refined,
@@ -264,6 +288,11 @@ RotationEstimate refine_rolling_shutter(const std::vector<RowSample>& samples, c
     return est;
   }
   est.omega = to_vec3(best.m.omega);
+  const Eigen::Matrix3d covariance = row_covariance(samples, best.m, sigma);
+  if (covariance.trace() > 0) {
+    est.raw_covariance = to_mat3(covariance);
+    est.covariance_known = true;
+  }
   est.translation_direction = to_vec3(best.m.v.dot(start_v) < 0 ? Eigen::Vector3d(-best.m.v) : best.m.v);
   est.converged = start.converged && best.converged;
   return est;

@@ -60,6 +60,38 @@ double GeneralQuadratic::significance(const Eigen::Vector3d& t, const Eigen::Vec
   return c > 0 ? dw.dot(h33(t) * dw) / c : 0.0;
 }
 
+Eigen::Matrix3d GeneralQuadratic::omega_covariance(const Eigen::Vector3d& t, double weight_sum) const {
+  // Each sample's residual nᵀ(r − A·Δω) with n = M·(T + ΔT) is Tᵀ(c_r − Σ Δω_j·c_j) + ΔTᵀ·c_r to
+  // first order, so the information matrix over (Δω, ΔT) comes from the Gram blocks
+  // G_kl = Σ w·c_k·c_lᵀ: H_ωω = TᵀG_jk T, H_ωT = −(TᵀG_j3)·P, H_TT = PᵀG_33 P (P: T's tangent
+  // basis; the change of |n|'s normalisation with T is second order at the solution).
+  const Eigen::Vector3d u = t.normalized();
+  Eigen::Matrix<double, 3, 2> p;
+  p.col(0) = u.unitOrthogonal();
+  p.col(1) = u.cross(p.col(0));
+  const Eigen::Matrix3d hww = h33(u);
+  Eigen::Matrix<double, 3, 2> hwt;
+  for (int j = 0; j < 3; ++j) hwt.row(j) = -(u.transpose() * gram_.block<3, 3>(3 * j, 9)) * p;
+  const Eigen::Matrix2d htt = p.transpose() * gram_.block<3, 3>(9, 9) * p;
+  Eigen::Matrix3d schur = hww;
+  const Eigen::LDLT<Eigen::Matrix2d> ldlt_t(htt);
+  if (ldlt_t.info() == Eigen::Success && ldlt_t.isPositive() && htt.trace() > 0) {
+    const Eigen::Matrix3d reduced = hww - hwt * ldlt_t.solve(hwt.transpose());
+    // T barely determined (pure rotation): its coupling to ω is noise; keep the conditional form.
+    if (reduced.allFinite() && reduced.determinant() > 1e-12 * hww.determinant()) schur = reduced;
+  }
+  // The residual Σψ·s² at T: the unnormalised cost, min over Δω.
+  Eigen::Matrix4d h;
+  for (int k = 0; k < 4; ++k)
+    for (int l = k; l < 4; ++l) h(k, l) = h(l, k) = u.dot(gram_.block<3, 3>(3 * k, 3 * l) * u);
+  const Eigen::Vector3d h3 = h.block<3, 1>(0, 3);
+  const double residual = std::max(0.0, h(3, 3) - h3.dot(hww.ldlt().solve(h3)));
+  const double dof = weight_sum - 5;
+  const Eigen::Matrix3d inverse = schur.inverse();
+  if (!(dof > 0) || !inverse.allFinite()) return Eigen::Matrix3d::Zero();
+  return residual / dof * inverse;
+}
+
 Eigen::Matrix3d GeneralQuadratic::h33(const Eigen::Vector3d& t) const {
   Eigen::Matrix3d h;
   for (int k = 0; k < 3; ++k)

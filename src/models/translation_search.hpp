@@ -39,6 +39,13 @@ class GeneralQuadratic {
   // the estimate, (normalised cost)·H₃₃⁻¹. Below 0.01 the step is a tenth of a standard error.
   double significance(const Eigen::Vector3d& t, const Eigen::Vector3d& dw) const;
 
+  // The covariance of ω at the solution T (unit), from this pass's Gram matrix (the pass at the
+  // final ω, T and σ): Gauss-Newton over (Δω, ΔT in T's tangent plane), T's two degrees of
+  // freedom marginalised out (the Schur complement), scaled by the residual variance
+  // Σψ·s² / (Σψ − 5) with Σψ = `weight_sum`. Raw: it treats the flow vectors as independent
+  // (motion_field_solver.cpp inflates it). A zero matrix when it is not defined.
+  Eigen::Matrix3d omega_covariance(const Eigen::Vector3d& t, double weight_sum) const;
+
  private:
   Eigen::Matrix3d h33(const Eigen::Vector3d& t) const;
 

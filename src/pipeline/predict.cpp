@@ -9,6 +9,7 @@
 #include <cmath>
 #include <optional>
 
+#include "inertialnet/core/constants.hpp"
 #include "inertialnet/io/bag.hpp"
 #include "inertialnet/io/calibration_file.hpp"
 #include "inertialnet/io/camera.hpp"
@@ -237,6 +238,12 @@ Prediction::Prediction(const PredictSettings& s) : settings_(s) {
   processor_.geometric.readout_time_s = s.readout_time_s;
   require_flow_check_setting(s.flow_check_px);
   processor_.flow_check_px = s.flow_check_px;
+  if (!std::isfinite(s.max_sigma_deg_s) || s.max_sigma_deg_s < 0) {
+    throw invalid_input("--max-sigma must be a non-negative number of deg/s (0: no limit), got " +
+                        std::to_string(s.max_sigma_deg_s));
+  }
+  processor_.max_sigma_rad_s = s.max_sigma_deg_s * kPi / 180;
+  smoother_ = parse_rate_smoother(s.smooth);
   source_ = open_frame_source(s.sequence, s.rate_hz > 0 ? std::optional<double>(s.rate_hz) : std::nullopt, s.camera, s.bag);
   notes_ = source_->notes();
   if (processor_.geometric_head || (processor_.inertialnet_head && processor_.head_input == HeadInput::Normalized)) {
@@ -311,6 +318,8 @@ std::vector<std::pair<std::string, std::string>> Prediction::csv_metadata() cons
   }
   if (settings_.time_offset_s) metadata.push_back({"time_offset_s", format_number(*settings_.time_offset_s)});
   if (settings_.readout_time_s > 0) metadata.push_back({"readout_time_s", format_number(settings_.readout_time_s)});
+  // Issue 22: smoothed rates say so (and their latency follows from the lag).
+  if (smoother_.enabled) metadata.push_back({"smoothing", to_string(smoother_)});
   return metadata;
 }
 
@@ -351,7 +360,25 @@ PipelineStats Prediction::run(FrameSource& source, const std::function<void(cons
     }
     sink(r);
   };
-  return run_pipeline(source, devices, factory, checked, options);
+  if (!smoother_.enabled) return run_pipeline(source, devices, factory, checked, options);
+  // The smoother holds `lag` pairs; what it holds when the run ends (or stops) goes out smoothed
+  // with what there is, also when the run failed, so that no computed pair is lost.
+  RateSmoother smoother(smoother_);
+  const auto smoothed = [&](const PairResult& r) {
+    for (const PairResult& out : smoother.push(r)) checked(out);
+  };
+  PipelineStats stats;
+  try {
+    stats = run_pipeline(source, devices, factory, smoothed, options);
+  } catch (...) {
+    try {
+      for (const PairResult& out : smoother.flush()) checked(out);
+    } catch (...) {  // the run's own error is the one to report
+    }
+    throw;
+  }
+  for (const PairResult& out : smoother.flush()) checked(out);
+  return stats;
 }
 
 RatesRow rates_row(const PairResult& r) {
@@ -361,8 +388,11 @@ RatesRow rates_row(const PairResult& r) {
   const EstimatorRates& first = r.rates.front();
   row.w = {first.w[0], first.w[1], first.w[2]};
   row.status = to_string(first.status);
+  // Layout order (rates_layout): the first estimator's σ, then each further one's rates and σ.
+  row.extra.insert(row.extra.end(), first.sigma.begin(), first.sigma.end());
   for (std::size_t i = 1; i < r.rates.size(); ++i) {
     row.extra.insert(row.extra.end(), r.rates[i].w.begin(), r.rates[i].w.end());
+    row.extra.insert(row.extra.end(), r.rates[i].sigma.begin(), r.rates[i].sigma.end());
     row.statuses.push_back(to_string(r.rates[i].status));
   }
   return row;

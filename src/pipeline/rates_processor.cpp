@@ -1,10 +1,15 @@
 // SPDX-License-Identifier: Apache-2.0
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <string>
 
+#include "inertialnet/core/constants.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/models/dis_flow.hpp"
 #include "inertialnet/models/flownet.hpp"
@@ -21,6 +26,33 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 Vec3 to_body(const std::optional<Mat3>& r, const Vec3& w) { return r ? mul(*r, w) : w; }
+
+// The standard deviation along the least certain direction of a covariance (its largest
+// eigenvalue's root).
+double least_certain_sigma(const Mat3& c) {
+  Eigen::Matrix3d m;
+  m << c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7], c[8];
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(m, Eigen::EigenvaluesOnly);
+  return std::sqrt(std::max(0.0, eig.eigenvalues()(2)));
+}
+
+// The per-axis standard deviations of a camera-frame covariance C after the rotation R (body
+// frame: diag(R·C·Rᵀ)); NaN when the covariance is not known.
+std::array<double, 3> axis_sigma(const std::optional<Mat3>& r, const RotationEstimate& e) {
+  if (!e.covariance_known) return {EstimatorRates::kUnknownSigma, EstimatorRates::kUnknownSigma, EstimatorRates::kUnknownSigma};
+  const Mat3& c = e.covariance;
+  std::array<double, 3> out{};
+  for (int i = 0; i < 3; ++i) {
+    double v = c[static_cast<std::size_t>(4 * i)];
+    if (r) {
+      v = 0;
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) v += (*r)[static_cast<std::size_t>(3 * i + a)] * c[static_cast<std::size_t>(3 * a + b)] * (*r)[static_cast<std::size_t>(3 * i + b)];
+    }
+    out[static_cast<std::size_t>(i)] = std::sqrt(std::max(0.0, v));
+  }
+  return out;
+}
 
 class RatesProcessor : public PairProcessor {
  public:
@@ -144,14 +176,32 @@ class RatesProcessor : public PairProcessor {
       try {
         const RotationEstimate estimate = geometric_->estimate(q, checked.defined() ? checked : flow, dt, &stop);
         const Vec3 w = to_body(options_.camera_to_body, estimate.omega);
+        const std::array<double, 3> sigma = axis_sigma(options_.camera_to_body, estimate);
+        // The σ along the least certain direction (the covariance's largest eigenvalue): the same in
+        // the camera and the body frame, so that --max-sigma picks the same pairs in either.
+        const double largest = estimate.covariance_known ? least_certain_sigma(estimate.covariance)
+                                                         : EstimatorRates::kUnknownSigma;
+        constexpr double kDeg = 180 / kPi;
         if (estimate.status != PairStatus::Ok) {
           answer.status = estimate.status;
           answer.reason = estimate.status_reason;
-        } else if (std::isfinite(w[0]) && std::isfinite(w[1]) && std::isfinite(w[2])) {
-          answer.w = {w[0], w[1], w[2]};
-        } else {
+        } else if (!(std::isfinite(w[0]) && std::isfinite(w[1]) && std::isfinite(w[2]))) {
           answer.status = PairStatus::NonFinite;
           answer.reason = "the geometric head's rates are not finite (NaN or infinity)";
+        } else if (options_.max_sigma_rad_s > 0 && largest > options_.max_sigma_rad_s) {
+          // Too uncertain to report (RatesProcessorOptions::max_sigma_rad_s); σ stays, for the user.
+          char text[200];
+          std::snprintf(text, sizeof text,
+                        "geometric head: the rates' standard deviation %.2f %.2f %.2f deg/s (%.2f along the least certain "
+                        "axis) exceeds the limit %.2f deg/s (--max-sigma)",
+                        sigma[0] * kDeg, sigma[1] * kDeg, sigma[2] * kDeg, largest * kDeg,
+                        options_.max_sigma_rad_s * kDeg);
+          answer.status = PairStatus::Uncertain;
+          answer.reason = text;
+          answer.sigma = sigma;
+        } else {
+          answer.w = {w[0], w[1], w[2]};
+          answer.sigma = sigma;
         }
       } catch (const UnanswerablePair& e) {
         answer.status = e.status();

@@ -64,10 +64,10 @@ def main():
         if f.read() != earlier_sidecar:
             problems.append("the earlier r.csv.json was changed")
     got = rows(partial)
-    if got[0] != "timestamp_ns,wx,wy,wz,status" or len(got) < 4:
+    if got[0] != "timestamp_ns,wx,wy,wz,status,sigma_wx,sigma_wy,sigma_wz" or len(got) < 4:
         problems.append(f"r.csv.partial holds {got[:2]}…, expected the header and at least 3 rows")
     for line in got[1:]:
-        if len(line.split(",")) != 5:
+        if len(line.split(",")) != 8:
             problems.append(f"a torn row in r.csv.partial: {line!r}")
     left = set(os.listdir(work)) - before
     if left != {"r.csv.partial", "r.csv.partial.json"}:

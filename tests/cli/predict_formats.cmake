@@ -52,11 +52,11 @@ expect_same(streamed.txt traj.txt)
 
 # 3. The CSV on standard output: the header first, the metadata as a note on the standard error.
 run_json(stdout_csv ${CLI} predict gap)
-if(NOT stdout_csv MATCHES "^timestamp_ns,wx,wy,wz,status\n")
+if(NOT stdout_csv MATCHES "^timestamp_ns,wx,wy,wz,status,sigma_wx,sigma_wy,sigma_wz\n")
   message(FATAL_ERROR "predict's standard output does not start with the header:\n${stdout_csv}")
 endif()
 run(0 ${CLI} predict gap)
-expect_match("note: the rates' metadata \\(a stream has no sidecar\\): schema: inertialnet.rates/3, frame: body, estimator: inter_frame")
+expect_match("note: the rates' metadata \\(a stream has no sidecar\\): schema: inertialnet.rates/4, frame: body, estimator: inter_frame")
 
 # 4. A run that fails leaves every earlier output as it was: all pairs without an answer.
 run(0 ${CLI} synth flat --frames 3 --size 376x240 --seed 2)
@@ -94,7 +94,7 @@ endif()
 # 6. The sidecar: one that describes another CSV is refused naming both; a newer schema is refused;
 #    a CSV alone reads without metadata and says so.
 file(COPY_FILE "${WORK}/rates.csv" "${WORK}/edited.csv")
-file(APPEND "${WORK}/edited.csv" "1403715279912142976,0.1,0.2,0.3,ok\n")
+file(APPEND "${WORK}/edited.csv" "1403715279912142976,0.1,0.2,0.3,ok,,,\n")
 file(COPY_FILE "${WORK}/rates.csv.json" "${WORK}/edited.csv.json")
 run(2 ${CLI} eval edited.csv gap)
 expect_match("edited.csv.json \\(the sidecar of edited.csv\\): it describes another CSV \\(11 rows")
@@ -102,8 +102,8 @@ file(COPY_FILE "${WORK}/rates.csv" "${WORK}/alone.csv")
 run(0 ${CLI} eval alone.csv gap)
 expect_match("alone.csv states no metadata \\(no sidecar alone.csv.json")
 file(COPY_FILE "${WORK}/rates.csv" "${WORK}/future.csv")
-file(WRITE "${WORK}/future.csv.json" "{\"schema\": \"inertialnet.rates/4\", \"metadata\": {}}")
+file(WRITE "${WORK}/future.csv.json" "{\"schema\": \"inertialnet.rates/5\", \"metadata\": {}}")
 foreach(command "eval;future.csv;gap" "export;future.csv;--format;tum;-o;f.txt" "calibrate-time;gap;future.csv")
   run(2 ${CLI} ${command})
-  expect_match("future.csv.json is a rates file of schema inertialnet.rates/4, newer than this version reads")
+  expect_match("future.csv.json is a rates file of schema inertialnet.rates/5, newer than this version reads")
 endforeach()

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// The rates CSV (schema inertialnet.rates/3: timestamp_ns,wx,wy,wz,status[,…] and its sidecar):
+// The rates CSV (schema inertialnet.rates/4 (3 before σ): timestamp_ns,wx,wy,wz,status[,…] and its sidecar):
 // round trip, statuses, schema-1 and -2 files, the sidecar, the journal a run writes, and errors.
 #include <gtest/gtest.h>
 
@@ -156,12 +156,14 @@ TEST(RatesCsv, MetadataRoundTripAndOldFiles) {
   write_rates_csv(path, t);
   const RatesTable back = read_rates_csv(path);
   auto expected = t.metadata;
-  expected.insert(expected.begin(), {"schema", "inertialnet.rates/3"});
+  expected.insert(expected.begin(), {"schema", "inertialnet.rates/4"});
   EXPECT_EQ(back.metadata, expected);
   EXPECT_EQ(back.meta("frame").value_or(""), "body");
   EXPECT_FALSE(back.meta("readout_time_s").has_value());
   EXPECT_NEAR(back.meta_number("time_offset_s").value_or(0), 0.04, 1e-15);
-  EXPECT_EQ(rates_csv_header(rates_layout({"", "_g"})), "timestamp_ns,wx,wy,wz,status,wx_g,wy_g,wz_g,status_g\n");
+  EXPECT_EQ(rates_csv_header(rates_layout({"", "_g"})),
+            "timestamp_ns,wx,wy,wz,status,sigma_wx,sigma_wy,sigma_wz,wx_g,wy_g,wz_g,status_g,sigma_wx_g,sigma_wy_g,"
+            "sigma_wz_g\n");
   EXPECT_THROW(rates_sidecar_text({{"two words", "x"}}), Error);
   // Schema 2 (today's files before the sidecar): the metadata in comment lines, read as before.
   const auto two = write_text(dir, "# schema: inertialnet.rates/2\n# frame: camera\ntimestamp_ns,wx,wy,wz,status\n5,1,2,3,ok\n");
@@ -184,26 +186,37 @@ TEST(RatesCsv, StatusesRoundTripWithEmptyRates) {
   {
     RatesCsvWriter writer(path, rates_layout({"", "_geometric"}), {{"frame", "body"}});
     const double nan = std::nan("");
-    writer.write({100, {0.1, 0.2, 0.3}, "ok", {1, 2, 3}, {"ok"}});
-    writer.write({200, {nan, nan, nan}, "no_texture", {nan, nan, nan}, {"no_texture"}});
-    writer.write({300, {0.4, 0.5, 0.6}, "ok", {nan, 5, nan}, {"too_few_vectors"}});
+    // Extras in layout order: the first group's σ, then the second group's rates and σ.
+    writer.write({100, {0.1, 0.2, 0.3}, "ok", {nan, nan, nan, 1, 2, 3, 0.01, 0.02, 0.03}, {"ok"}});
+    writer.write({200, {nan, nan, nan}, "no_texture", {nan, nan, nan, nan, nan, nan, nan, nan, nan}, {"no_texture"}});
+    writer.write({300, {0.4, 0.5, 0.6}, "ok", {nan, nan, nan, nan, 5, nan, nan, nan, nan}, {"too_few_vectors"}});
+    // Schema 4: an uncertain pair keeps its σ (why it is uncertain) and loses its rates.
+    writer.write({400, {0.4, 0.5, 0.6}, "ok", {nan, nan, nan, 7, 8, 9, 0.2, 0.3, 0.4}, {"uncertain"}});
     writer.close();
   }
   std::ifstream in(path);
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  EXPECT_TRUE(contains(text, "timestamp_ns,wx,wy,wz,status,wx_geometric,wy_geometric,wz_geometric,status_geometric\n")) << text;
-  EXPECT_TRUE(contains(text, "\n200,,,,no_texture,,,,no_texture\n")) << text;
-  EXPECT_TRUE(contains(text, "\n300,0.4,0.5,0.6,ok,,,,too_few_vectors\n")) << text;  // a rate without an answer is not written
+  EXPECT_TRUE(contains(text, "timestamp_ns,wx,wy,wz,status,sigma_wx,sigma_wy,sigma_wz,wx_geometric,wy_geometric,"
+                             "wz_geometric,status_geometric,sigma_wx_geometric,sigma_wy_geometric,sigma_wz_geometric\n"))
+      << text;
+  EXPECT_TRUE(contains(text, "\n100,0.1,0.2,0.3,ok,,,,1,2,3,ok,0.01,0.02,0.03\n")) << text;
+  EXPECT_TRUE(contains(text, "\n200,,,,no_texture,,,,,,,no_texture,,,\n")) << text;
+  EXPECT_TRUE(contains(text, "\n300,0.4,0.5,0.6,ok,,,,,,,too_few_vectors,,,\n")) << text;  // a rate without an answer is not written
+  EXPECT_TRUE(contains(text, "\n400,0.4,0.5,0.6,ok,,,,,,,uncertain,0.2,0.3,0.4\n")) << text;
   const RatesTable r = read_rates_csv(path);
-  ASSERT_EQ(r.size(), 3u);
-  EXPECT_EQ(r.status(), (std::vector<std::string>{"ok", "no_texture", "ok"}));
-  EXPECT_EQ(r.status("_geometric"), (std::vector<std::string>{"ok", "no_texture", "too_few_vectors"}));
+  ASSERT_EQ(r.size(), 4u);
+  EXPECT_EQ(r.status(), (std::vector<std::string>{"ok", "no_texture", "ok", "ok"}));
+  EXPECT_EQ(r.status("_geometric"), (std::vector<std::string>{"ok", "no_texture", "too_few_vectors", "uncertain"}));
+  EXPECT_EQ(r.column("sigma_wy_geometric")[0], 0.02);
+  EXPECT_EQ(r.column("sigma_wz_geometric")[3], 0.4);
+  EXPECT_TRUE(std::isnan(r.column("sigma_wx")[0]));  // σ not known: an empty cell, whatever the status
+  EXPECT_TRUE(std::isnan(r.column("wx_geometric")[3]));
   EXPECT_TRUE(std::isnan(r.w[1][0]));
   EXPECT_TRUE(std::isnan(r.rates("_geometric")[2][1]));
   const RatesTable ok = r.ok_rows("_geometric");
   ASSERT_EQ(ok.size(), 1u);
   EXPECT_EQ(ok.t_ns[0], 100);
-  EXPECT_EQ(r.ok_rows().t_ns, (std::vector<std::int64_t>{100, 300}));
+  EXPECT_EQ(r.ok_rows().t_ns, (std::vector<std::int64_t>{100, 300, 400}));
   // A schema-1 file (no status column) reads as all ok.
   const RatesTable old = read_rates_csv(write_text(dir, "timestamp_ns,wx,wy,wz\n5,1,2,3\n"));
   EXPECT_EQ(old.status(), std::vector<std::string>{"ok"});
@@ -220,10 +233,10 @@ TEST(RatesCsv, StatusErrorsNameTheLine) {
   EXPECT_TRUE(contains(m, "line 2: status is \"\"")) << m;
   m = msg("timestamp_ns,wx,wy,wz\n1,,0,0\n");  // schema 1: no status to explain an empty rate
   EXPECT_TRUE(contains(m, "line 2")) << m;
-  m = msg("# schema: inertialnet.rates/4\ntimestamp_ns,wx,wy,wz,status\n1,0,0,0,ok\n");
+  m = msg("# schema: inertialnet.rates/5\ntimestamp_ns,wx,wy,wz,status\n1,0,0,0,ok\n");
   EXPECT_TRUE(contains(m, "newer than this version reads")) << m;
   m = msg("# schema: something/else\ntimestamp_ns,wx,wy,wz,status\n1,0,0,0,ok\n");
-  EXPECT_TRUE(contains(m, "expected inertialnet.rates/3")) << m;
+  EXPECT_TRUE(contains(m, "expected inertialnet.rates/4")) << m;
 }
 
 // A run's rows go to <name>.partial, one write each, and replace <name> only when the run
@@ -286,13 +299,13 @@ TEST(RatesCsv, SidecarHoldsTheMetadata) {
   const std::string csv = file_text(path);
   EXPECT_EQ(csv.substr(0, csv.find('\n')), "timestamp_ns,wx,wy,wz,status");
   const std::string sidecar = file_text(rates_sidecar_path(path));
-  EXPECT_TRUE(contains(sidecar, "\"schema\": \"inertialnet.rates/3\"")) << sidecar;
+  EXPECT_TRUE(contains(sidecar, "\"schema\": \"inertialnet.rates/4\"")) << sidecar;
   EXPECT_TRUE(contains(sidecar, "\"rows\": 2")) << sidecar;
   EXPECT_TRUE(contains(sidecar, "\"time_offset_s\": \"0.04\"")) << sidecar;
   EXPECT_FALSE(std::filesystem::exists(rates_sidecar_path(partial_rates_path(path))));
   const RatesTable r = read_rates_csv(path);
   EXPECT_EQ(r.metadata, (std::vector<std::pair<std::string, std::string>>{
-                            {"schema", "inertialnet.rates/3"}, {"frame", "body"}, {"time_offset_s", "0.04"}}));
+                            {"schema", "inertialnet.rates/4"}, {"frame", "body"}, {"time_offset_s", "0.04"}}));
   EXPECT_TRUE(r.notes.empty());
 
   // A run killed between the sidecar's rename and the CSV's: the new sidecar beside the old CSV
@@ -308,7 +321,7 @@ TEST(RatesCsv, SidecarHoldsTheMetadata) {
   m = invalid_input_message([&] { read_rates_csv(path); });
   EXPECT_TRUE(contains(m, "describes another CSV (2 rows")) << m;
   // Newer sidecars, other documents and broken JSON: refused with the sidecar's name.
-  std::ofstream(rates_sidecar_path(path)) << "{\"schema\": \"inertialnet.rates/4\"}";
+  std::ofstream(rates_sidecar_path(path)) << "{\"schema\": \"inertialnet.rates/5\"}";
   EXPECT_TRUE(contains(invalid_input_message([&] { read_rates_csv(path); }), "newer than this version reads"));
   std::ofstream(rates_sidecar_path(path)) << "{\"schema\": \"inertialnet.rates/3\", \"metadata\": {\"frame\": [1]}}";
   EXPECT_TRUE(contains(invalid_input_message([&] { read_rates_csv(path); }), "neither a string nor a number"));
@@ -321,7 +334,7 @@ TEST(RatesCsv, SidecarHoldsTheMetadata) {
   ASSERT_EQ(bare.notes.size(), 1u);
   EXPECT_TRUE(contains(bare.notes[0], "states no metadata (no sidecar rates.csv.json")) << bare.notes[0];
   // A file that states its metadata itself (schema 2) does not read a sidecar beside it.
-  std::ofstream(rates_sidecar_path(path)) << "{\"schema\": \"inertialnet.rates/4\"}";
+  std::ofstream(rates_sidecar_path(path)) << "{\"schema\": \"inertialnet.rates/5\"}";
   const RatesTable two = read_rates_csv(write_text(dir, "# schema: inertialnet.rates/2\n# frame: camera\ntimestamp_ns,wx,wy,wz\n5,1,2,3\n"));
   EXPECT_EQ(two.meta("frame").value_or(""), "camera");
 }
@@ -352,4 +365,18 @@ TEST(RatesCsv, FailedRunKeepsThePreviousPair) {
   EXPECT_FALSE(std::filesystem::exists(partial_rates_path(path)));
   EXPECT_FALSE(std::filesystem::exists(rates_sidecar_path(partial_rates_path(path))));
   EXPECT_EQ(file_text(rates_sidecar_path(path)), sidecar);
+}
+
+// Schema 4 added the σ columns; a schema-3 CSV with its sidecar (what predict wrote before) still
+// reads, without σ columns.
+TEST(RatesCsv, SchemaThreeFilesStillRead) {
+  te::TempDir dir("rates_schema3");
+  const auto path = write_text(dir, "timestamp_ns,wx,wy,wz,status\n10,0.1,0.2,0.3,ok\n20,,,,no_texture\n");
+  std::ofstream(rates_sidecar_path(path)) << "{\"schema\": \"inertialnet.rates/3\", \"metadata\": {\"frame\": \"body\"}}";
+  const RatesTable r = read_rates_csv(path);
+  ASSERT_EQ(r.size(), 2u);
+  EXPECT_EQ(r.meta("schema").value_or(""), "inertialnet.rates/3");
+  EXPECT_EQ(r.meta("frame").value_or(""), "body");
+  EXPECT_TRUE(r.extra_names.empty());
+  EXPECT_EQ(r.status()[1], "no_texture");
 }

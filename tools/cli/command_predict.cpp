@@ -75,6 +75,8 @@ struct PredictOptions {
   BagTopics bag;                     // --image-topic, --camera-info-topic
   std::string time_offset, readout_time;
   double flow_check_px = 0.5;  // PredictSettings' default
+  double max_sigma_deg_s = 10.0;  // PredictSettings' default (issue 22)
+  std::string smooth = "lag:2";   // PredictSettings' default (issue 22)
   int lanes = 0;  // 0: default_lanes_per_device()
   int decode_threads = 2;
   std::size_t max_pairs = 0;
@@ -168,6 +170,8 @@ PredictSettings settings_of(const PredictOptions& options, const GlobalOptions& 
   settings.camera = o->camera_name;
   settings.bag = o->bag;
   settings.flow_check_px = o->flow_check_px;
+  settings.max_sigma_deg_s = o->max_sigma_deg_s;
+  settings.smooth = o->smooth;
   if (!o->readout_time.empty()) settings.readout_time_s = parse_seconds(o->readout_time, "--readout-time");
   if (!o->time_offset.empty()) settings.time_offset_s = parse_seconds(o->time_offset, "--time-offset");
   settings.device = global.device;
@@ -471,6 +475,16 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
                  "this many pixels (at 752 columns, scaled with the width); 0: off")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1e6));
+  // Issue 22: confidence per pair and more than two frames.
+  app.add_option("--max-sigma", o->max_sigma_deg_s,
+                 "geometric head: a pair whose rates' standard deviation exceeds this many deg/s (along the least "
+                 "certain axis) gets the status uncertain instead of rates; 0: no limit")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e6));
+  app.add_option("--smooth", o->smooth,
+                 "off (two-frame rates), or lag:L: a fixed-lag smoother over the pairs' rates weighted by their sigma, "
+                 "each pair L frame intervals late (lag:L,q:Q sets its jerk density)")
+      ->capture_default_str();
   app.add_option("--lanes", o->lanes, "frame pairs in flight per device (default: 1 on CPU devices, 2 on others)")
       ->check(CLI::Range(1, 16));
   app.add_option("--decode-threads", o->decode_threads, "image decoding threads")->capture_default_str()->check(CLI::Range(1, 64));

@@ -20,9 +20,10 @@ enum class PairStatus {
   TooFewVectors,  // too few usable flow vectors on the geometric head's sample grid
   Unreliable,     // the solve's fit or conditioning is too poor to trust (noise, a blur burst)
   NonFinite,      // the flow or the rates computed are not finite numbers
+  Uncertain,      // the rates' standard deviation exceeds the run's limit (predict --max-sigma)
 };
 
-// "ok", "decode_error", "no_texture", "too_few_vectors", "unreliable", "non_finite": the words
+// "ok", "decode_error", "no_texture", "too_few_vectors", "unreliable", "non_finite", "uncertain": the words
 // the rates CSV's status columns hold.
 inline const char* to_string(PairStatus status) {
   switch (status) {
@@ -31,6 +32,7 @@ inline const char* to_string(PairStatus status) {
     case PairStatus::TooFewVectors: return "too_few_vectors";
     case PairStatus::Unreliable: return "unreliable";
     case PairStatus::NonFinite: return "non_finite";
+    case PairStatus::Uncertain: return "uncertain";
     case PairStatus::Ok: break;
   }
   return "ok";

@@ -1,10 +1,15 @@
 // SPDX-License-Identifier: Apache-2.0
-// The angular-rates CSV that `predict` writes and `eval` reads (schema inertialnet.rates/3):
+// The angular-rates CSV that `predict` writes and `eval` reads (schema inertialnet.rates/4):
 //
 //   rates.csv                                   rates.csv.json (the sidecar)
-//   timestamp_ns,wx,wy,wz,status                {"schema": "inertialnet.rates/3", "rows": 2,
-//   1403715273312143104,0.0123,-0.0456,0.0789,ok  "fnv1a64": "…", "metadata": {"frame": "body", …}}
-//   1403715273362143104,,,,no_texture
+//   timestamp_ns,wx,wy,wz,status,sigma_wx,sigma_wy,sigma_wz   {"schema": "inertialnet.rates/4", "rows": 2,
+//   1403715273312143104,0.0123,-0.0456,0.0789,ok,0.004,0.005,0.003  "fnv1a64": "…", "metadata": {…}}
+//   1403715273362143104,,,,no_texture,,,
+//
+// Schema 4 (issue 22) adds each estimator group's standard deviations sigma_wx<suffix>,
+// sigma_wy<suffix>, sigma_wz<suffix> (rad/s) after its status: empty where σ is not known (the
+// InertialNet head, OpenGV, a pair without an answer); an `uncertain` pair keeps its σ (why it is
+// uncertain) with empty rates. Schema-3 files (no σ columns) and their sidecars stay readable.
 //
 // The CSV's first line is its header, so that pandas.read_csv(path) and
 // numpy.genfromtxt(path, delimiter=",", names=True) read it with their defaults; what the
@@ -26,8 +31,8 @@
 // Older files stay readable: schema 2 states its metadata in "# key: value" lines before the
 // header (`# schema: inertialnet.rates/2` first), schema 1 has no schema line and no status
 // columns (every row is `ok`). Such a file describes itself and a sidecar beside it is not read.
-// A CSV without comment lines and without a sidecar (a schema-3 CSV copied alone, a file of
-// one's own) reads with no metadata, and RatesTable::notes says so. A schema newer than 3, in a
+// A CSV without comment lines and without a sidecar (a schema-3 or 4 CSV copied alone, a file of
+// one's own) reads with no metadata, and RatesTable::notes says so. A schema newer than 4, in a
 // "# schema:" line or a sidecar, is refused.
 //
 // Metadata (the sidecar's "metadata" object; "# key: value" lines in schema 2):
@@ -58,7 +63,7 @@
 
 namespace inertialnet {
 
-inline constexpr const char* kRatesSchema = "inertialnet.rates/3";
+inline constexpr const char* kRatesSchema = "inertialnet.rates/4";
 
 struct RatesTable {
   std::vector<std::int64_t> t_ns;
@@ -96,7 +101,7 @@ struct RatesTable {
 // (a symbolic link's sidecar is its target's).
 RatesTable read_rates_csv(const std::filesystem::path& path);
 
-// `<path>.json`: the sidecar holding a schema-3 CSV's schema, row count, hash and metadata.
+// `<path>.json`: the sidecar holding a schema-3 or 4 CSV's schema, row count, hash and metadata.
 std::filesystem::path rates_sidecar_path(const std::filesystem::path& path);
 
 // The columns after timestamp_ns: wx,wy,wz,status, then the numeric `extra_names` in order, a
@@ -109,7 +114,8 @@ struct RatesLayout {
   std::vector<std::string> columns() const;
 };
 
-// The layout of estimator groups: "" → wx,wy,wz,status; "_geometric" → wx_geometric,…,status_geometric.
+// The layout of estimator groups (schema 4): "" → wx,wy,wz,status,sigma_wx,sigma_wy,sigma_wz;
+// "_geometric" → wx_geometric,…,status_geometric,sigma_wx_geometric,…,sigma_wz_geometric.
 RatesLayout rates_layout(const std::vector<std::string>& suffixes);
 
 // One row: the primary rates and status, then `extra` in the order of extra_names and `statuses`

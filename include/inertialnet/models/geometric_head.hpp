@@ -114,6 +114,18 @@ struct RotationEstimate {
   // solution: its cost was worse or its ω implausible; src/models/rolling_shutter_solver.hpp);
   // "" when none was refused.
   std::string refinement_note;
+  // The covariance of ω (camera frame, (rad/s)², row-major), calibrated
+  // (src/models/rate_uncertainty.cpp: the solve's covariance from its normal equations and
+  // residual, widened for the flow's correlated errors); raw_covariance is the solve's own,
+  // which treats every flow vector as independent. Both all zero when covariance_known is false
+  // (the OpenGV solver).
+  bool covariance_known = false;
+  Mat3 covariance{};
+  Mat3 raw_covariance{};
+  // RMS of the inliers' flow along the translational direction (normalised image velocity, 1/s;
+  // the general model's parallax): 0 for the rotation model. How well translation is told from
+  // rotation, which the calibrated covariance uses.
+  double parallax = 0;
 };
 
 // A rotation that fewer than this share of the usable vectors (or this many) agree with is not

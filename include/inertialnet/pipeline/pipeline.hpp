@@ -20,6 +20,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -47,6 +48,12 @@ struct EstimatorRates {
   std::array<double, 3> w{};     // rad/s; NaN unless status is ok
   PairStatus status = PairStatus::Ok;
   std::string reason;            // for the user, when status is not ok ("only 5 flow vectors …")
+  // The standard deviation of each rate (rad/s, same frame as w): the geometric head's calibrated
+  // σ (RotationEstimate::covariance); NaN where not known (the InertialNet head, OpenGV) or the
+  // pair is not ok. A pair whose largest σ exceeds RatesProcessorOptions::max_sigma_rad_s is
+  // PairStatus::Uncertain, its σ kept (w NaN as for any status but ok).
+  std::array<double, 3> sigma{kUnknownSigma, kUnknownSigma, kUnknownSigma};
+  static constexpr double kUnknownSigma = std::numeric_limits<double>::quiet_NaN();
   bool ok() const { return status == PairStatus::Ok; }
 };
 

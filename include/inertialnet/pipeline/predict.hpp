@@ -18,6 +18,7 @@
 #include "inertialnet/io/rates_csv.hpp"
 #include "inertialnet/models/weights.hpp"
 #include "inertialnet/pipeline/pipeline.hpp"
+#include "inertialnet/pipeline/rate_smoother.hpp"
 #include "inertialnet/pipeline/rates_processor.hpp"
 #include "inertialnet/runtime/device.hpp"
 #include "inertialnet/runtime/layer_profiler.hpp"
@@ -50,6 +51,11 @@ struct PredictSettings {
   double readout_time_s = 0;
   // DIS or LK forward-backward check (RatesProcessorOptions::flow_check_px); 0: off.
   double flow_check_px = 0.5;
+  // Issue 22: the largest per-axis σ a geometric rate may have, deg/s (RatesProcessorOptions::
+  // max_sigma_rad_s; 0: no limit), and the smoother over the pairs ("off", "lag:L"; rate_smoother.hpp):
+  // lag 2 by default, the best of the synthetic conditions (docs/real_cameras.md, "More than two frames").
+  double max_sigma_deg_s = 10.0;
+  std::string smooth = "lag:2";
   // Camera-IMU time offset (t_imu = t_cam + offset) stated in the CSV for eval; not applied here.
   std::optional<double> time_offset_s;
   std::string device;                // a --device spec; "": $INERTIALNET_DEVICE, else the default
@@ -102,12 +108,16 @@ class Prediction {
   // camera: one code path for every source.
   PipelineStats run(FrameSource& source, const std::function<void(const PairResult&)>& sink,
                     const PipelineOptions& options = {});
+  // With PredictSettings::smooth, each pair reaches the sink `lag` pairs late (the rest when the
+  // run ends, cancelled or not); the smoother's settings.
+  const RateSmootherOptions& smoother() const { return smoother_; }
 
  private:
   PredictSettings settings_;
   std::unique_ptr<FrameSource> source_;
   std::vector<std::string> notes_;
   RatesProcessorOptions processor_;
+  RateSmootherOptions smoother_;
   std::vector<DeviceInfo> infos_;
   std::vector<std::unique_ptr<Device>> devices_;
   std::vector<std::unique_ptr<WeightSet>> weight_sets_;

@@ -56,6 +56,12 @@ struct RatesProcessorOptions {
   // size whatever the frames' size, and with the normalized convention divided by the pair's
   // interval and the focal lengths of `camera` (then required).
   HeadInput head_input = HeadInput::Paper;
+  // A geometric rate whose σ along its least certain direction (the calibrated covariance's
+  // largest eigenvalue; at least every per-axis EstimatorRates::sigma, and the same in any frame)
+  // exceeds this many rad/s is not reported: the pair gets PairStatus::Uncertain (predict
+  // --max-sigma, in deg/s; docs/real_cameras.md, "Confidence per pair"). 0: no limit.
+  double max_sigma_rad_s = kDefaultMaxSigmaRadS;
+  static constexpr double kDefaultMaxSigmaRadS = 0.174532925199;  // 10 deg/s
 };
 
 // Each lane gets its own queue and model instances. `weights` holds one set per device, loaded
