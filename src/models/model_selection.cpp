@@ -27,15 +27,6 @@
 // ρ here is the solver's own Tukey loss at its final robust scale σ (2ρ/σ² = e²/σ² for a small
 // residual, bounded by 7.3 for an outlier, for either model), so the criterion needs no other
 // noise model than the one the solve already assumes.
-// The rolling-shutter model (conditioning_loss_reason) is the other richer model, and there
-// neither GRIC nor a BIC-like cost drop can tell a good solve from an outlier: on the phone clip
-// with its 33 ms readout the row-linear model lowered the robust cost by 2 600–14 000 σ² on every
-// pair (6·ln n ≈ 59 would pay for its parameters), and its ω moved by 3–6 deg/s on good pairs as
-// on the 14–22 deg/s outliers; nor does the σ of the change (the good pairs moved by up to 24
-// calibrated σ). What set the outliers apart was the conditioning: adding α and a made ω's raw σ
-// on the axis that moved 2.5–10 times the start's (0.29 against 0.13, 0.34 against 0.03, 0.11
-// against 0.03 deg/s), on no good pair more than 2 times except one of 4 deg/s. So the test is
-// that ratio, with the round factor kConditioningLoss.
 // The general answer is replaced only when both say so: a disagreement alone is what real
 // translation produces (the rotation-only answer is then biased), and a GRIC preference alone
 // with agreeing answers changes nothing worth a change.
@@ -83,22 +74,6 @@ std::string rotation_preferred_reason(const Vec3& general, const ModelFit& gener
                 "the rotation model's %.4g) and its rate is %.1f sigma from the rotation-only answer",
                 g_general, g_rotation, sigmas);
   return text;
-}
-
-std::string conditioning_loss_reason(const Mat3& start, const Mat3& refined) {
-  for (int a = 0; a < 3; ++a) {
-    const double s = start[4 * a], r = refined[4 * a];  // the diagonal
-    if (!(s > 0) || !(r > 0)) return "";
-    if (r > kConditioningLoss * kConditioningLoss * s) {
-      char text[200];
-      std::snprintf(text, sizeof text,
-                    "it determines the rate about axis %d %.1f times worse than the global-shutter solution (raw "
-                    "sigma %.3g against %.3g rad/s): the rate trades off with its change across the rows",
-                    a, std::sqrt(r / s), std::sqrt(r), std::sqrt(s));
-      return text;
-    }
-  }
-  return "";
 }
 
 }  // namespace inertialnet::detail

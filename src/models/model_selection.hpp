@@ -34,15 +34,4 @@ double gric(const ModelFit& fit, double sigma, int manifold_dimension, int param
 std::string rotation_preferred_reason(const Vec3& general, const ModelFit& general_fit, const Vec3& rotation,
                                       const Mat3& rotation_covariance, const ModelFit& rotation_fit, double sigma);
 
-// The rolling-shutter solve against its global-shutter start (issue 22): the row-linear model's
-// six extra parameters (the rate's and the velocity's change across the rows) trade off with ω;
-// where they make ω worse determined than the start's by more than this factor in σ on some
-// axis, the refined ω rests on that trade-off and the start's stands.
-inline constexpr double kConditioningLoss = 2.0;
-
-// Why the rolling-shutter ω (raw covariance `refined`) must give way to the global-shutter start
-// (raw covariance `start`), both (rad/s)², row-major: "" when it may stand (or when either
-// covariance is unknown: all zero).
-std::string conditioning_loss_reason(const Mat3& start, const Mat3& refined);
-
 }  // namespace inertialnet::detail

@@ -42,7 +42,6 @@
 #include "core/eigen_conversions.hpp"
 #include "inertialnet/io/flow_io.hpp"
 #include "inertialnet/ops/motion_field.hpp"
-#include "models/model_selection.hpp"
 #include "models/translation_search.hpp"
 
 namespace inertialnet::detail {
@@ -281,18 +280,15 @@ RotationEstimate refine_rolling_shutter(const std::vector<RowSample>& samples, c
       if (fit.cost < best.cost) best = fit;
   }
   est.iterations += iterations;
-  const Eigen::Matrix3d covariance = row_covariance(samples, best.m, sigma);
-  std::string fallback =
+  const std::string fallback =
       rolling_shutter_fallback_reason(start.omega, robust_cost(samples, m, sigma), to_vec3(best.m.omega), best.cost);
-  // And the conditioning guard (src/models/model_selection.cpp): a refinement that leaves ω much
-  // worse determined than the start rests on the rate–row trade-off.
-  if (fallback.empty() && start.covariance_known) fallback = conditioning_loss_reason(start.raw_covariance, to_mat3(covariance));
   if (!fallback.empty()) {
     est.method = start.method + "+rows-fallback";
     est.refinement_note = "rolling-shutter solve not taken: " + fallback;
     return est;
   }
   est.omega = to_vec3(best.m.omega);
+  const Eigen::Matrix3d covariance = row_covariance(samples, best.m, sigma);
   if (covariance.trace() > 0) {
     est.raw_covariance = to_mat3(covariance);
     est.covariance_known = true;

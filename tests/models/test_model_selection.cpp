@@ -44,16 +44,3 @@ TEST(ModelSelection, RotationReplacesTheGeneralAnswerOnlyWhenBothTestsSaySo) {
   EXPECT_EQ(rotation_preferred_reason(far, general_noise, rotation, covariance, rotation_noise, 0.0), "");
   EXPECT_EQ(rotation_preferred_reason({NAN, 0, 0}, general_noise, rotation, covariance, rotation_noise, sigma), "");
 }
-
-TEST(ModelSelection, RollingShutterSolveThatLosesConditioningGivesWay) {
-  const Mat3 start{1e-6, 0, 0, 0, 4e-6, 0, 0, 0, 1e-6};  // raw σ 0.001, 0.002, 0.001 rad/s
-  // As well or better determined, or up to kConditioningLoss worse: the refinement stands.
-  EXPECT_EQ(conditioning_loss_reason(start, Mat3{0.5e-6, 0, 0, 0, 4e-6, 0, 0, 0, 1e-6}), "");
-  EXPECT_EQ(conditioning_loss_reason(start, Mat3{3.9e-6, 0, 0, 0, 15e-6, 0, 0, 0, 3.9e-6}), "");
-  // The phone clip's outliers: σ on the moving axis 2.5–10 times the start's.
-  const std::string reason = conditioning_loss_reason(start, Mat3{1e-6, 0, 0, 0, 36e-6, 0, 0, 0, 1e-6});
-  EXPECT_NE(reason.find("about axis 1 3.0 times worse"), std::string::npos) << reason;
-  // Unknown covariances decide nothing.
-  EXPECT_EQ(conditioning_loss_reason(Mat3{}, Mat3{1, 0, 0, 0, 1, 0, 0, 0, 1}), "");
-  EXPECT_EQ(conditioning_loss_reason(start, Mat3{}), "");
-}
