@@ -272,7 +272,7 @@ RotationEstimate solve_motion_field(const MomentsFunction& moments, double dt, d
   // Orient T so that the inliers' depths come out positive.
   est.translation_direction = to_vec3(best.last.parallel_sum < 0 ? Eigen::Vector3d(-best.t) : best.t);
   p.scale = sigma_final;
-  guard_translation(est, moments, p, omega_rotation, best.last, focal_px, dt, options, to_norm);
+  if (options.translation_guard) guard_translation(est, moments, p, omega_rotation, best.last, focal_px, dt, options, to_norm);
   return est;
 }
 

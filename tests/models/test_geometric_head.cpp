@@ -251,13 +251,16 @@ TEST(GeometricHead, RecoversRotationUnderTranslation) {
     m.velocity = kVelocities[i];
     m.seed = 20 + static_cast<unsigned>(i);
     const Tensor flow = upload(queue, render(k, map, m));
-    head.set_options(quarter_options());
+    GeometricHeadOptions guarded = quarter_options();
+    guarded.translation_guard = true;
+    head.set_options(guarded);
     const RotationEstimate e = head.estimate(queue, flow, m.dt);
     // Measured ≤ 0.5 deg/s at this size (0.2 deg/s at 752×480); the acceptance bound is 3.
     EXPECT_TRUE(near_rates(e.omega, m.omega, 1.5));
     EXPECT_TRUE(e.converged);
     // The translation is seen well above the noise: the guard against an implausible
-    // translation (ImplausibleTranslationGivesWayToTheRotationModel) keeps the general answer.
+    // translation (ImplausibleTranslationGivesWayToTheRotationModel), switched on here, keeps
+    // the general answer.
     EXPECT_EQ(e.method, "motion-field/general/tukey") << e.refinement_note;
     // The translation direction is found, with the sign that puts the scene in front.
     const double vn = std::sqrt(m.velocity[0] * m.velocity[0] + m.velocity[1] * m.velocity[1] + m.velocity[2] * m.velocity[2]);
@@ -398,7 +401,9 @@ TEST(GeometricHead, ImplausibleTranslationGivesWayToTheRotationModel) {
   k.fx *= 4;
   k.fy *= 4;
   const std::vector<float> map = normalized_coordinate_map(k);
-  GeometricHead head(testing::test_device(), k, quarter_options());
+  GeometricHeadOptions guarded = quarter_options();
+  guarded.translation_guard = true;
+  GeometricHead head(testing::test_device(), k, guarded);
   for (double amplitude_px : {0.25, 0.5}) {
     SCOPED_TRACE("flow error amplitude " + std::to_string(amplitude_px) + " px");
     Motion m;
