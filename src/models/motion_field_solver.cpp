@@ -58,6 +58,8 @@
 #include "core/eigen_conversions.hpp"
 #include "inertialnet/core/pair_status.hpp"
 #include "inertialnet/runtime/error.hpp"
+#include "models/model_selection.hpp"
+#include "models/rate_uncertainty.hpp"
 #include "models/translation_search.hpp"
 
 namespace inertialnet::detail {
@@ -105,6 +107,39 @@ void fill_diagnostics(RotationEstimate& e, const MotionFieldMoments& m, double t
   e.samples = static_cast<int>(m.usable);
   e.inlier_fraction = m.usable > 0 ? m.inliers / m.usable : 0;
   e.residual_px = m.inliers > 0 ? std::sqrt(m.inlier_sq_residual / m.inliers) / to_norm : 0;
+}
+
+
+// The guard against an implausible general-model solve (src/models/model_selection.cpp): the
+// rotation-only ω of the same vectors (stage 1's) replaces the general answer when GRIC prefers
+// the rotation model and the two differ by more than a few of the rotation model's calibrated σ.
+// Then the method is suffixed "+rotation", the diagnostics and covariance are the rotation
+// model's, there is no translation, and refinement_note says why. One more pass (rotation mode
+// at the final σ).
+void guard_translation(RotationEstimate& est, const MomentsFunction& moments, MotionFieldParams p,
+                       const Vec3& omega_rotation, const MotionFieldMoments& general, double focal_px, double dt,
+                       const GeometricHeadOptions& options, double to_norm) {
+  p.mode = MotionFieldMode::Rotation;
+  p.omega = omega_rotation;
+  p.translation = Vec3{};
+  const MotionFieldMoments rotation = moments(p);
+  ++est.iterations;
+  RotationEstimate alternative = est;
+  alternative.omega = omega_rotation;
+  alternative.parallax = 0;
+  alternative.covariance_known = false;
+  set_rotation_covariance(alternative, rotation);
+  if (!alternative.covariance_known) return;
+  calibrate_covariance(alternative, focal_px, dt, options);
+  const std::string reason =
+      rotation_preferred_reason(est.omega, ModelFit{general.loss_sum, general.usable}, omega_rotation,
+                                alternative.covariance, ModelFit{rotation.loss_sum, rotation.usable}, p.scale);
+  if (reason.empty()) return;
+  est = alternative;
+  est.method += "+rotation";
+  est.refinement_note = reason;
+  est.translation_direction = Vec3{};
+  fill_diagnostics(est, rotation, to_norm);
 }
 
 }  // namespace
@@ -236,6 +271,8 @@ RotationEstimate solve_motion_field(const MomentsFunction& moments, double dt, d
   }
   // Orient T so that the inliers' depths come out positive.
   est.translation_direction = to_vec3(best.last.parallel_sum < 0 ? Eigen::Vector3d(-best.t) : best.t);
+  p.scale = sigma_final;
+  if (options.translation_guard) guard_translation(est, moments, p, omega_rotation, best.last, focal_px, dt, options, to_norm);
   return est;
 }
 
