@@ -1162,7 +1162,7 @@ PYBIND11_MODULE(_inertialnet, m) {
            bool keep_flow, const py::object& max_pairs, int lanes, int decode_threads, double flow_check,
            const py::object& progress, const py::object& time_offset, double readout_time, const std::string& camera,
            const std::string& calibration, const std::string& calibration_camera, const std::string& image_topic,
-           const std::string& camera_info_topic, double max_sigma, const std::string& smooth) {
+           const std::string& camera_info_topic, double max_sigma, const std::string& smooth, bool fuse) {
           // The CLI's checks of --max-pairs, --rate, --fx, --fy: a value they refuse is a ValueError
           // here, not ignored (a negative rate or focal length was taken as "not given").
           const std::int64_t pairs = integer_of(max_pairs, "max_pairs");
@@ -1219,6 +1219,7 @@ PYBIND11_MODULE(_inertialnet, m) {
           s.flow_check_px = flow_check;
           s.max_sigma_deg_s = max_sigma;  // predict --max-sigma, --smooth (issue 22)
           s.smooth = smooth;
+          s.fuse = fuse;  // predict --fuse (issue 23)
           if (lanes < 1 || decode_threads < 1) throw invalid_input("lanes and decode_threads must be at least 1");
           return predict(s, static_cast<std::size_t>(pairs), lanes, decode_threads, progress);
         });
