@@ -1,128 +1,63 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: Apache-2.0
-"""Convert a flownet2-pytorch checkpoint or an InertialNet head state_dict to safetensors.
+"""Convert a FlowNet2-family checkpoint or an InertialNet head state_dict to safetensors.
 
 Inputs:
-  * flownet2-pytorch `*.pth.tar` files (torch.save of {'epoch', 'state_dict', 'best_EPE'}) of
-    FlowNet2, FlowNet2-C, -S, -SD, -CS or -CSS; the kind is detected from the tensor names.
+  * FlowNet2, FlowNet2-C, -S, -SD, -CS or -CSS checkpoints as they are published: NVIDIA
+    flownet2-pytorch's `*_checkpoint.pth.tar` ({'epoch', 'state_dict', 'best_EPE'}, torch's legacy
+    format) and ptlflow's Lightning `*-things-<sha256 prefix>.ckpt` (torch's zip format); the kind
+    is detected from the tensor names. This part is python/inertialnet/convert.py, loaded from
+    the source tree (the installed package runs it as `python -m inertialnet.convert`): numpy
+    only, no torch; docs/weights.md says where to download each file.
   * an InertialNet head: a torch.save'd state_dict (names `head.conv1.weight` ... or
     `conv1.weight` ...), optionally wrapped as {'state_dict': ..., 'head_config': {...}}. The
     flow size the head was trained on cannot be read off the weights: give --head-input WxH
-    (or a head_config / --head-config holding input_width and input_height).
+    (or a head_config / --head-config holding input_width and input_height). Heads need torch
+    for the reference HeadConfig (tools/reference/head.py); the checkpoint itself is read
+    without it.
 
-Every tensor name and shape is validated against the PyTorch reference model
-(tools/reference/); all missing, unexpected and mis-shaped tensors are listed together.
-The output holds float32 tensors under the flownet2-pytorch names and the metadata
+Checkpoints are read through a restricted unpickler (tensors, storages, OrderedDict and plain
+values only; nothing a pickle names is ever imported or run). Every tensor name and shape is
+validated; all missing, unexpected and mis-shaped tensors are listed together. The output holds
+float32 tensors under the flownet2-pytorch names and the metadata
   inertialnet.model      FlowNet2 | FlowNet2-C | FlowNet2-S | FlowNet2-SD | FlowNet2-CS |
                          FlowNet2-CSS | InertialNetHead
   inertialnet.synthetic  "false"
   inertialnet.head       (head only) JSON of the head's hyper-parameters incl. input H and W
   inertialnet.source     file name of the input
+  inertialnet.checkpoint.*  file, format, layout, sha256, published, checksum, url: which
+                         published checkpoint the weights came from (`inertialnet weights --info`)
 
 Exit codes: 0 success; 1 runtime failure (I/O, --check mismatch); 2 bad usage or bad input.
-Needs torch, numpy and safetensors (tools/reference/requirements.txt).
 """
 
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import json
 import os
 import sys
-import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "reference"))
 
-EXIT_OK, EXIT_RUNTIME, EXIT_INPUT = 0, 1, 2
-FLOWNET2_PREFIXES = ("flownetc", "flownets_1", "flownets_2", "flownets_d", "flownetfusion")
-HEAD_LAYERS = ("conv1", "conv2", "conv3", "fc1", "fc2")
+
+def _load_convert_module():
+    # By path, not `import inertialnet.convert`: the package's __init__ needs the built native module.
+    path = os.path.join(os.path.dirname(HERE), "python", "inertialnet", "convert.py")
+    spec = importlib.util.spec_from_file_location("inertialnet_convert", path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module
+    spec.loader.exec_module(module)
+    return module
 
 
-class InputError(Exception):
-    """Bad input or usage: exit code 2."""
-
-
-def _import_torch():
-    import importlib
-
-    try:
-        for module in ("torch", "safetensors", "numpy"):
-            importlib.import_module(module)
-    except ImportError as e:  # pragma: no cover - depends on the environment
-        raise InputError(f"this tool needs torch and safetensors ({e}); run it with the "
-                         "virtual environment of tools/reference/regenerate_fixtures.sh") from e
-
-
-# ------------------------------------------------------------------------------- loading ----
-
-def load_checkpoint(path: str, trust_pickle: bool):
-    import torch
-
-    if not os.path.isfile(path):
-        raise InputError(f"{path}: no such file")
-    try:
-        obj = torch.load(path, map_location="cpu", weights_only=True)
-    except Exception as e:  # noqa: BLE001 - torch raises many types for foreign files
-        if not trust_pickle:
-            raise InputError(
-                f"{path}: cannot be read as a tensors-only torch checkpoint ({type(e).__name__}: "
-                f"{str(e).splitlines()[0] if str(e) else ''}); if you trust the file, pass "
-                "--trust-pickle to load arbitrary pickled objects") from e
-        try:
-            obj = torch.load(path, map_location="cpu", weights_only=False)
-        except Exception as e2:  # noqa: BLE001
-            raise InputError(f"{path}: not a torch checkpoint ({type(e2).__name__}: {e2})") from e2
-    head_config = None
-    if isinstance(obj, dict) and "state_dict" in obj and isinstance(obj["state_dict"], dict):
-        head_config = obj.get("head_config")
-        state = obj["state_dict"]
-    elif isinstance(obj, dict):
-        state = obj
-    else:
-        raise InputError(f"{path}: holds a {type(obj).__name__}, expected a dict with a "
-                         "'state_dict' or a state_dict itself")
-    tensors = {}
-    not_tensors = []
-    for k, v in state.items():
-        if isinstance(v, torch.Tensor):
-            tensors[str(k)] = v
-        else:
-            not_tensors.append(str(k))
-    if not_tensors:
-        raise InputError(f"{path}: state_dict entries that are not tensors: {not_tensors}")
-    if not tensors:
-        raise InputError(f"{path}: the state_dict holds no tensors")
-    if all(k.startswith("module.") for k in tensors):  # saved from nn.DataParallel
-        tensors = {k[len("module."):]: v for k, v in tensors.items()}
-    return tensors, head_config
-
-
-# ------------------------------------------------------------------------------ detection ---
-
-def detect_kind(names) -> str:
-    names = set(names)
-    prefixes = {n.split(".", 1)[0] for n in names}
-    if prefixes & set(FLOWNET2_PREFIXES):
-        if "flownetfusion" in prefixes or "flownets_d" in prefixes:
-            return "FlowNet2"
-        if "flownets_2" in prefixes:
-            return "FlowNet2-CSS"
-        if "flownets_1" in prefixes:
-            return "FlowNet2-CS"
-        raise InputError("the checkpoint has only flownetc.* tensors; no FlowNet2 variant is "
-                         "a FlowNetC with a prefix (pass --model to force one)")
-    if "head" in prefixes or {"fc1.weight", "fc2.weight", "conv3.weight"} <= names:
-        return "InertialNetHead"
-    if "conv_redir.0.weight" in names:
-        return "FlowNet2-C"
-    if "inter_conv2.0.weight" in names or "conv0.0.weight" in names:
-        return "FlowNet2-SD"
-    if "conv1.0.weight" in names:
-        return "FlowNet2-S"
-    sample = sorted(names)[:5]
-    raise InputError(f"cannot tell which model the checkpoint holds (first names: {sample}); "
-                     "pass --model")
+cv = _load_convert_module()
+InputError = cv.InputError
+EXIT_OK, EXIT_RUNTIME, EXIT_INPUT = cv.EXIT_OK, cv.EXIT_RUNTIME, cv.EXIT_INPUT
+detect_kind = cv.detect_kind
+check = cv.check_written
 
 
 # --------------------------------------------------------------------------------- head -----
@@ -138,9 +73,17 @@ def parse_size(text: str):
         raise InputError(f"--head-input expects WxH with positive integers, got {text!r}") from None
 
 
-def head_config_for(tensors: dict, embedded, args):
-    import head as hd
+def _import_head():
+    try:
+        import head as hd
+    except ImportError as e:  # pragma: no cover - depends on the environment
+        raise InputError(f"converting a head needs torch for tools/reference/head.py ({e}); run it with the "
+                         "virtual environment of tools/reference/regenerate_fixtures.sh") from e
+    return hd
 
+
+def head_config_for(tensors: dict, embedded, args):
+    hd = _import_head()
     # Accept bare layer names (a head module saved on its own) as well as head.*.
     if not any(k.startswith("head.") for k in tensors):
         tensors = {f"head.{k}": v for k, v in tensors.items()}
@@ -190,120 +133,47 @@ def head_config_for(tensors: dict, embedded, args):
     return tensors, config
 
 
-# ----------------------------------------------------------------------------- validation ---
-
-def _fmt(shape) -> str:
-    return "[" + ",".join(str(int(s)) for s in shape) + "]"
-
-
-def validate(tensors: dict, expected: dict, model: str):
-    import torch
-
-    missing = [n for n in expected if n not in tensors]
-    extra = sorted(n for n in tensors if n not in expected)
-    wrong = [f"{n}: file {_fmt(tensors[n].shape)}, model {_fmt(expected[n])}"
-             for n in expected if n in tensors and tuple(tensors[n].shape) != tuple(expected[n])]
-    bad_dtype = [f"{n}: {tensors[n].dtype}" for n in expected
-                 if n in tensors and not tensors[n].is_floating_point()]
-    problems = []
-    if missing:
-        problems.append(f"missing {len(missing)} tensor(s): " + ", ".join(missing))
-    if extra:
-        problems.append(f"{len(extra)} unexpected tensor(s): " + ", ".join(extra))
-    if wrong:
-        problems.append(f"{len(wrong)} with the wrong shape: " + "; ".join(wrong))
-    if bad_dtype:
-        problems.append(f"{len(bad_dtype)} not floating point: " + "; ".join(bad_dtype))
-    if problems:
-        n_file = sum(int(t.numel()) for t in tensors.values())
-        n_model = sum(int(torch.Size(s).numel()) for s in expected.values())
-        raise InputError(f"the checkpoint does not fit {model} ({len(tensors)} tensors, "
-                         f"{n_file:,} parameters; the model has {len(expected)} tensors, "
-                         f"{n_model:,} parameters):\n  " + "\n  ".join(problems))
-
-
-# ------------------------------------------------------------------------------- writing ----
-
-def to_float32(tensors: dict, order, quiet: bool) -> dict:
-    import torch
-
-    out = {}
-    for n in order:
-        t = tensors[n].detach().cpu()
-        if t.dtype != torch.float32:
-            if not quiet:
-                print(f"note: {n} is {t.dtype}, stored as float32", file=sys.stderr)
-            t = t.to(torch.float32)
-        out[n] = t.contiguous()
-    return out
-
-
-def write(path: str, tensors: dict, metadata: dict) -> None:
-    from safetensors.torch import save_file
-
-    folder = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(folder):
-        raise InputError(f"{path}: the folder {folder} does not exist")
-    fd, tmp = tempfile.mkstemp(prefix=".convert-", suffix=".safetensors", dir=folder)
-    os.close(fd)
-    try:
-        save_file(tensors, tmp, metadata=metadata)
-        os.replace(tmp, path)  # never leave a half-written file under the final name
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-
-
-def check(path: str, tensors: dict, metadata: dict) -> list:
-    """Reloads `path` and compares names, shapes, dtypes, bits and metadata."""
-    import torch
-    from safetensors import safe_open
-
-    problems = []
-    with safe_open(path, framework="pt") as f:
-        names = set(f.keys())
-        if names != set(tensors):
-            problems.append(f"names differ: missing {sorted(set(tensors) - names)}, "
-                            f"extra {sorted(names - set(tensors))}")
-        for n in sorted(names & set(tensors)):
-            got = f.get_tensor(n)
-            want = tensors[n]
-            if got.dtype != torch.float32 or got.shape != want.shape:
-                problems.append(f"{n}: reloaded {got.dtype} {_fmt(got.shape)}, "
-                                f"wrote {want.dtype} {_fmt(want.shape)}")
-            elif not torch.equal(got.view(torch.int32), want.view(torch.int32)):
-                diff = int((got.view(torch.int32) != want.view(torch.int32)).sum())
-                problems.append(f"{n}: {diff} element(s) differ bitwise")
-        meta = f.metadata() or {}
-        for k, v in metadata.items():
-            if meta.get(k) != v:
-                problems.append(f"metadata {k}: reloaded {meta.get(k)!r}, wrote {v!r}")
-    return problems
+def convert_head(args) -> dict:
+    sha256 = cv.sha256_of(args.input) if os.path.isfile(args.input) else ""
+    obj, fmt = cv.read_checkpoint(args.input)
+    tensors, layout = cv.state_dict_of(obj, args.input)
+    embedded = obj.get("head_config") if isinstance(obj, dict) and "state_dict" in obj else None
+    tensors, cfg = head_config_for(tensors, embedded, args)
+    expected = _import_head().expected_shapes(cfg)
+    cv.validate(tensors, expected, cv.HEAD_KIND)
+    origin = {"published": "none", "checksum": "no head checkpoint is published"}
+    metadata = {"inertialnet.model": cv.HEAD_KIND, "inertialnet.synthetic": "false",
+                "inertialnet.source": os.path.basename(args.input), "inertialnet.head": cfg.to_json()}
+    metadata.update(cv.checkpoint_metadata(args.input, fmt, layout, sha256, origin))
+    notes = []
+    cv.write_safetensors(args.output, [(n, expected[n], cv._as_float32(n, tensors[n], notes)) for n in expected],
+                         metadata)
+    problems = check(args.output, {n: tensors[n] for n in expected}, metadata) if args.check else []
+    return {"kind": cv.HEAD_KIND, "tensors": len(expected), "notes": notes, "problems": problems,
+            "parameters": sum(int(cv.np.prod(s, dtype=cv.np.int64)) for s in expected.values())}
 
 
 # ---------------------------------------------------------------------------------- main ----
 
-MODEL_CHOICES = ("FlowNet2", "FlowNet2-C", "FlowNet2-S", "FlowNet2-SD", "FlowNet2-CS",
-                 "FlowNet2-CSS", "InertialNetHead")
+MODEL_CHOICES = cv.FLOWNET2_KINDS + (cv.HEAD_KIND,)
 
 
 def build_parser():
     ap = argparse.ArgumentParser(
         prog="convert_checkpoint.py",
-        description="Convert a flownet2-pytorch .pth.tar checkpoint or an InertialNet head "
-                    "state_dict to a validated float32 safetensors file.",
+        description="Convert a FlowNet2-family checkpoint (flownet2-pytorch .pth.tar, ptlflow .ckpt) or an "
+                    "InertialNet head state_dict to a validated float32 safetensors file.",
         epilog="Exit codes: 0 success, 1 runtime failure (I/O, --check mismatch), 2 bad usage "
                "or input (unreadable checkpoint, unknown model, missing/extra/mis-shaped "
-               "tensors).")
-    ap.add_argument("input", help="checkpoint (.pth.tar / .pth / .pt)")
+               "tensors, checksum mismatch). docs/weights.md lists where to download checkpoints.")
+    ap.add_argument("input", help="checkpoint (.pth.tar / .ckpt / .pth / .pt)")
     ap.add_argument("output", help="safetensors file to write")
     ap.add_argument("--model", choices=MODEL_CHOICES,
                     help="model kind; detected from the tensor names when omitted")
     ap.add_argument("--check", action="store_true",
                     help="reload the written file and compare every tensor bit for bit")
-    ap.add_argument("--trust-pickle", action="store_true",
-                    help="allow arbitrary pickled objects in the checkpoint (only for files "
-                         "you trust; needed for checkpoints holding non-tensor objects)")
+    ap.add_argument("--sha256", metavar="HEX",
+                    help="refuse the checkpoint unless its SHA-256 begins with HEX (8 or more hex digits)")
     ap.add_argument("--head-input", metavar="WxH",
                     help="head only: width x height of the flow the head takes, e.g. 752x480")
     ap.add_argument("--head-config", metavar="JSON",
@@ -317,36 +187,34 @@ def build_parser():
 
 
 def run(args) -> int:
-    _import_torch()
-    import flownet2 as fn
-    import head as hd
-
-    tensors, embedded_head = load_checkpoint(args.input, args.trust_pickle)
-    kind = args.model or detect_kind(tensors)
-    metadata = {"inertialnet.model": kind, "inertialnet.synthetic": "false",
-                "inertialnet.source": os.path.basename(args.input)}
-    if kind == "InertialNetHead":
-        tensors, cfg = head_config_for(tensors, embedded_head, args)
-        expected = hd.expected_shapes(cfg)
-        metadata["inertialnet.head"] = cfg.to_json()
+    head_options = args.head_input or args.head_config or args.head_dropout is not None \
+        or args.head_flow_scale is not None
+    kind = args.model
+    if kind is None:
+        obj, _ = cv.read_checkpoint(args.input)
+        kind = cv.detect_kind(cv.state_dict_of(obj, args.input)[0])
+    if kind == cv.HEAD_KIND:
+        if args.sha256:
+            raise InputError("--sha256 applies to published FlowNet2 checkpoints, not heads")
+        done = convert_head(args)
     else:
-        if args.head_input or args.head_config or args.head_dropout is not None \
-                or args.head_flow_scale is not None:
+        if head_options:
             raise InputError(f"--head-* options apply to InertialNetHead, not {kind}")
-        expected = fn.expected_shapes(kind)
-    validate(tensors, expected, kind)
-    out = to_float32(tensors, list(expected), args.quiet)
-    write(args.output, out, metadata)
-    if args.check:
-        problems = check(args.output, out, metadata)
-        if problems:
-            print(f"error: {args.output} does not read back as written:\n  " + "\n  ".join(problems),
-                  file=sys.stderr)
-            return EXIT_RUNTIME
+        done = cv.convert(args.input, args.output, kind, args.check, args.sha256)
     if not args.quiet:
-        n = sum(int(t.numel()) for t in out.values())
-        print(f"{args.output}: {kind}, {len(out)} tensors, {n:,} parameters"
+        for note in done["notes"]:
+            print(f"note: {note}", file=sys.stderr)
+    if done["problems"]:
+        print(f"error: {args.output} does not read back as written:\n  " + "\n  ".join(done["problems"]),
+              file=sys.stderr)
+        return EXIT_RUNTIME
+    if not args.quiet:
+        print(f"{args.output}: {done['kind']}, {done['tensors']} tensors, {done['parameters']:,} parameters"
               + (", verified bit for bit" if args.check else ""))
+        meta = done.get("metadata")
+        if meta:
+            print(f"  published checkpoint: {meta['inertialnet.checkpoint.published']} (checksum: "
+                  f"{meta['inertialnet.checkpoint.checksum']})")
     return EXIT_OK
 
 

@@ -199,7 +199,7 @@ def predict(
     keep_flow: bool = False,
     flow_check: float = 0.5,
     progress: Optional[Callable[[int, int], object]] = None,
-    max_sigma: float = 5.0,
+    max_sigma: float = 10.0,
     smooth: str = "lag:2",
     fuse: bool = False,
 ):
@@ -220,9 +220,11 @@ def predict(
     ``--camera-info-topic`` (None: a :class:`Sequence`'s own, else the bag's only image topic);
     ``time_offset`` and ``readout_time`` are ``--time-offset`` and ``--readout-time`` (seconds;
     stated in the rates for :func:`evaluate`, the readout time also corrects the geometric head);
-    ``flow_check`` is ``--flow-check`` (the DIS forward-backward check for the geometric head,
-    pixels at 752 columns; 0: off). ``max_sigma`` is ``--max-sigma`` (deg/s: a geometric rate whose
-    standard deviation exceeds it on any axis gets the status ``"uncertain"``; 0: no limit) and
+    ``flow`` is ``--flow``: ``"flownet2"``, ``"dis"`` or ``"lk"`` (sparse Lucas–Kanade at the
+    geometric head's sample points, for the geometric head only; None: flownet2 with weights, dis
+    without). ``flow_check`` is ``--flow-check`` (the DIS or LK forward-backward check for the
+    geometric head, pixels at 752 columns; 0: off). ``max_sigma`` is ``--max-sigma`` (deg/s: a geometric rate whose standard deviation
+    along its least certain direction exceeds it gets the status ``"uncertain"``; 0: no limit) and
     ``smooth`` is ``--smooth`` (``"lag:2"``, the default: a fixed-lag smoother over the pairs using
     their σ; ``"off"``: the two-frame rates); ``rates.sigma`` holds each rate's σ. ``fuse`` is
     ``--fuse`` (with ``head="both"``: a third estimator, ``rates.head("fused")``, the two heads'

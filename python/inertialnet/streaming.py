@@ -35,7 +35,7 @@ def stream(
     max_pairs: int = 0,
     lanes: int = 2,
     flow_check: float = 0.5,
-    max_sigma: float = 5.0,
+    max_sigma: float = 10.0,
     smooth: str = "lag:2",
     fuse: bool = False,
 ) -> Iterator[Tuple[int, np.ndarray, Union[str, Tuple[str, ...]]]]:

@@ -22,7 +22,7 @@ def cli_rates(cli, sequence, tmp_path, *args):
 def test_predict_matches_the_cli(cli, sequence, tmp_path):
     header, expected = cli_rates(cli, sequence, tmp_path)
     rates = inertialnet.predict(sequence)
-    assert rates.columns == header == ["timestamp_ns", "wx", "wy", "wz", "status"]
+    assert rates.columns == header == ["timestamp_ns", "wx", "wy", "wz", "status", "sigma_wx", "sigma_wy", "sigma_wz"]
     assert len(rates) == len(expected) == 4
     np.testing.assert_array_equal(rates["timestamp_ns"], expected[:, 0].astype(np.int64))
     assert list(rates["status"]) == ["ok"] * 4
@@ -31,8 +31,21 @@ def test_predict_matches_the_cli(cli, sequence, tmp_path):
         assert [csv_text(v) for v in rates[name]] == [csv_text(v) for v in expected[:, i]]
 
 
+def test_predict_flow_lk_matches_the_cli(cli, sequence, tmp_path):
+    """flow="lk" is --flow lk: the same rates, to the digit, and not DIS's."""
+    header, expected = cli_rates(cli, sequence, tmp_path, "--flow", "lk")
+    rates = inertialnet.predict(sequence, flow="lk")
+    assert rates.columns == header and len(rates) == len(expected) == 4
+    for i, name in enumerate(header[1:4], start=1):
+        assert [csv_text(v) for v in rates[name]] == [csv_text(v) for v in expected[:, i]]
+    dis = inertialnet.predict(sequence)
+    assert not np.array_equal(dis.w, rates.w)
+    with pytest.raises(ValueError, match="expected flownet2, dis or lk"):
+        inertialnet.predict(sequence, flow="sparse")
+
+
 def test_dis_flow_and_geometric_head_step_by_step_match_the_cli(cli, sequence, tmp_path):
-    _, expected = cli_rates(cli, sequence, tmp_path)
+    _, expected = cli_rates(cli, sequence, tmp_path, "--smooth", "off")  # pair by pair: the two-frame rates
     seq = inertialnet.Sequence(sequence)
     camera, to_body, t = seq.camera, seq.camera_to_body, seq.timestamps_ns
     assert camera.width == 128 and to_body.shape == (3, 3)

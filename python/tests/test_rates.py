@@ -53,7 +53,7 @@ def test_rates_state_estimator_frame_and_times(sequence):
     np.testing.assert_array_equal(np.asarray(rates), rates.w)
     np.testing.assert_array_equal(rates.w[:, 1], rates["wy"])
     assert rates.timestamps_ns.dtype == np.int64 and list(rates.status) == ["ok"] * 4
-    assert rates.columns == ["timestamp_ns", "wx", "wy", "wz", "status"]
+    assert rates.columns == ["timestamp_ns", "wx", "wy", "wz", "status", "sigma_wx", "sigma_wy", "sigma_wz"]
     assert "estimator=inter_frame" in repr(rates) and "4 pairs" in repr(rates)
     # Rows keep the metadata; a row is a dict.
     assert rates[1:3].frame == "body" and len(rates[rates.ok]) == 4
@@ -122,7 +122,7 @@ def test_evaluate_takes_imu_and_extrinsics_for_a_folder_as_eval_does(cli, sequen
 
 def test_an_old_structured_array_still_evaluates(sequence):
     records = inertialnet.predict(sequence).to_records()
-    assert records.dtype.names == ("timestamp_ns", "wx", "wy", "wz", "status")
+    assert records.dtype.names == ("timestamp_ns", "wx", "wy", "wz", "status", "sigma_wx", "sigma_wy", "sigma_wz")
     report = inertialnet.evaluate(records, sequence, target="mean")
     assert report["estimators"][0]["frames_evaluated"] == 4
 
@@ -144,3 +144,25 @@ def test_calibration_file_for_a_folder_as_predict_and_eval_take_it(cli, sequence
     np.testing.assert_allclose(rmse(report, "raw"), rmse(expected, "raw"), rtol=1e-9)
     with pytest.raises(FileNotFoundError):
         inertialnet.predict(folder, calibration=tmp_path / "missing.yaml")
+
+
+# Issue 22: each rate's σ, the --max-sigma limit and the smoother, as the CLI's keywords.
+def test_sigma_max_sigma_and_smooth_as_predict_takes_them(cli, sequence, tmp_path):
+    rates = inertialnet.predict(sequence, smooth="off")
+    assert rates.sigma.shape == (4, 3) and np.all(np.isfinite(rates.sigma)) and np.all(rates.sigma > 0)
+    np.testing.assert_array_equal(rates.sigma[:, 2], rates["sigma_wz"])
+    # The CLI's CSV holds the same σ (to its %.9g digits).
+    cli("predict", str(sequence), "--smooth", "off", "-o", str(tmp_path / "r.csv"))
+    np.testing.assert_allclose(inertialnet.read_rates(tmp_path / "r.csv").sigma, rates.sigma, rtol=1e-7)
+    # A limit below every σ: every pair is uncertain, its rates NaN, its σ kept.
+    strict = inertialnet.predict(sequence, smooth="off", max_sigma=1e-6)
+    assert list(strict.status) == ["uncertain"] * 4 and np.all(np.isnan(strict.w))
+    np.testing.assert_array_equal(strict.sigma, rates.sigma)
+    # The default smoother (lag 2) changes the rates and lowers σ; the metadata says so.
+    smoothed = inertialnet.predict(sequence)
+    assert smoothed.metadata.get("smoothing") == "lag:2,q:40" and "smoothing" not in rates.metadata
+    assert np.all(smoothed.sigma <= rates.sigma) and not np.array_equal(smoothed.w, rates.w)
+    with pytest.raises(ValueError, match="\"lag:x\": expected off"):
+        inertialnet.predict(sequence, smooth="lag:x")
+    with pytest.raises(ValueError, match="max.sigma.* must be a non-negative number"):
+        inertialnet.predict(sequence, max_sigma=-1)

@@ -62,6 +62,12 @@ std::string RotationFit::summary() const {
   return buf;
 }
 
+std::string RotationFit::confidence() const {
+  if (!determined) return "none";
+  if (!(angle_std_error_deg <= kLowRotationStdErrorDeg)) return "low";
+  return angle_std_error_deg < kHighRotationStdErrorDeg ? "high" : "medium";
+}
+
 RotationFit fit_rotation(const std::vector<Vec3>& predicted, const std::vector<Vec3>& gyro) {
   if (predicted.size() != gyro.size() || predicted.size() < 3) {
     throw invalid_input("Rotation fit: " + std::to_string(predicted.size()) + " predictions and " +

@@ -36,6 +36,17 @@ double centred_cost(const std::vector<Vec3>& predicted, const std::vector<Vec3>&
   return cost;
 }
 
+// a·b for row-major 3×3 matrices.
+Mat3 product(const Mat3& a, const Mat3& b) {
+  Mat3 m{};
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      for (int k = 0; k < 3; ++k) m[static_cast<std::size_t>(3 * i + j)] += a[static_cast<std::size_t>(3 * i + k)] * b[static_cast<std::size_t>(3 * k + j)];
+    }
+  }
+  return m;
+}
+
 // Rotation below this RMS (rad/s, about 0.006 deg/s, far under any gyro's noise) is no motion:
 // the predictions of constant frames, or a zero gyro.
 constexpr double kNoMotionRadS = 1e-4;
@@ -236,6 +247,24 @@ TimeOffsetEstimate estimate_time_offset(const std::vector<std::int64_t>& from, c
   if (!e.determined) {
     e.offset_s = 0;
     e.std_error_s = std::numeric_limits<double>::infinity();
+  } else if (options.readout) {
+    // The readout from the residual at the final offset and rotation, in the camera frame the
+    // correction makes true (R·R_BS), against the gyro's mean acceleration over each interval.
+    const bool rotated = e.rotation && e.rotation->determined;
+    const Mat3 r = rotated ? e.rotation->rotation : Mat3{1, 0, 0, 0, 1, 0, 0, 0, 1};
+    std::vector<Vec3> residual(pred.size()), acceleration(pred.size()), corrected(pred.size());
+    for (std::size_t i = 0; i < pred.size(); ++i) {
+      const double s = a[i] + e.offset_s, t = b[i] + e.offset_s;
+      const Vec3 p = mul(r, pred[i]);
+      corrected[i] = p;
+      for (int k = 0; k < 3; ++k) {
+        residual[i][k] = p[k] - spline[k].mean(s, t);
+        acceleration[i][k] = (spline[k](t) - spline[k](s)) / (t - s);
+      }
+    }
+    ReadoutModel model = *options.readout;
+    model.camera_to_imu = product(r, model.camera_to_imu);
+    e.readout = fit_readout(residual, acceleration, corrected, model);
   }
   return e;
 }

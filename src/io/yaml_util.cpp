@@ -41,6 +41,34 @@ bool key_without_value(const std::string& line) {
   return s.size() > indentation(s) + 1 && s.back() == ':' && !sequence_item(s);
 }
 
+// YAML reads a ':' inside a plain scalar as part of the string (a colon opens a mapping only
+// before a space or at the end), but OpenCV's parser takes it for a key's colon: "comment: HERO4
+// 16:9 profile" is refused ("Incorrect indentation") and "url: https://a" reads as an empty
+// value. The converted GoPro recording of issue 22 has such a comment. A "key: value" line whose
+// plain value holds a ':' gets the value double-quoted (backslashes and quotes escaped), which
+// OpenCV reads as the same string; a trailing comment, quoted and flow values, block scalars,
+// anchors/tags and sequence items are left alone.
+std::string quote_plain_value_with_colon(const std::string& line) {
+  if (blank_or_comment(line) || sequence_item(line)) return line;
+  const std::size_t start = indentation(line);
+  const std::size_t colon = line.find(": ", start);
+  if (colon == std::string::npos) return line;
+  if (line.substr(start, colon - start).find_first_of("\"'[]{}#") != std::string::npos) return line;
+  const std::size_t v = line.find_first_not_of(' ', colon + 1);
+  if (v == std::string::npos) return line;
+  std::size_t e = std::min(line.find(" #", v), line.size());
+  while (e > v && (line[e - 1] == ' ' || line[e - 1] == '\t' || line[e - 1] == '\r')) --e;
+  if (e == v || std::string("\"'[{|>&*!%@`#").find(line[v]) != std::string::npos) return line;
+  const std::string value = line.substr(v, e - v);
+  if (value.find(':') == std::string::npos) return line;
+  std::string quoted = "\"";
+  for (const char c : value) {
+    if (c == '"' || c == '\\') quoted += '\\';
+    quoted += c;
+  }
+  return line.substr(0, v) + quoted + "\"" + line.substr(e);
+}
+
 // A "%YAML…" line opens the text; normalise() puts OpenCV's own before any text without one.
 bool starts_with_directive(const std::string& text) { return text.rfind("%YAML", 0) == 0; }
 
@@ -132,7 +160,7 @@ std::string normalise(std::string text) {
   }
   std::string out;
   out.reserve(text.size() + 64);
-  for (const auto& line : lines) out += line + "\n";
+  for (const auto& line : lines) out += quote_plain_value_with_colon(line) + "\n";
   return out;
 }
 

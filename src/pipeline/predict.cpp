@@ -30,8 +30,9 @@ ModelKind flow_model_of(const WeightSet& weights, const std::string& requested) 
 }
 
 const char* kNoWeightsHelp =
-    "Convert a flownet2-pytorch checkpoint with `python3 tools/convert_checkpoint.py FlowNet2_checkpoint.pth.tar "
-    "flownet2.safetensors` (and the head the same way), or write synthetic weights for a trial run with "
+    "Download a published FlowNet2 checkpoint (docs/weights.md lists where: ptlflow's flownet2-things-*.ckpt or "
+    "flownet2-pytorch's FlowNet2_checkpoint.pth.tar) and convert it with `python3 -m inertialnet.convert "
+    "flownet2-things-d63b53a7.ckpt flownet2.safetensors` (no torch needed), or write synthetic weights for a trial run with "
     "`inertialnet weights --synthetic FlowNet2 -o flownet2.safetensors` and `inertialnet weights --synthetic "
     "InertialNetHead --size WxH -o head.safetensors`";
 
@@ -251,7 +252,9 @@ std::size_t Prediction::pairs(std::size_t max_pairs) const {
 }
 
 std::string Prediction::method() const {
-  std::string method = processor_.flow == FlowMethod::DIS ? std::string("DIS flow") : to_string(processor_.flow_model);
+  std::string method = processor_.flow == FlowMethod::DIS  ? std::string("DIS flow")
+                       : processor_.flow == FlowMethod::LK ? std::string("Lucas-Kanade flow")
+                                                           : to_string(processor_.flow_model);
   method += processor_.inertialnet_head && processor_.geometric_head ? " + InertialNet and geometric heads"
             : processor_.inertialnet_head                            ? " + InertialNet head"
                                                                      : " + geometric head";

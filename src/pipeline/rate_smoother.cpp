@@ -24,6 +24,13 @@ bool usable(const EstimatorRates& answer) {
          std::isfinite(answer.sigma[2]) && answer.sigma[0] > 0 && answer.sigma[1] > 0 && answer.sigma[2] > 0;
 }
 
+// The pair's variance for every axis: the mean of its three (trace/3, the same in any frame). One
+// variance for all axes keeps the smoother a linear map with the same gain on each axis, so that it
+// commutes with a rotation of the rates: camera-frame and body-frame rates smooth alike.
+double isotropic_variance(const EstimatorRates& answer) {
+  return (answer.sigma[0] * answer.sigma[0] + answer.sigma[1] * answer.sigma[1] + answer.sigma[2] * answer.sigma[2]) / 3;
+}
+
 Eigen::Matrix2d cov(const double p[3]) {
   Eigen::Matrix2d m;
   m << p[0], p[1], p[1], p[2];
@@ -86,9 +93,13 @@ std::string to_string(const RateSmootherOptions& options) {
 RateSmoother::RateSmoother(const RateSmootherOptions& options) : options_(options) { options_.validate(); }
 
 void RateSmoother::filter(PairResult& result) {
-  const double mid = 0.5e-9 * (static_cast<double>(result.t0_ns) + static_cast<double>(result.t1_ns));
-  const double dt = have_last_ ? std::max(0.0, mid - last_mid_s_) : 0.0;
-  last_mid_s_ = mid;
+  // From the integer stamps' differences: a double of an epoch in seconds (1.4e9 s) keeps only
+  // ≈0.2 µs, which would make a video's rates (stamps from 0) differ from its frames' (EuRoC epochs).
+  const double dt = have_last_ ? std::max(0.0, 0.5e-9 * (static_cast<double>(result.t0_ns - last_t0_ns_) +
+                                                         static_cast<double>(result.t1_ns - last_t1_ns_)))
+                               : 0.0;
+  last_t0_ns_ = result.t0_ns;
+  last_t1_ns_ = result.t1_ns;
   have_last_ = true;
   if (last_.size() < 3 * result.rates.size()) last_.resize(3 * result.rates.size());
   std::vector<State> states(last_.size());
@@ -109,7 +120,7 @@ void RateSmoother::filter(PairResult& result) {
         s.xp[1] = x(1);
       }
       if (usable(answer)) {
-        const double z = answer.w[a], r = answer.sigma[a] * answer.sigma[a];
+        const double z = answer.w[a], r = isotropic_variance(answer);
         if (!s.started) {
           s.xp[0] = z;
           s.xp[1] = 0;
@@ -158,7 +169,8 @@ PairResult RateSmoother::smoothed(std::size_t index) const {
       }
       if (!std::isfinite(xs(0)) || !(ps(0, 0) >= 0)) continue;  // keep the pair's own answer
       answer.w[a] = xs(0);
-      answer.sigma[a] = std::sqrt(ps(0, 0));
+      // Each axis's σ shrinks as the common one did.
+      answer.sigma[a] *= std::sqrt(ps(0, 0) / isotropic_variance(held_[index].rates[e]));
     }
   }
   return out;

@@ -1,4 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
+#include <Eigen/Dense>
+
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -12,6 +14,7 @@
 #include "inertialnet/models/dis_flow.hpp"
 #include "inertialnet/models/flownet.hpp"
 #include "inertialnet/models/inertialnet_head.hpp"
+#include "inertialnet/models/lk_flow.hpp"
 #include "inertialnet/models/texture.hpp"
 #include "inertialnet/pipeline/rate_fusion.hpp"
 #include "inertialnet/pipeline/rates_processor.hpp"
@@ -24,6 +27,15 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 Vec3 to_body(const std::optional<Mat3>& r, const Vec3& w) { return r ? mul(*r, w) : w; }
+
+// The standard deviation along the least certain direction of a covariance (its largest
+// eigenvalue's root).
+double least_certain_sigma(const Mat3& c) {
+  Eigen::Matrix3d m;
+  m << c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7], c[8];
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(m, Eigen::EigenvaluesOnly);
+  return std::sqrt(std::max(0.0, eig.eigenvalues()(2)));
+}
 
 // The per-axis standard deviations of a camera-frame covariance C after the rotation R (body
 // frame: diag(R·C·Rᵀ)); NaN when the covariance is not known.
@@ -50,7 +62,15 @@ class RatesProcessor : public PairProcessor {
     if (options.flow == FlowMethod::FlowNet) flownet_ = std::make_unique<FlowNet>(device, options.flow_model, *weights);
     if (options.flow == FlowMethod::DIS) dis_ = std::make_unique<DisFlow>();
     if (options.inertialnet_head) head_ = std::make_unique<InertialNetHead>(device, *weights);
-    if (options.geometric_head) geometric_ = std::make_unique<GeometricHead>(device, *options.camera, options.geometric);
+    if (options.geometric_head) {
+      GeometricHeadOptions geometric = options.geometric;
+      // LK tracks the head's grid points and nothing else: its coarser grid is the head's.
+      if (options.flow == FlowMethod::LK) {
+        lk_ = std::make_unique<LkFlow>();
+        geometric.stride = lk_grid_stride(options.camera->width);
+      }
+      geometric_ = std::make_unique<GeometricHead>(device, *options.camera, geometric);
+    }
   }
 
   void process(const Frame& previous, const Frame& current, PairResult& result,
@@ -100,17 +120,23 @@ class RatesProcessor : public PairProcessor {
         std::copy(field.v.begin(), field.v.end(), data.begin() + static_cast<std::ptrdiff_t>(field.pixel_count()));
         return Tensor::from_host(q, {1, 2, height, width}, data);
       };
-      const FlowField field = dis_->compute(previous.image, current.image);
-      std::vector<float> planes(field.u);
-      planes.insert(planes.end(), field.v.begin(), field.v.end());
-      flow_problem = non_finite_flow(planes);
-      flow = upload(field);
-      // Only the geometric head's solvers skip unknown vectors; the learned head and the saved
-      // flow get the flow as computed (an unknown marker is no input for a network).
-      if (geometric_ && options_.flow_check_px > 0 && flow_problem.empty()) {
-        FlowField marked = field;
-        dis_->check(marked, previous.image, current.image, options_.flow_check_px);
-        checked = upload(marked);
+      if (lk_) {
+        // The check is part of the tracking (the same points, tracked back): the head and the
+        // saved flow get the field with its marks. Its values are finite by construction.
+        flow = upload(lk_->compute(previous.image, current.image, geometric_->options().stride, options_.flow_check_px));
+      } else {
+        const FlowField field = dis_->compute(previous.image, current.image);
+        std::vector<float> planes(field.u);
+        planes.insert(planes.end(), field.v.begin(), field.v.end());
+        flow_problem = non_finite_flow(planes);
+        flow = upload(field);
+        // Only the geometric head's solvers skip unknown vectors; the learned head and the saved
+        // flow get the flow as computed (an unknown marker is no input for a network).
+        if (geometric_ && options_.flow_check_px > 0 && flow_problem.empty()) {
+          FlowField marked = field;
+          dis_->check(marked, previous.image, current.image, options_.flow_check_px);
+          checked = upload(marked);
+        }
       }
     }
     t = lap(result, "flow", t);
@@ -141,7 +167,10 @@ class RatesProcessor : public PairProcessor {
         const RotationEstimate estimate = geometric_->estimate(q, checked.defined() ? checked : flow, dt, &stop);
         const Vec3 w = to_body(options_.camera_to_body, estimate.omega);
         const std::array<double, 3> sigma = axis_sigma(options_.camera_to_body, estimate);
-        const double largest = std::max({sigma[0], sigma[1], sigma[2]});
+        // The σ along the least certain direction (the covariance's largest eigenvalue): the same in
+        // the camera and the body frame, so that --max-sigma picks the same pairs in either.
+        const double largest = estimate.covariance_known ? least_certain_sigma(estimate.covariance)
+                                                         : EstimatorRates::kUnknownSigma;
         constexpr double kDeg = 180 / kPi;
         if (estimate.status != PairStatus::Ok) {
           answer.status = estimate.status;
@@ -153,9 +182,9 @@ class RatesProcessor : public PairProcessor {
           // Too uncertain to report (RatesProcessorOptions::max_sigma_rad_s); σ stays, for the user.
           char text[200];
           std::snprintf(text, sizeof text,
-                        "geometric head: the rates' standard deviation %.2f %.2f %.2f deg/s exceeds the limit %.2f deg/s "
-                        "(--max-sigma)",
-                        sigma[0] * kDeg, sigma[1] * kDeg, sigma[2] * kDeg,
+                        "geometric head: the rates' standard deviation %.2f %.2f %.2f deg/s (%.2f along the least certain "
+                        "axis) exceeds the limit %.2f deg/s (--max-sigma)",
+                        sigma[0] * kDeg, sigma[1] * kDeg, sigma[2] * kDeg, largest * kDeg,
                         options_.max_sigma_rad_s * kDeg);
           answer.status = PairStatus::Uncertain;
           answer.reason = text;
@@ -225,12 +254,13 @@ class RatesProcessor : public PairProcessor {
     return "";
   }
 
-  // Frames too small for DIS are a property of the sequence, not of one pair: bad input.
+  // Frames too small for DIS or LK are a property of the sequence, not of one pair: bad input.
   void check_minimum_size(const Frame& f) const {
-    if (dis_ && (f.image.width < kDisMinimumSide || f.image.height < kDisMinimumSide)) {
+    const int minimum = dis_ ? kDisMinimumSide : kLkMinimumSide;
+    if ((dis_ || lk_) && (f.image.width < minimum || f.image.height < minimum)) {
       throw invalid_input(frame_name(f) + " is " + std::to_string(f.image.width) + "x" + std::to_string(f.image.height) +
-                          "; DIS optical flow needs frames of at least " + std::to_string(kDisMinimumSide) + "x" +
-                          std::to_string(kDisMinimumSide) + " pixels.");
+                          (dis_ ? "; DIS" : "; Lucas-Kanade") + " optical flow needs frames of at least " +
+                          std::to_string(minimum) + "x" + std::to_string(minimum) + " pixels.");
     }
   }
 
@@ -245,6 +275,7 @@ class RatesProcessor : public PairProcessor {
   std::unique_ptr<Queue> queue_;
   std::unique_ptr<FlowNet> flownet_;
   std::unique_ptr<DisFlow> dis_;
+  std::unique_ptr<LkFlow> lk_;
   std::unique_ptr<InertialNetHead> head_;
   std::unique_ptr<GeometricHead> geometric_;
   std::unique_ptr<HeadUncertainty> uncertainty_;  // with options_.fuse, made on the first pair
@@ -252,12 +283,20 @@ class RatesProcessor : public PairProcessor {
 
 }  // namespace
 
-std::string to_string(FlowMethod method) { return method == FlowMethod::DIS ? "dis" : "flownet2"; }
+std::string to_string(FlowMethod method) {
+  switch (method) {
+    case FlowMethod::DIS: return "dis";
+    case FlowMethod::LK: return "lk";
+    case FlowMethod::FlowNet: break;
+  }
+  return "flownet2";
+}
 
 FlowMethod parse_flow_method(const std::string& text) {
   if (text == "flownet2" || text == "flownet") return FlowMethod::FlowNet;
   if (text == "dis") return FlowMethod::DIS;
-  throw invalid_input("unknown flow method '" + text + "'; expected flownet2 or dis");
+  if (text == "lk") return FlowMethod::LK;
+  throw invalid_input("unknown flow method '" + text + "'; expected flownet2, dis or lk");
 }
 
 ProcessorFactory rates_processor(const std::map<const Device*, const WeightSet*>& weights,
@@ -266,6 +305,10 @@ ProcessorFactory rates_processor(const std::map<const Device*, const WeightSet*>
   if (options.geometric_head && !options.camera) {
     throw invalid_input("the geometric head needs the camera intrinsics (a EuRoC sequence's cam0/sensor.yaml, or "
                         "--fx --fy --cx --cy)");
+  }
+  if (options.flow == FlowMethod::LK && options.inertialnet_head) {
+    throw invalid_input("--flow lk tracks the geometric head's sample points only; the InertialNet head needs a dense "
+                        "flow field: use --flow flownet2 or dis with it");
   }
   if (options.fuse && !(options.inertialnet_head && options.geometric_head)) {
     throw invalid_input("--fuse combines the InertialNet and the geometric head: it needs --head both");

@@ -2,8 +2,12 @@
 #include "synth/euroc_files.hpp"
 
 #include <charconv>
+#include <cmath>
 #include <fstream>
 
+#include <Eigen/Geometry>
+
+#include "inertialnet/core/constants.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "synth/euroc_calibration.hpp"
 
@@ -29,6 +33,31 @@ void write_text(const fs::path& path, const std::string& text) {
   if (!f) throw runtime_error("synth: could not write " + path.string() + ".");
 }
 
+namespace {
+
+// cam0's T_BS as the file states it: EuRoC's exactly, or with its rotation replaced by
+// Exp(−θ)·R_BS for a camera–IMU rotation error θ (SynthOptions::extrinsic_error_deg).
+std::string t_bs_yaml(const SynthOptions& o) {
+  const auto& e = o.extrinsic_error_deg;
+  const Eigen::Vector3d theta = Eigen::Vector3d(e[0], e[1], e[2]) * (kPi / 180);
+  if (theta.norm() == 0) return kEurocT_BS_Yaml;
+  const Eigen::Matrix3d error = Eigen::AngleAxisd(theta.norm(), theta.normalized()).toRotationMatrix();
+  const Eigen::Matrix3d r = error.transpose() * euroc_R_BS();
+  const Eigen::Vector3d t = euroc_t_BS();
+  std::string s = "T_BS:\n  cols: 4\n  rows: 4\n  data: [";
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      append_number(s, r(i, j));
+      s += ", ";
+    }
+    append_number(s, t(i));
+    s += i < 2 ? ",\n         " : ",\n         0.0, 0.0, 0.0, 1.0]\n";
+  }
+  return s;
+}
+
+}  // namespace
+
 std::string camera_yaml(const SynthOptions& o, const std::array<double, 4>& k) {
   std::string s = "%YAML:1.0\n";
   s += "# Written by inertialnet synth (motion " + std::string(to_string(o.motion)) + ", seed " +
@@ -39,7 +68,12 @@ std::string camera_yaml(const SynthOptions& o, const std::array<double, 4>& k) {
   s += "sensor_type: camera\n";
   s += "comment: synthetic camera (inertialnet synth)\n\n";
   s += "# Sensor extrinsics wrt. the body-frame.\n";
-  s += kEurocT_BS_Yaml;
+  const auto& e = o.extrinsic_error_deg;
+  if (e[0] != 0 || e[1] != 0 || e[2] != 0) {
+    s += "# Deliberately wrong (synth --extrinsic-error " + number(e[0]) + "," + number(e[1]) + "," + number(e[2]) +
+         "): the images were rendered with\n# EuRoC's R_BS; this is Exp(-theta)*R_BS, theta in degrees in the body frame.\n";
+  }
+  s += t_bs_yaml(o);
   s += "\n# Camera specific definitions.\n";
   s += "rate_hz: " + number(o.camera_rate_hz) + "\n";
   s += "resolution: [" + std::to_string(o.width) + ", " + std::to_string(o.height) + "]\n";

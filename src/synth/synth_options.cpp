@@ -66,6 +66,14 @@ void SynthOptions::validate() const {
     throw invalid_input("synth: the exposure time should be within 0..0.05 s, found " +
                         std::to_string(o.exposure_time_s) + " s.");
   }
+  {
+    const auto& e = o.extrinsic_error_deg;
+    const double angle = std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+    if (!(std::isfinite(angle) && angle <= 30)) {
+      throw invalid_input("synth: the camera-IMU rotation error should be a rotation vector of at most 30 degrees, found " +
+                          std::to_string(angle) + " degrees.");
+    }
+  }
   if (!(std::isfinite(o.drop_fraction) && o.drop_fraction >= 0 && o.drop_fraction <= 0.5)) {
     throw invalid_input("synth: the frame drop fraction should be within 0..0.5, found " + std::to_string(o.drop_fraction) + ".");
   }

@@ -137,6 +137,10 @@ TrainingSet::TrainingSet(const TrainingSetOptions& options) : options_(options) 
                         std::to_string(options.height) + " is too small (at least " +
                         std::to_string(kDisMinimumSide) + " pixels a side)");
   }
+  if (options.flow == FlowMethod::LK) {
+    throw invalid_input("training set: --flow lk gives flow at the geometric head's sample points only; the "
+                        "InertialNet head trains on dense flow: dis or flownet2");
+  }
   if (options.flow == FlowMethod::FlowNet && (!options.flownet_weights || !options.device)) {
     throw invalid_input("training set: FlowNet2 flow needs weights (--weights) and a device");
   }

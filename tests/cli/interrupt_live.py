@@ -27,7 +27,7 @@ def data_rows(text):
 
 def check_rows(rows, stopped, what, problems):
     for line in rows:
-        if len(line.split(",")) != 5:
+        if len(line.split(",")) != 8:  # timestamp_ns, wx, wy, wz, status, sigma_wx, sigma_wy, sigma_wz
             problems.append(f"{what}: a torn row {line!r}")
     if stopped is None:
         problems.append(f"{what}: no 'stopped after N pairs (Ctrl-C)' message")

@@ -15,7 +15,7 @@ endfunction()
 # not_ok(<csv> <var>): its rows whose status is not ok.
 function(not_ok csv var)
   rows(${csv} all)
-  list(FILTER all EXCLUDE REGEX ",ok$")
+  list(FILTER all EXCLUDE REGEX ",ok,[^,]*,[^,]*,[^,]*$")
   set(${var} "${all}" PARENT_SCOPE)
 endfunction()
 
@@ -53,7 +53,7 @@ set(got "")
 foreach(line IN LISTS bad)
   string(REGEX REPLACE ",.*" "" t "${line}")
   list(APPEND got "${t}")
-  if(NOT line MATCHES "^[0-9]+,,,,(no_texture|too_few_vectors|unreliable)$")
+  if(NOT line MATCHES "^[0-9]+,,,,(no_texture|too_few_vectors|unreliable),,,$")
     message(FATAL_ERROR "a pair without an answer reads '${line}'")
   endif()
 endforeach()
@@ -77,7 +77,7 @@ endforeach()
 
 # 2. The same faults on standard output and in calibrate-time: every pair, the run goes on.
 run(0 ${CLI} predict faulty --max-pairs 155)
-expect_match("\n[0-9]+,,,,no_texture\n")
+expect_match("\n[0-9]+,,,,no_texture,,,\n")
 expect_match("4 of 155 pairs without an answer")
 run(0 ${CLI} calibrate-time faulty)
 expect_match("pair 150 ")
@@ -98,11 +98,11 @@ if(NOT header STREQUAL "timestamp_ns,wx,wy,wz,status,sigma_wx,sigma_wy,sigma_wz,
 endif()
 rows(both.csv both_rows)
 list(GET both_rows 2 noise_pair)  # pair 3
-if(NOT noise_pair MATCHES "^[0-9]+,[-0-9.e]+,[-0-9.e]+,[-0-9.e]+,ok,,,,(too_few_vectors|unreliable)$")
+if(NOT noise_pair MATCHES "^[0-9]+,[-0-9.e]+,[-0-9.e]+,[-0-9.e]+,ok,,,,,,,(too_few_vectors|unreliable),,,$")
   message(FATAL_ERROR "the pair with a frame of noise reads '${noise_pair}'")
 endif()
 list(GET both_rows 5 flat_pair)  # pair 6
-if(NOT flat_pair MATCHES "^[0-9]+,,,,no_texture,,,,no_texture$")
+if(NOT flat_pair MATCHES "^[0-9]+,,,,no_texture,,,,,,,no_texture,,,$")
   message(FATAL_ERROR "the pair with a uniform frame reads '${flat_pair}'")
 endif()
 
@@ -144,14 +144,15 @@ file(GLOB first_bad_frames "${WORK}/first_bad/mav0/cam0/data/*.png")
 list(SORT first_bad_frames)
 list(GET first_bad_frames 0 frame0)
 file(WRITE "${frame0}" "not an image")
-run(0 ${CLI} predict first_bad -o first_bad.csv --stats)
+# --max-sigma 0: at 96x64 a pair's σ (5-7 deg/s) exceeds the default limit; this case is about decoding.
+run(0 ${CLI} predict first_bad -o first_bad.csv --stats --max-sigma 0)
 expect_match("pair 1 \\(frames 0 → 1, [^\n]*decode_error: ")
 not_ok(first_bad.csv first_bad_rows)
 list(LENGTH first_bad_rows count)
 if(NOT count EQUAL 1)
   message(FATAL_ERROR "first_bad.csv holds ${count} rows without an answer, expected 1 (pair 1)")
 endif()
-run(0 ${CLI} predict first_bad --fx 80)
+run(0 ${CLI} predict first_bad --fx 80 --max-sigma 0)
 expect_match("1 of 4 pairs without an answer \\(decode_error 1\\)")
 
 # 5. -o never names an input: the sequence's own files, the weights.

@@ -40,7 +40,7 @@ def fnv1a64(data):
 
 def check_csv(path, rates):
     frame = pd.read_csv(path)
-    if list(frame.columns) != ["timestamp_ns", "wx", "wy", "wz", "status"]:
+    if list(frame.columns) != ["timestamp_ns", "wx", "wy", "wz", "status", "sigma_wx", "sigma_wy", "sigma_wz"]:
         fail(f"pandas.read_csv({path}) columns {list(frame.columns)}")
     if frame["timestamp_ns"].dtype != np.int64 or len(frame) != len(rates):
         fail(f"pandas: {len(frame)} rows of {frame['timestamp_ns'].dtype} timestamps, expected {len(rates)} int64")
@@ -54,7 +54,7 @@ def check_csv(path, rates):
         if w is not None and [f32(v) for v in got] != [f32(v) for v in w]:
             fail(f"pandas: {got} against {w}")
     table = np.genfromtxt(path, delimiter=",", names=True)
-    if table.dtype.names != ("timestamp_ns", "wx", "wy", "wz", "status") or table.shape != (len(rates),):
+    if table.dtype.names != ("timestamp_ns", "wx", "wy", "wz", "status", "sigma_wx", "sigma_wy", "sigma_wz") or table.shape != (len(rates),):
         fail(f"numpy.genfromtxt({path}): fields {table.dtype.names}, shape {table.shape}")
     if not np.array_equal(table["wx"], frame["wx"].to_numpy(), equal_nan=True):
         fail("numpy.genfromtxt's wx differs from pandas'")

@@ -157,6 +157,29 @@ TEST(CameraImu, YamlIndentlessSequencesAreIndented) {
   EXPECT_EQ(yaml::normalise("a:\n  - 1\n"), "%YAML:1.0\na:\n  - 1\n");
 }
 
+// A ':' inside a plain scalar is part of the string in YAML (a colon opens a mapping only before a
+// space), but OpenCV's parser refuses "comment: … 16:9 …" ("Incorrect indentation") and reads
+// "a:b" as an empty value. The GoPro converter of the real-data notes writes such a comment
+// (issue 22's error budget could not read its sensor.yaml). Such values are double-quoted.
+TEST(CameraImu, YamlPlainScalarsWithAColonAreQuoted) {
+  EXPECT_EQ(yaml::normalise("comment: HERO4 Wide 16:9 profile  # a: b\r\nrate_hz: 20\n"),
+            "%YAML:1.0\ncomment: \"HERO4 Wide 16:9 profile\"  # a: b\r\nrate_hz: 20\n");
+  EXPECT_EQ(yaml::normalise("c: say \"x\" at 12:30\\n\n"), "%YAML:1.0\nc: \"say \\\"x\\\" at 12:30\\\\n\"\n");
+  // Quoted, flow and colon-free values, keys without a value and sequence items stay as they are.
+  const std::string same = "%YAML:1.0\na: \"x:y\"\nb: 'x:y'\nc: [1, 2]\nd: 3 # e:f\ng:\n  - h:i\nj: k\n";
+  EXPECT_EQ(yaml::normalise(same), same);
+
+  te::TempDir dir("yaml_colon");
+  const fs::path p = dir.path() / "sensor.yaml";
+  write(p, "%YAML:1.0\nsensor_type: camera\ncomment: GoPro frames; HERO4 Wide 1080p 16:9 profile\n"
+           "url: https://example.org/a:b\nrate_hz: 29.97\nresolution: [854, 480]\n");
+  cv::FileStorage fs = yaml::open(p);
+  EXPECT_EQ(fs["comment"].string(), "GoPro frames; HERO4 Wide 1080p 16:9 profile");
+  EXPECT_EQ(fs["url"].string(), "https://example.org/a:b");
+  EXPECT_DOUBLE_EQ(static_cast<double>(fs["rate_hz"]), 29.97);
+  EXPECT_EQ(static_cast<int>(fs["resolution"][1]), 480);
+}
+
 // OpenCV's parser loops forever on a '-' where it looks for a second document, which it does
 // whenever the root mapping ends before the text; such files are refused first, naming the line
 // of the file (not of the adjusted text). The first case is the fuzzer's 35-byte finding.

@@ -3,8 +3,13 @@
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
+
+#include "inertialnet/runtime/error.hpp"
+#include "inertialnet/runtime/excerpt.hpp"
 
 namespace inertialnet::cli {
 
@@ -17,7 +22,53 @@ nlohmann::json number(double v) { return std::isfinite(v) ? nlohmann::json(v) : 
 
 bool rotation_determined(const TimeOffsetEstimate& e) { return e.determined && e.rotation && e.rotation->determined; }
 
+int rank(const std::string& confidence) {
+  return confidence == "high" ? 3 : confidence == "medium" ? 2 : confidence == "low" ? 1 : 0;
+}
+
+// The time_offset and rotation_correction members both schemas share.
+void offset_and_rotation_json(nlohmann::json& j, const TimeOffsetEstimate& e) {
+  nlohmann::json t = {{"determined", e.determined},
+                      {"offset_s", e.offset_s},
+                      {"std_error_s", number(e.std_error_s)},
+                      {"confidence", e.confidence()},
+                      {"contrast", e.contrast},
+                      {"excitation_deg_s", e.excitation_deg_s},
+                      {"explained", e.explained},
+                      {"at_range_edge", e.at_range_edge},
+                      {"pairs", e.pairs},
+                      {"rmse_deg_s", e.rmse_deg_s},
+                      {"rmse_at_zero_deg_s", e.rmse_at_zero_deg_s}};
+  if (!e.determined) t["undetermined_reason"] = e.undetermined_reason;
+  j["time_offset"] = t;
+  if (e.determined && e.rotation) {
+    const RotationFit& r = *e.rotation;
+    nlohmann::json o = {{"determined", r.determined},
+                        {"rotation_vector_deg", vec_json(r.rotation_vector_deg)},
+                        {"std_error_deg", {{"x", number(r.std_error_deg[0])},
+                                           {"y", number(r.std_error_deg[1])},
+                                           {"z", number(r.std_error_deg[2])}}},
+                        {"angle_deg", r.angle_deg},
+                        {"angle_std_error_deg", number(r.angle_std_error_deg)},
+                        {"min_excitation_deg_s", r.min_excitation_deg_s},
+                        {"pairs", r.pairs},
+                        {"rmse_deg_s", r.rmse_deg_s},
+                        {"rmse_before_deg_s", r.rmse_before_deg_s},
+                        {"confidence", rotation_confidence(e)}};
+    if (!r.determined) o["undetermined_reason"] = r.undetermined_reason;
+    j["rotation_correction"] = o;
+  } else {
+    j["rotation_correction"] = nullptr;
+  }
+}
+
 }  // namespace
+
+std::string rotation_confidence(const TimeOffsetEstimate& e) {
+  if (!rotation_determined(e)) return "none";
+  const std::string own = e.rotation->confidence(), offset = e.confidence();
+  return rank(own) <= rank(offset) ? own : offset;
+}
 
 std::string calibrate_time_eval_options(const TimeOffsetEstimate& e) {
   if (!e.determined || e.confidence() == "low") return "";
@@ -55,40 +106,132 @@ std::string calibrate_time_json(const TimeOffsetEstimate& e, const std::string& 
   j["schema"] = kCalibrateTimeJsonSchema;
   j["sequence"] = sequence;
   j["rates_file"] = rates_file.empty() ? nlohmann::json(nullptr) : nlohmann::json(rates_file);
-  nlohmann::json t = {{"determined", e.determined},
-                      {"offset_s", e.offset_s},
-                      {"std_error_s", number(e.std_error_s)},
-                      {"confidence", e.confidence()},
-                      {"contrast", e.contrast},
-                      {"excitation_deg_s", e.excitation_deg_s},
-                      {"explained", e.explained},
-                      {"at_range_edge", e.at_range_edge},
-                      {"pairs", e.pairs},
-                      {"rmse_deg_s", e.rmse_deg_s},
-                      {"rmse_at_zero_deg_s", e.rmse_at_zero_deg_s}};
-  if (!e.determined) t["undetermined_reason"] = e.undetermined_reason;
-  j["time_offset"] = t;
-  if (e.determined && e.rotation) {
-    const RotationFit& r = *e.rotation;
-    nlohmann::json o = {{"determined", r.determined},
-                        {"rotation_vector_deg", vec_json(r.rotation_vector_deg)},
-                        {"std_error_deg", {{"x", number(r.std_error_deg[0])},
-                                           {"y", number(r.std_error_deg[1])},
-                                           {"z", number(r.std_error_deg[2])}}},
-                        {"angle_deg", r.angle_deg},
-                        {"angle_std_error_deg", number(r.angle_std_error_deg)},
-                        {"min_excitation_deg_s", r.min_excitation_deg_s},
-                        {"pairs", r.pairs},
-                        {"rmse_deg_s", r.rmse_deg_s},
-                        {"rmse_before_deg_s", r.rmse_before_deg_s}};
-    if (!r.determined) o["undetermined_reason"] = r.undetermined_reason;
-    j["rotation_correction"] = o;
-  } else {
-    j["rotation_correction"] = nullptr;
-  }
+  offset_and_rotation_json(j, e);
   j["apply"] = calibrate_time_eval_options(e);
   j["warnings"] = warnings;
   return j.dump(2) + "\n";
+}
+
+std::string calibrate_text(const CalibrationReport& c) {
+  std::string s = calibrate_time_text(c.offset);
+  if (rotation_determined(c.offset)) s += "rotation_confidence " + rotation_confidence(c.offset) + "\n";
+  if (c.readout) {
+    const ReadoutEstimate& r = *c.readout;
+    char buf[200];
+    if (!r.determined) {
+      std::snprintf(buf, sizeof buf, "readout_time_s none\n");
+    } else if (r.detected) {
+      std::snprintf(buf, sizeof buf, "readout_time_s %.6f\nreadout_std_error_s %.6f\n", r.readout_s, r.std_error_s);
+    } else {
+      std::snprintf(buf, sizeof buf, "readout_time_s 0\nreadout_upper_bound_s %.6f\n", r.upper_bound_s);
+    }
+    s += buf;
+    s += "readout_confidence " + r.confidence() + "\n";
+  }
+  return s;
+}
+
+std::string calibrate_json(const CalibrationReport& c, const std::string& sequence, const std::string& rates_file,
+                           const std::vector<std::string>& warnings) {
+  nlohmann::json j;
+  j["schema"] = kCalibrateJsonSchema;
+  j["sequence"] = sequence;
+  j["rates_file"] = rates_file.empty() ? nlohmann::json(nullptr) : nlohmann::json(rates_file);
+  j["rates_readout_time_s"] = c.rates_readout_time_s;
+  offset_and_rotation_json(j, c.offset);
+  if (c.readout) {
+    const ReadoutEstimate& r = *c.readout;
+    j["readout_time"] = {{"searched", true},
+                         {"determined", r.determined},
+                         {"detected", r.detected},
+                         {"readout_s", r.readout_s},
+                         {"std_error_s", number(r.std_error_s)},
+                         {"statistical_error_s", number(r.statistical_error_s)},
+                         {"upper_bound_s", number(r.upper_bound_s)},
+                         {"confidence", r.confidence()},
+                         {"reason", r.confidence_reason()},
+                         {"pairs", r.pairs},
+                         {"leak_excitation_deg_s2", r.leak_excitation_deg_s2},
+                         {"rmse_deg_s", r.rmse_deg_s},
+                         {"rmse_after_deg_s", r.rmse_after_deg_s}};
+  } else {
+    j["readout_time"] = {{"searched", false}, {"reason", c.readout_skipped}};
+  }
+  j["apply"] = calibrate_time_eval_options(c.offset);
+  j["warnings"] = warnings;
+  return j.dump(2) + "\n";
+}
+
+CalibrationToApply read_calibration_json(const std::string& path) {
+  const std::string where = "--calibration-from " + excerpt(path);
+  std::ifstream file(path, std::ios::binary);
+  if (!file) throw invalid_input(where + ": cannot read the file.");
+  std::stringstream text;
+  text << file.rdbuf();
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text.str());
+  } catch (const nlohmann::json::parse_error& e) {
+    throw invalid_input(where + ": not JSON (byte " + std::to_string(e.byte) +
+                        "); expected the --json report of inertialnet calibrate or calibrate-time.");
+  }
+  const auto* schema = j.is_object() && j.contains("schema") && j["schema"].is_string() ? j["schema"].get_ptr<const std::string*>() : nullptr;
+  if (!schema || (*schema != kCalibrateJsonSchema && *schema != kCalibrateTimeJsonSchema)) {
+    throw invalid_input(where + ": key \"schema\" should be \"" + kCalibrateJsonSchema + "\" or \"" +
+                        kCalibrateTimeJsonSchema + "\", found " + (schema ? "\"" + excerpt(*schema) + "\"" : "none") +
+                        " (the --json report of inertialnet calibrate).");
+  }
+  // A number at j[a][b], or invalid_input naming the key.
+  const auto number_at = [&](const nlohmann::json& parent, const std::string& key, const std::string& name) {
+    if (!parent.is_object() || !parent.contains(key) || !parent[key].is_number()) {
+      throw invalid_input(where + ": key \"" + name + "\" should be a number.");
+    }
+    return parent[key].get<double>();
+  };
+  CalibrationToApply c;
+  if (j.contains("rates_readout_time_s")) c.rates_readout_time_s = number_at(j, "rates_readout_time_s", "rates_readout_time_s");
+  const nlohmann::json& t = j.contains("time_offset") ? j["time_offset"] : nlohmann::json();
+  if (!t.is_object() || !t.contains("determined") || !t["determined"].is_boolean() || !t.contains("confidence") ||
+      !t["confidence"].is_string()) {
+    throw invalid_input(where + ": key \"time_offset\" should be an object with \"determined\" and \"confidence\".");
+  }
+  const std::string confidence = t["confidence"].get<std::string>();
+  if (!t["determined"].get<bool>() || confidence == "low" || confidence == "none") {
+    // As with --time-offset auto: an offset the calibration itself did not trust is not applied.
+    const std::string why = t.contains("undetermined_reason") && t["undetermined_reason"].is_string()
+                                ? ": " + t["undetermined_reason"].get<std::string>()
+                                : "";
+    throw invalid_input(where + ": the camera-IMU time offset in it is " +
+                        (t["determined"].get<bool>() ? "rated " + confidence : std::string("not determined")) + why +
+                        "; not applying it. Give the offset instead (--time-offset).");
+  }
+  c.time_offset_s = number_at(t, "offset_s", "time_offset.offset_s");
+  if (!std::isfinite(c.time_offset_s) || std::abs(c.time_offset_s) > 3600) {
+    throw invalid_input(where + ": key \"time_offset.offset_s\" should be within an hour.");
+  }
+  if (j.contains("rotation_correction") && j["rotation_correction"].is_object()) {
+    const nlohmann::json& r = j["rotation_correction"];
+    const bool determined = r.contains("determined") && r["determined"].is_boolean() && r["determined"].get<bool>();
+    const std::string rating = r.contains("confidence") && r["confidence"].is_string() ? r["confidence"].get<std::string>() : "";
+    if (!determined) {
+      c.rotation_skipped = "the rotation correction in it is not determined";
+    } else if (rating == "low") {
+      c.rotation_skipped = "the rotation correction in it is rated low";
+    } else {
+      const nlohmann::json& v = r.contains("rotation_vector_deg") ? r["rotation_vector_deg"] : nlohmann::json();
+      Vec3 w{};
+      for (int k = 0; k < 3; ++k) {
+        const std::string axis(1, static_cast<char>('x' + k));
+        w[static_cast<std::size_t>(k)] = number_at(v, axis, "rotation_correction.rotation_vector_deg." + axis);
+      }
+      if (!(std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) <= 180)) {
+        throw invalid_input(where + ": key \"rotation_correction.rotation_vector_deg\" should be a rotation vector "
+                            "of at most 180 degrees.");
+      }
+      c.rotation_correction_deg = w;
+    }
+  }
+  return c;
 }
 
 }  // namespace inertialnet::cli

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
-// What `inertialnet calibrate-time` found — the camera–IMU time offset and rotation correction
-// with their uncertainties — and its two renderings: text lines and JSON with a stable schema.
+// What `inertialnet calibrate` and `calibrate-time` found — the camera–IMU time offset, rotation
+// correction and (calibrate) rolling-shutter readout time with their uncertainties and ratings —
+// its two renderings, text lines and JSON with a stable schema, and the JSON read back
+// (eval --calibration-from).
 //
 // Text: the estimate's summary line, then `key value` lines a script can read:
 //   time_offset_s 0.039909 / std_error_s 0.000599 / confidence high
@@ -18,21 +20,49 @@
 //         "rmse_at_zero_deg_s", "undetermined_reason" (when not determined)},
 //     "rotation_correction": null (offset not determined) or {"determined": bool,
 //         "rotation_vector_deg": xyz, "std_error_deg": xyz, "angle_deg", "angle_std_error_deg",
-//         "min_excitation_deg_s", "pairs", "rmse_deg_s", "rmse_before_deg_s",
-//         "undetermined_reason" (when not determined)},
+//         "min_excitation_deg_s", "pairs", "rmse_deg_s", "rmse_before_deg_s", "confidence"
+//         (rotation_confidence below), "undetermined_reason" (when not determined)},
 //     "apply": string (the eval options that apply the estimate; "" when nothing to apply:
 //         not determined, or confidence low),
 //     "warnings": [string] }
+//
+// `calibrate` adds rotation_confidence and the readout lines to the text (readout_time_s: the
+// estimate, 0 when none is detected or "none" when not determined; readout_std_error_s when
+// detected, readout_upper_bound_s when not; readout_confidence), and its JSON has the schema
+// "inertialnet.calibrate/1": the fields above, plus
+//     "rates_readout_time_s": number (the readout the rates were predicted with: the offset holds
+//         for rates with that readout, whose mid-exposure shift eval adds),
+//     "readout_time": {"searched": false, "reason": string} or {"searched": true, "determined",
+//         "detected", "readout_s" (signed, also when not detected), "std_error_s",
+//         "statistical_error_s", "upper_bound_s",
+//         "confidence", "reason" (why "none" or "low"; "" otherwise), "pairs",
+//         "leak_excitation_deg_s2", "rmse_deg_s", "rmse_after_deg_s"}
+//     (readout_fit.hpp: what they mean).
 #pragma once
+
+#include <optional>
 
 #include <string>
 #include <vector>
 
+#include "inertialnet/eval/readout_fit.hpp"
 #include "inertialnet/eval/time_offset.hpp"
 
 namespace inertialnet::cli {
 
 inline constexpr const char* kCalibrateTimeJsonSchema = "inertialnet.calibrate-time/1";
+inline constexpr const char* kCalibrateJsonSchema = "inertialnet.calibrate/1";
+
+// What calibrate found.
+struct CalibrationReport {
+  TimeOffsetEstimate offset;                // with its rotation correction
+  double rates_readout_time_s = 0;          // the rates' own readout (their CSV's readout_time_s)
+  std::optional<ReadoutEstimate> readout;   // when searched
+  std::string readout_skipped;              // why not searched ("" when searched)
+};
+
+// The rotation's rating, no higher than the offset's it was fitted at ("none" when there is none).
+std::string rotation_confidence(const TimeOffsetEstimate& e);
 
 // The eval options applying `e` ("--time-offset 0.0399 --rotation-correction 1.01,1.99,2.00"),
 // or "" when the offset is not determined or its confidence is low (eval's auto refuses it).
@@ -43,5 +73,23 @@ std::string calibrate_time_text(const TimeOffsetEstimate& e);
 
 std::string calibrate_time_json(const TimeOffsetEstimate& e, const std::string& sequence, const std::string& rates_file,
                                  const std::vector<std::string>& warnings);
+
+// calibrate's text lines and JSON.
+std::string calibrate_text(const CalibrationReport& c);
+std::string calibrate_json(const CalibrationReport& c, const std::string& sequence, const std::string& rates_file,
+                           const std::vector<std::string>& warnings);
+
+// What eval --calibration-from applies from a calibrate or calibrate-time JSON report.
+struct CalibrationToApply {
+  double time_offset_s = 0;         // for rates with readout rates_readout_time_s
+  double rates_readout_time_s = 0;  // 0 when the report does not say (calibrate-time/1)
+  std::optional<Vec3> rotation_correction_deg;  // unset: not determined or rated low
+  std::string rotation_skipped;                 // why it is unset, when the report has a rotation
+};
+
+// Reads `path`; invalid_input (exit 2) naming the file and key for anything that is not one of the
+// two schemas, a missing or non-numeric field, or a time offset that is not determined or rated
+// low (eval --time-offset auto refuses the same).
+CalibrationToApply read_calibration_json(const std::string& path);
 
 }  // namespace inertialnet::cli

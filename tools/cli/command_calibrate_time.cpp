@@ -1,9 +1,12 @@
 // SPDX-License-Identifier: Apache-2.0
-// `inertialnet calibrate-time SEQ [RATES.csv]`: the camera–IMU time offset and rotation
-// correction of a EuRoC-layout sequence, or of an image folder or a video with --imu FILE,
-// estimated by aligning predicted rates with its gyro (include/inertialnet/eval/time_offset.hpp,
-// rotation_fit.hpp). Without a rates file the weight-free path (DIS flow + geometric head)
-// predicts them first.
+// `inertialnet calibrate SEQ [RATES.csv]`: the self-calibration of a EuRoC-layout sequence, or of
+// an image folder or a video with --imu FILE, from its images and gyro (issue 22): the camera–IMU
+// time offset and rotation correction (include/inertialnet/eval/time_offset.hpp,
+// rotation_fit.hpp) and, when it predicts the rates itself, the rolling-shutter readout time
+// (readout_fit.hpp), each with its uncertainty and a confidence rating. Without a rates file the
+// weight-free path (DIS flow + geometric head) predicts them first.
+// `inertialnet calibrate-time` is the same without the readout search (the command's first name;
+// its --json keeps the schema inertialnet.calibrate-time/1).
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -13,7 +16,11 @@
 #include "common.hpp"
 #include "console.hpp"
 #include "input_options.hpp"
+#include "readout_leak.hpp"
 #include "inertialnet/eval/evaluate.hpp"
+#include "inertialnet/eval/imu_sync.hpp"
+#include "inertialnet/eval/readout_fit.hpp"
+#include "inertialnet/io/camera.hpp"
 #include "inertialnet/io/euroc.hpp"
 #include "inertialnet/io/rates_csv.hpp"
 #include "inertialnet/pipeline/predict.hpp"
@@ -23,19 +30,30 @@ namespace inertialnet::cli {
 
 namespace {
 struct CalibrateTimeOptions {
+  std::string name;  // "calibrate" or "calibrate-time", for messages
   std::string sequence, rates, head;
   double range = 0.2;
   bool json = false;
+  bool readout = false;  // calibrate: fit the readout time
+  bool no_readout = false;
   IntrinsicsCliOptions camera;
   ImuCliOptions input;
 };
 
+// The camera and solver the rates were solved with, for the readout fit.
+struct SolvedWith {
+  std::optional<CameraIntrinsics> camera;
+  GeometricHeadOptions head;
+  std::optional<Mat3> camera_to_body;  // unset: the rates are in the camera frame
+};
+
 // Weight-free rates of every frame pair, set up as `inertialnet predict SEQ` sets them up (the
 // library's Prediction: DIS flow + geometric head, in the body frame when cam0 gives T_BS).
-RatesTable predict_weight_free(const CalibrateTimeOptions& o, const EurocSequence& seq, const GlobalOptions& global) {
+RatesTable predict_weight_free(const CalibrateTimeOptions& o, const EurocSequence& seq, const GlobalOptions& global,
+                               SolvedWith& solved) {
   const bool given = o.camera.fx || o.camera.fy || !o.camera.calibration.file.empty();
   if (!seq.camera && !given) {
-    throw invalid_input("calibrate-time: " + o.sequence + (seq.mav0.empty() ? " has no camera calibration" : " has no " + o.input.camera + "/sensor.yaml") +
+    throw invalid_input(o.name + ": " + o.sequence + (seq.mav0.empty() ? " has no camera calibration" : " has no " + o.input.camera + "/sensor.yaml") +
                         " to predict with; give --calibration FILE or --fx (and --fy --cx --cy), or a rates file.");
   }
   PredictSettings settings;
@@ -52,6 +70,9 @@ RatesTable predict_weight_free(const CalibrateTimeOptions& o, const EurocSequenc
   settings.device = global.device;
   settings.no_cache = global.no_cache;
   Prediction prediction(settings);
+  solved.camera = prediction.processor().camera;
+  solved.head = prediction.processor().geometric;
+  solved.camera_to_body = prediction.processor().camera_to_body;
   for (const auto& note : prediction.notes()) info("note: " + note);
   RatesTable table;
   table.metadata = prediction.csv_metadata();
@@ -73,8 +94,12 @@ RatesTable predict_weight_free(const CalibrateTimeOptions& o, const EurocSequenc
 }
 }  // namespace
 
-Command register_calibrate_time(CLI::App& app, const GlobalOptions& global) {
+namespace {
+
+Command register_calibration(CLI::App& app, const GlobalOptions& global, bool readout) {
   auto o = std::make_shared<CalibrateTimeOptions>();
+  o->name = readout ? "calibrate" : "calibrate-time";
+  o->readout = readout;
   app.add_option("sequence", o->sequence, "EuRoC-layout sequence with mav0/imu0, an image folder or video with --imu, or a ROS bag")
       ->required()
       ->check(CLI::ExistingPath);
@@ -82,7 +107,10 @@ Command register_calibrate_time(CLI::App& app, const GlobalOptions& global) {
       ->check(CLI::ExistingFile);
   app.add_option("--range", o->range, "search +-this many seconds")->capture_default_str();
   app.add_option("--head", o->head, "use columns wx<_HEAD>…, e.g. --head geometric");
-  app.add_flag("--json", o->json, "machine-readable report (schema inertialnet.calibrate-time/1, docs/cli.md)");
+  app.add_flag("--json", o->json,
+               std::string("machine-readable report (schema ") +
+                   (readout ? kCalibrateJsonSchema : kCalibrateTimeJsonSchema) + ", docs/cli.md)");
+  if (readout) app.add_flag("--no-readout", o->no_readout, "skip the readout fit (time offset and rotation only)");
   add_imu_options(app, o->input);
   add_intrinsics_options(app, o->camera);
   return [o, &global]() {
@@ -96,14 +124,48 @@ Command register_calibrate_time(CLI::App& app, const GlobalOptions& global) {
     options.input = imu_sequence_options(o->input);
     const EurocSequence seq = read_sequence_with_imu(o->sequence, options.input);
     for (const auto& note : seq.notes) info(note);
-    const RatesTable rates = o->rates.empty() ? predict_weight_free(*o, seq, global) : read_rates_csv(o->rates);
+    SolvedWith solved;
+    const RatesTable rates = o->rates.empty() ? predict_weight_free(*o, seq, global, solved) : read_rates_csv(o->rates);
+    CalibrationReport calibration;
+    if (o->readout && o->no_readout) calibration.readout_skipped = "--no-readout";
+    if (o->readout && !o->no_readout) {
+      // A rates file: the camera of the sequence's sensor.yaml and the default solver.
+      if (!o->rates.empty() && seq.camera) solved.camera = CameraIntrinsics::from_calibration(*seq.camera);
+      if (solved.camera) {
+        ReadoutModel model;
+        if (solved.camera_to_body) {
+          model.camera_to_imu = *solved.camera_to_body;
+        } else {
+          // Rates in the camera frame, or from a file: eval rotates them into the IMU frame with this.
+          const Mat3 r = imu_to_camera_rotation(seq);
+          model.camera_to_imu = {r[0], r[3], r[6], r[1], r[4], r[7], r[2], r[5], r[8]};
+        }
+        try {
+          model.leak = readout_leak(*solved.camera, solved.head, global.device);
+          options.time_offset_search.readout = model;
+        } catch (const Error& error) {
+          // A rates file needs no device for the offset and rotation; without one the readout alone is skipped.
+          calibration.readout_skipped = std::string("the readout's leak model needs an OpenCL device: ") + error.what();
+        }
+      } else {
+        calibration.readout_skipped = "no camera intrinsics to fit it with (the sequence's sensor.yaml)";
+      }
+    }
     const EvalReport report = evaluate(rates, seq, options);
     const TimeOffsetEstimate& e = *report.time_offset_estimate;
+    calibration.offset = e;
+    calibration.rates_readout_time_s = rates.meta_number("readout_time_s").value_or(0.0);
+    calibration.readout = e.readout;
+    if (o->readout && !o->no_readout && !e.readout && calibration.readout_skipped.empty()) {
+      calibration.readout_skipped = "the time offset is not determined";
+    }
     if (o->json) {
-      std::cout << calibrate_time_json(e, o->sequence, o->rates, report.warnings);
+      std::cout << (o->readout ? calibrate_json(calibration, o->sequence, o->rates, report.warnings)
+                               : calibrate_time_json(e, o->sequence, o->rates, report.warnings));
     } else {
       std::cout << e.summary() << "\n";
       if (e.determined && e.rotation) std::cout << e.rotation->summary() << "\n";
+      if (calibration.readout) std::cout << calibration.readout->summary() << "\n";
     }
     if (!e.determined) {
       // No number to apply: a range edge or an infinitely uncertain offset is not an estimate.
@@ -118,7 +180,7 @@ Command register_calibrate_time(CLI::App& app, const GlobalOptions& global) {
         std::printf("the camchain states timeshift_cam_imu %+.3f ms (same sign: t_imu = t_cam + shift)\n",
                     *options.input.camera_imu->timeshift_cam_imu_s * 1e3);
       }
-      std::cout << calibrate_time_text(e);
+      std::cout << (o->readout ? calibrate_text(calibration) : calibrate_time_text(e));
       std::string input;
       if (o->input.camera != "cam0") input += " --camera " + o->input.camera;
       if (!o->input.imu.empty()) input += " --imu " + o->input.imu;
@@ -140,9 +202,20 @@ Command register_calibrate_time(CLI::App& app, const GlobalOptions& global) {
                   << calibrate_time_eval_options(e) << "\n";
       }
     }
+    if (o->readout && !o->no_readout && !calibration.readout_skipped.empty()) {
+      warning("the readout time is not fitted: " + calibration.readout_skipped);
+    }
     for (const auto& w : report.warnings) warning(w);
     return 0;
   };
+}
+
+}  // namespace
+
+Command register_calibrate(CLI::App& app, const GlobalOptions& global) { return register_calibration(app, global, true); }
+
+Command register_calibrate_time(CLI::App& app, const GlobalOptions& global) {
+  return register_calibration(app, global, false);
 }
 
 }  // namespace inertialnet::cli

@@ -7,6 +7,7 @@
 #include <iostream>
 #include <memory>
 
+#include "calibrate_time_report.hpp"
 #include "commands.hpp"
 #include "common.hpp"
 #include "console.hpp"
@@ -24,7 +25,29 @@ struct EvalCliOptions {
   double offset_range = 0.2;
   bool json = false, series = false, camera_frame = false;
   ImuCliOptions input;
+  std::string calibration_from;  // calibrate --json's report (issue 22)
 };
+
+// --calibration-from FILE: the time offset and rotation correction of calibrate's (or
+// calibrate-time's) JSON report. Its offset holds for rates predicted with its
+// rates_readout_time_s; eval adds each file's mid-exposure shift (readout / 2) to the offset, so
+// the offset applied here keeps their sum: offset + (readout_calibrated − readout_here) / 2.
+void apply_calibration_from(const EvalCliOptions& o, EvalOptions& options) {
+  if (!o.time_offset.empty() || !o.rotation_correction.empty()) {
+    throw invalid_input("--calibration-from gives the time offset and rotation correction: leave out --time-offset "
+                        "and --rotation-correction, or the file.");
+  }
+  const CalibrationToApply c = read_calibration_json(o.calibration_from);
+  const double readout = options.readout_time_s ? *options.readout_time_s
+                                                : read_rates_csv(o.rates).meta_number("readout_time_s").value_or(0.0);
+  options.time_offset_s = c.time_offset_s + (c.rates_readout_time_s - readout) / 2;
+  options.rotation_correction_deg = c.rotation_correction_deg;
+  char line[200];
+  std::snprintf(line, sizeof line, "calibration from %s: time offset %+.3f ms%s", o.calibration_from.c_str(),
+                *options.time_offset_s * 1e3, c.rotation_correction_deg ? " and the camera-IMU rotation correction" : "");
+  info(line);
+  if (!c.rotation_skipped.empty()) warning("--calibration-from: " + c.rotation_skipped + "; not applied");
+}
 }  // namespace
 
 Command register_eval(CLI::App& app, const GlobalOptions&) {
@@ -48,6 +71,10 @@ Command register_eval(CLI::App& app, const GlobalOptions&) {
   app.add_option("--rotation-correction", o->rotation_correction,
                  "camera-IMU rotation correction rx,ry,rz in degrees (a rotation vector in the IMU frame, as "
                  "calibrate-time prints it): predictions are rotated by it before the comparison");
+  app.add_option("--calibration-from", o->calibration_from,
+                 "apply the time offset and camera-IMU rotation of calibrate's --json report (instead of --time-offset "
+                 "and --rotation-correction)")
+      ->check(CLI::ExistingFile);
   app.add_option("--readout-time", o->readout_time,
                  "rolling-shutter readout time in seconds (rates belong to mid-exposure); default: the rates file's");
   app.add_option("--gyro-bias", o->gyro_bias, "gyro bias x,y,z in rad/s (IMU frame), or auto: a constant fitted against the predictions by least squares; "
@@ -79,6 +106,7 @@ Command register_eval(CLI::App& app, const GlobalOptions&) {
       options.rotation_correction_deg = v;
     }
     if (!o->readout_time.empty()) options.readout_time_s = parse_seconds(o->readout_time, "--readout-time");
+    if (!o->calibration_from.empty()) apply_calibration_from(*o, options);
     options.sync.camera_frame = o->camera_frame;
     if (o->gyro_bias == "auto") {
       options.sync.bias = BiasSource::LeastSquares;

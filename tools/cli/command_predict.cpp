@@ -72,7 +72,7 @@ struct PredictOptions {
   BagTopics bag;                     // --image-topic, --camera-info-topic
   std::string time_offset, readout_time;
   double flow_check_px = 0.5;  // PredictSettings' default
-  double max_sigma_deg_s = 5.0;   // PredictSettings' default (issue 22)
+  double max_sigma_deg_s = 10.0;  // PredictSettings' default (issue 22)
   std::string smooth = "lag:2";   // PredictSettings' default (issue 22)
   bool fuse = false;              // issue 23
   int lanes = 0;  // 0: default_lanes_per_device()
@@ -159,8 +159,10 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
   app.add_option("-w,--weights", o->weights,
                  "weights (safetensors) holding FlowNet2 and/or the InertialNet head; repeat for several files");
   app.add_option("--model", o->model, "flow network (default FlowNet2)")->transform(choice("model", flow_model_names()));
-  app.add_option("--flow", o->flow, "flownet2 (default with weights) or dis (OpenCV DIS; default without weights)")
-      ->transform(choice("flow method", {"flownet2", "dis"}));
+  app.add_option("--flow", o->flow,
+                 "flownet2 (default with weights), dis (OpenCV DIS; default without weights) or lk (sparse "
+                 "Lucas-Kanade at the geometric head's sample points; geometric head only)")
+      ->transform(choice("flow method", {"flownet2", "dis", "lk"}));
   app.add_option("--head", o->head, "inertialnet (default with weights), geometric (default without), or both")
       ->transform(choice("head", {"inertialnet", "geometric", "both"}));
   app.add_option("--solver", o->solver, "geometric head's solver")
@@ -191,14 +193,14 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
                  "and the motion's change across the rows, and the CSV states it for eval (rates belong to "
                  "mid-exposure)");
   app.add_option("--flow-check", o->flow_check_px,
-                 "DIS: also compute the backward flow and leave out vectors whose round trip misses by more than "
+                 "DIS and LK: also compute the backward flow and leave out vectors whose round trip misses by more than "
                  "this many pixels (at 752 columns, scaled with the width); 0: off")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1e6));
   // Issue 22: confidence per pair and more than two frames.
   app.add_option("--max-sigma", o->max_sigma_deg_s,
-                 "geometric head: a pair whose rates' standard deviation exceeds this many deg/s on any axis gets the "
-                 "status uncertain instead of rates; 0: no limit")
+                 "geometric head: a pair whose rates' standard deviation exceeds this many deg/s (along the least "
+                 "certain axis) gets the status uncertain instead of rates; 0: no limit")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1e6));
   app.add_option("--smooth", o->smooth,
@@ -263,7 +265,10 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
     // A live source runs until Ctrl-C or its end; Ctrl-C is then its normal end, not an interruption.
     const bool live = prediction.source().open_ended();
     const auto& infos = prediction.device_infos();
-    if (!have_weights) info("no weights given: weight-free DIS optical flow + geometric head");
+    if (!have_weights) {
+      info(std::string("no weights given: weight-free ") + (o->flow == "lk" ? "Lucas-Kanade" : "DIS") +
+           " optical flow + geometric head");
+    }
     const std::string count = !live      ? std::to_string(pairs) + " pairs"
                               : pairs > 0 ? "up to " + std::to_string(pairs) + " pairs"
                                           : std::string("pairs until Ctrl-C or its end");

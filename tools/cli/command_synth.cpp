@@ -7,13 +7,14 @@
 
 #include "commands.hpp"
 #include "common.hpp"
+#include "inertialnet/eval/imu_sync.hpp"
 #include "inertialnet/synth/synthetic_sequence.hpp"
 
 namespace inertialnet::cli {
 
 namespace {
 struct SynthCliOptions {
-  std::string out, motion = "rotation", size = "752x480";
+  std::string out, motion = "rotation", size = "752x480", extrinsic_error;
   int frames = 40;
   std::uint64_t seed = 1;
   double max_rate = 60, time_offset = 0, readout_time = 0, exposure_time = 0;
@@ -37,6 +38,9 @@ Command register_synth(CLI::App& app, const GlobalOptions&) {
       ->capture_default_str();
   app.add_option("--readout-time", o->readout_time, "rolling shutter: seconds from the first row to the last")
       ->capture_default_str();
+  app.add_option("--extrinsic-error", o->extrinsic_error,
+                 "write cam0's camera-IMU rotation this far off, rx,ry,rz in degrees (a rotation vector in the IMU "
+                 "frame: the correction calibrate should find)");
   app.add_option("--exposure-time", o->exposure_time, "motion blur: seconds each row is exposed")->capture_default_str();
   app.add_option("--drop-frames", o->drop_fraction, "leave out each inner frame with this probability")
       ->capture_default_str();
@@ -60,6 +64,10 @@ Command register_synth(CLI::App& app, const GlobalOptions&) {
     options.time_offset_s = o->time_offset;
     options.readout_time_s = o->readout_time;
     options.exposure_time_s = o->exposure_time;
+    if (!o->extrinsic_error.empty()) {
+      const Vec3 e = parse_vec3(o->extrinsic_error, "--extrinsic-error");
+      options.extrinsic_error_deg = {e[0], e[1], e[2]};
+    }
     options.drop_fraction = o->drop_fraction;
     options.exposure_variation = o->exposure_variation;
     options.texture_contrast = o->texture_contrast;

@@ -2,7 +2,9 @@
 // `inertialnet weights`: write deterministic synthetic weights (for benchmarks and for trying
 // the tools without a checkpoint), or describe a weight file.
 #include <iostream>
+#include <map>
 #include <memory>
+#include <string>
 
 #include "commands.hpp"
 #include "common.hpp"
@@ -13,6 +15,26 @@
 namespace inertialnet::cli {
 
 namespace {
+// Weights converted from a downloaded checkpoint (python -m inertialnet.convert) carry the
+// inertialnet.checkpoint.* block: say first which published checkpoint they came from and how that
+// was established (checksum or file name); the raw keys follow with the rest of the metadata.
+void print_checkpoint_origin(const std::map<std::string, std::string>& meta) {
+  const auto value = [&meta](const std::string& key) {
+    const auto found = meta.find("inertialnet.checkpoint." + key);
+    return found == meta.end() ? std::string() : found->second;
+  };
+  const std::string published = value("published");
+  if (published.empty()) return;
+  std::cout << "  converted from " << value("file") << " (" << value("layout") << " layout, " << value("format")
+            << " format, SHA-256 " << value("sha256") << ")\n";
+  if (published == "none") {
+    std::cout << "  not a published checkpoint: " << value("checksum") << "\n";
+  } else {
+    std::cout << "  published checkpoint: " << published << " (checksum: " << value("checksum") << ")\n";
+    if (!value("url").empty()) std::cout << "  download: " << value("url") << "\n";
+  }
+}
+
 struct WeightsOptions {
   std::string synthetic;
   std::uint64_t seed = 1;
@@ -40,6 +62,7 @@ Command register_weights(CLI::App& app, const GlobalOptions&) {
       std::int64_t parameters = 0;
       for (const auto& name : file.names()) parameters += file.info(name).numel();
       std::cout << o->info << ": " << file.names().size() << " tensors, " << parameters << " parameters\n";
+      print_checkpoint_origin(file.metadata());
       for (const auto& [key, value] : file.metadata()) std::cout << "  " << key << " = " << value << "\n";
       return 0;
     }

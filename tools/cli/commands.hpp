@@ -29,6 +29,7 @@ Command register_eval(CLI::App& app, const GlobalOptions& global);
 Command register_synth(CLI::App& app, const GlobalOptions& global);
 Command register_bench(CLI::App& app, const GlobalOptions& global);
 Command register_calibrate_time(CLI::App& app, const GlobalOptions& global);
+Command register_calibrate(CLI::App& app, const GlobalOptions& global);
 Command register_viz(CLI::App& app, const GlobalOptions& global);
 Command register_train(CLI::App& app, const GlobalOptions& global);
 Command register_tune(CLI::App& app, const GlobalOptions& global);

@@ -33,12 +33,17 @@ std::string help_examples(const std::string& subcommand) {
        "  inertialnet eval rates.csv data/seq --plot out/rates.png --target mean\n"
        "  inertialnet eval rates.csv data/seq --json --series > report.json\n"
        "  inertialnet eval rates.csv data/seq --time-offset auto --gyro-bias auto\n"
+       "  inertialnet eval rates.csv data/seq --calibration-from calib.json  # calibrate --json's offset and rotation\n"
        "  inertialnet eval rates.csv clip.mp4 --imu imu.csv --camchain camchain-imucam.yaml  # Kalibr's calibration\n"
        "  inertialnet eval rates.csv frames/ --imu imu.csv --T-cam-imu '0 -1 0 0  1 0 0 0  0 0 1 0  0 0 0 1'\n"},
       {"export",
        "  inertialnet export rates.csv --format gyroflow -o clip.gcsv            # Gyroflow's gyro log\n"
        "  inertialnet export rates.csv --format euroc-imu -o virtual/imu0/data.csv # a gyro for a VIO to replay\n"
        "  inertialnet export rates.csv --format tum --head geometric -o orientation.txt  # evo_traj tum orientation.txt\n"},
+      {"calibrate",
+       "  inertialnet calibrate data/seq                       # offset, rotation and readout, predicting weight-free\n"
+       "  inertialnet calibrate data/seq --json > calib.json && inertialnet eval rates.csv data/seq --calibration-from calib.json\n"
+       "  inertialnet calibrate phone.mp4 --imu gyro.csv --calibration camchain-imucam.yaml --readout-max 0.05\n"},
       {"calibrate-time",
        "  inertialnet calibrate-time data/seq                  # predicts weight-free, then estimates\n"
        "  inertialnet calibrate-time data/seq rates.csv --range 0.3\n"

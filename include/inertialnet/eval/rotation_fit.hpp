@@ -44,7 +44,15 @@ struct RotationFit {
   bool determined = true;
   std::string undetermined_reason;
   std::string summary() const;     // one line for reports
+  // The verdict: "none" (not determined); "low" (the angle's 1σ above kLowRotationStdErrorDeg);
+  // "high" (below kHighRotationStdErrorDeg, so that 2σ stays within the 0.5° a calibration check
+  // asks for, issue 22); else "medium". calibrate rates it no higher than the offset it was
+  // fitted at (a rotation fitted at a wrong offset absorbs timing error).
+  std::string confidence() const;
 };
+
+inline constexpr double kLowRotationStdErrorDeg = 1.0;
+inline constexpr double kHighRotationStdErrorDeg = 0.25;
 
 // Rates below this excitation (deg/s about the least excited axis) fix no rotation about it.
 inline constexpr double kMinRotationExcitationDegS = 0.5;

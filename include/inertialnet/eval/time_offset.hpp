@@ -36,6 +36,9 @@
 // that offset, the offset again on the rotated predictions, twice; then the rotation once more at
 // the final offset. A rotation error leaks rate from one axis into the others, which the offset
 // search alone would partly absorb; the alternation lowers one cost over both unknowns.
+//
+// With a `readout` model (calibrate) the rolling-shutter readout time is then fitted on the
+// residual left at the final offset and rotation (readout_fit.hpp).
 #pragma once
 
 #include <cstddef>
@@ -45,6 +48,7 @@
 #include <vector>
 
 #include "inertialnet/core/vec3.hpp"
+#include "inertialnet/eval/readout_fit.hpp"
 #include "inertialnet/eval/rotation_fit.hpp"
 #include "inertialnet/io/euroc.hpp"
 
@@ -54,6 +58,7 @@ struct TimeOffsetOptions {
   double range_s = 0.2;    // candidates over [−range_s, range_s]
   double step_s = 0.001;   // grid step before the parabolic refinement
   bool fit_rotation = false;  // also fit the camera–IMU rotation correction (see above)
+  std::optional<ReadoutModel> readout;  // also fit the readout time (see above)
 };
 
 struct TimeOffsetEstimate {
@@ -69,6 +74,7 @@ struct TimeOffsetEstimate {
   bool determined = true;         // false: the data fix no offset; nothing to apply
   std::string undetermined_reason;  // why not, in words ("the gyro shows no rotation …")
   std::optional<RotationFit> rotation;  // with fit_rotation (unset when the offset search ended on the edge)
+  std::optional<ReadoutEstimate> readout;  // with a readout model, when the offset is determined
   std::string summary() const; // one line for reports
   // The verdict: "none" (not determined); "low" (on the range edge, no curvature, contrast > 0.9,
   // under kLowExplained explained or under kLowExcitationDegS of gyro motion); "high" (σ < 2 ms,

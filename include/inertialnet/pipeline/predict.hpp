@@ -29,7 +29,7 @@ struct PredictSettings {
   std::filesystem::path sequence;    // EuRoC folder, image folder, video or live source (io/live_source.hpp)
   std::vector<std::string> weights;  // safetensors files; empty: the weight-free path
   std::string model;                 // flow network; "" takes it from the weights (else FlowNet2)
-  std::string flow;                  // "flownet2" or "dis"; "": flownet2 with weights, dis without
+  std::string flow;                  // "flownet2", "dis" or "lk"; "": flownet2 with weights, dis without
   std::string head;                  // "inertialnet", "geometric" or "both"; "": by the weights
   std::string solver = "motion-field";  // geometric head: "motion-field" or "opengv"
   // A calibration file (calibration_file.hpp: EuRoC sensor.yaml, Kalibr camchain, OpenCV YAML/XML)
@@ -49,12 +49,12 @@ struct PredictSettings {
   // Rolling shutter: seconds from the first row's exposure to the last's (0: global shutter). The
   // geometric head corrects each flow vector's interval; the CSV states it for eval.
   double readout_time_s = 0;
-  // DIS forward-backward check (RatesProcessorOptions::flow_check_px); 0: off.
+  // DIS or LK forward-backward check (RatesProcessorOptions::flow_check_px); 0: off.
   double flow_check_px = 0.5;
   // Issue 22: the largest per-axis σ a geometric rate may have, deg/s (RatesProcessorOptions::
   // max_sigma_rad_s; 0: no limit), and the smoother over the pairs ("off", "lag:L"; rate_smoother.hpp):
   // lag 2 by default, the best of the synthetic conditions (docs/real_cameras.md, "More than two frames").
-  double max_sigma_deg_s = 5.0;
+  double max_sigma_deg_s = 10.0;
   std::string smooth = "lag:2";
   // Issue 23: with head "both", a third estimator "fused" (columns wx_fused, …): the two heads'
   // rates weighted by their σ, the InertialNet head's σ from Monte-Carlo dropout

@@ -4,15 +4,18 @@
 //
 // Per estimator and axis, a constant-velocity Kalman model of the rate at each pair's midpoint
 // time: state (ω, ω̇), ω̇ driven by white noise of spectral density q ((rad/s²)²·s); a pair's
-// rate is a measurement of ω with variance σ². Each pair's rate is the Rauch–Tung–Striebel
+// rate is a measurement of ω with the variance (σx² + σy² + σz²)/3 on every axis (one gain for
+// all three axes, so that smoothing commutes with rotating the rates: camera and body frame
+// alike), each axis's σ then scaled as that variance shrank. Each pair's rate is the Rauch–Tung–Striebel
 // smoothed ω given every pair up to `lag` pairs after it, so it is emitted `lag` pairs late:
 // the smoother adds lag frame intervals of latency (lag 0: the causal filter, no latency).
 // A pair that is not ok, or whose σ is not known (the InertialNet head), is passed through as it
 // came: no answer is invented for it, and it does not update the filter (the state is only
-// predicted across it). The smoothed σ replaces the pair's σ.
+// predicted across it).
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <deque>
 #include <string>
 #include <vector>
@@ -60,7 +63,7 @@ class RateSmoother {
   std::deque<PairResult> held_;                 // pairs not yet emitted (the raw results)
   std::deque<std::vector<State>> states_;       // their filter states
   std::vector<State> last_;                     // the newest filter state per estimator axis
-  double last_mid_s_ = 0;
+  std::int64_t last_t0_ns_ = 0, last_t1_ns_ = 0;  // the previous pair's frames
   bool have_last_ = false;
 };
 

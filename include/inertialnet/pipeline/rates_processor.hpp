@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
 // The pair processors the pipeline runs: what turns two frames into angular rates.
 //
-// Flow comes from FlowNet2 (or a lighter family member, on the device) or from OpenCV's DIS
-// optical flow (classical, weight-free; through OpenCV's T-API, so on OpenCL where OpenCV can).
+// Flow comes from FlowNet2 (or a lighter family member, on the device), from OpenCV's DIS
+// optical flow (classical, weight-free; through OpenCV's T-API, so on OpenCL where OpenCV can), or
+// from OpenCV's pyramidal Lucas–Kanade tracker at the geometric head's sample points only
+// (weight-free, sparse; include/inertialnet/models/lk_flow.hpp).
 // Rates come from the InertialNet head (learned) and/or the geometric head (weight-free,
 // include/inertialnet/models/geometric_head.hpp), named "inertialnet" and "geometric".
 #pragma once
@@ -20,8 +22,9 @@
 
 namespace inertialnet {
 
-enum class FlowMethod { FlowNet, DIS };
-std::string to_string(FlowMethod method);           // "flownet2", "dis"
+// LK: sparse, for the geometric head alone (the InertialNet head needs a dense field).
+enum class FlowMethod { FlowNet, DIS, LK };
+std::string to_string(FlowMethod method);           // "flownet2", "dis", "lk"
 FlowMethod parse_flow_method(const std::string& text);  // invalid_input listing the choices
 
 struct RatesProcessorOptions {
@@ -35,20 +38,25 @@ struct RatesProcessorOptions {
   // (EuRoC's cam0 T_BS), its rates are reported in the body (IMU) frame like the gyro and the
   // InertialNet head, ω_B = R_BS·ω_C.
   std::optional<Mat3> camera_to_body;
-  bool keep_flow = false;  // download the dense flow into PairResult::flow (--save-flow)
-  // DIS only: also compute the backward flow and leave out (mark unknown) each vector whose
+  // Download the flow into PairResult::flow (--save-flow); with LK it is known at the tracked grid
+  // points only (after the forward-backward check), unknown elsewhere.
+  bool keep_flow = false;
+  // DIS and LK: also compute the backward flow and leave out (mark unknown) each vector whose
   // round trip misses by more than this many pixels at 752 columns (scaled with the width);
   // 0: no check (include/inertialnet/models/flow_consistency.hpp). 0.5 px was better than no
   // check in every synthetic condition measured (it leaves out 2–4 % of the vectors) and takes
   // the close-range rolling-shutter case at 752×480 from 0.67 1.20 0.92 to 0.41 0.29 0.29
   // deg/s, for a second DIS pass; tighter was better still on synthetic frames but leaves out
-  // up to a fifth of the field (docs/real_cameras.md, "Forward-backward flow check").
+  // up to a fifth of the field (docs/real_cameras.md, "Forward-backward flow check"). LK tracks
+  // each of its points back (include/inertialnet/models/lk_flow.hpp) with the same setting; with
+  // LK the geometric head's sample stride is lk_grid_stride(width), not geometric.stride.
   double flow_check_px = 0.5;
-  // A geometric rate whose largest per-axis σ (EstimatorRates::sigma, the calibrated standard
-  // deviation) exceeds this many rad/s is not reported: the pair gets PairStatus::Uncertain
-  // (predict --max-sigma, in deg/s; docs/real_cameras.md, "Confidence per pair"). 0: no limit.
+  // A geometric rate whose σ along its least certain direction (the calibrated covariance's
+  // largest eigenvalue; at least every per-axis EstimatorRates::sigma, and the same in any frame)
+  // exceeds this many rad/s is not reported: the pair gets PairStatus::Uncertain (predict
+  // --max-sigma, in deg/s; docs/real_cameras.md, "Confidence per pair"). 0: no limit.
   double max_sigma_rad_s = kDefaultMaxSigmaRadS;
-  static constexpr double kDefaultMaxSigmaRadS = 0.0872664625997;  // 5 deg/s
+  static constexpr double kDefaultMaxSigmaRadS = 0.174532925199;  // 10 deg/s
   // Issue 23 (predict --fuse): with both heads, the InertialNet head gets its own σ
   // (head_uncertainty.hpp) and a third estimator "fused" follows the two (rate_fusion.hpp). Both
   // heads must answer in the same frame: the geometric one needs camera_to_body.
@@ -59,7 +67,8 @@ struct RatesProcessorOptions {
 // Each lane gets its own queue and model instances. `weights` holds one set per device, loaded
 // beforehand (needed by FlowNet and the InertialNet head; may be empty otherwise); they must
 // outlive the pipeline. Throws invalid_input for contradictory options (no head, a geometric
-// head without a camera, FlowNet without weights, fusion without both heads and camera_to_body).
+// head without a camera, FlowNet without weights, LK flow for the InertialNet head, fusion without both
+// heads and camera_to_body).
 ProcessorFactory rates_processor(const std::map<const Device*, const WeightSet*>& weights,
                                  const RatesProcessorOptions& options);
 

@@ -39,6 +39,11 @@ struct SynthOptions {
   // Motion blur: each row averages 5 renders spread evenly over an exposure this long, centred on
   // the row's time. 0: instantaneous. At most 0.05 s.
   double exposure_time_s = 0;
+  // A camera–IMU calibration this far off (a rotation vector θ in degrees, body/IMU frame): the
+  // images are rendered with EuRoC cam0's true T_BS, but cam0/sensor.yaml states R_BS' =
+  // Exp(−θ)·R_BS, so predictions rotated into the body frame with the file miss the gyro by
+  // Exp(−θ) and the correction `calibrate` should find is θ itself (issue 22). |θ| ≤ 30°.
+  std::array<double, 3> extrinsic_error_deg{0, 0, 0};
   // With noise: the gyro bias also drifts as a random walk with EuRoC's gyroscope_random_walk
   // (1.9393e-5 rad/s²/√Hz), written to the ground truth's bias columns as it goes.
   bool bias_random_walk = false;

@@ -137,3 +137,30 @@ def test_usage_errors_and_help(tmp_path):
     junk.write_bytes(b"not a checkpoint")
     r = _cli(junk, tmp_path / "x.safetensors")
     assert r.returncode == 2 and "junk.pth.tar" in r.stderr
+
+
+def test_ptlflow_lightning_checkpoint_runs_the_same_network(tmp_path):
+    """A Lightning checkpoint as ptlflow publishes them (torch's zip format, the state dict beside
+    Lightning's keys), converted without torch, loads strictly into the reference network and
+    gives the original network's flow bit for bit."""
+    model = fn.build("FlowNet2-CS")
+    sy.fill_synthetic(model, 11)
+    src = tmp_path / "flownetcs-things-mine.ckpt"
+    torch.save({"epoch": 0, "global_step": 0, "pytorch-lightning_version": "1.3.8",
+                "state_dict": model.state_dict(), "hyper_parameters": {"div_flow": 20.0, "input_channels": 12}},
+               src)
+    out = tmp_path / "cs.safetensors"
+    r = _cli(src, out, "--check")
+    assert r.returncode == 0, r.stderr
+    tensors, meta = _read(out)
+    assert meta["inertialnet.checkpoint.layout"] == "ptlflow-lightning"
+    assert meta["inertialnet.checkpoint.format"] == "torch-zip"
+    converted = fn.build("FlowNet2-CS")
+    converted.load_state_dict(tensors, strict=True)
+    g = torch.Generator().manual_seed(0)
+    frame1 = torch.rand(1, 3, 64, 128, generator=g) * 255
+    frame2 = torch.roll(frame1, shifts=(2, 3), dims=(2, 3))
+    with torch.no_grad():
+        want = model(frame1, frame2)["flow"]
+        got = converted(frame1, frame2)["flow"]
+    assert torch.equal(got, want)

@@ -1,0 +1,51 @@
+# SPDX-License-Identifier: Apache-2.0
+# `predict --flow lk` (sparse pyramidal Lucas-Kanade at the geometric head's sample points) end to
+# end: on the same synthetic sequences, its rates meet the bounds the weight-free DIS path is held
+# to (tests/pipeline/test_weight_free.cpp: pure rotation within 1 deg/s, general motion within 3
+# deg/s per axis; a sign flip, swapped axes or a unit slip miss them by tens of deg/s), DIS's
+# rates here too; the saved flow is known at the grid points only; and the uses it cannot serve
+# (the InertialNet head, training) are bad input.
+#   cmake -DCLI=<inertialnet> -DWORK=<scratch dir> -P lk_flow.cmake
+include(${CMAKE_CURRENT_LIST_DIR}/run_helpers.cmake)
+file(REMOVE_RECURSE "${WORK}")
+file(MAKE_DIRECTORY "${WORK}")
+
+# expect_rmse_within(<rates csv> <sequence> <bound deg/s> <what>): every axis of eval's RMSE
+# against gyro - bias at most the bound.
+function(expect_rmse_within csv sequence bound what)
+  run_json(document ${CLI} eval ${csv} ${sequence} --json)
+  foreach(axis x y z)
+    expect_json("${document}" estimators 0 bias_corrected rmse_deg_s ${axis})
+    if(NOT value LESS_EQUAL ${bound})
+      message(FATAL_ERROR "${what}: RMSE ${axis} ${value} deg/s, above ${bound}")
+    endif()
+    message(STATUS "${what}: RMSE ${axis} ${value} deg/s")
+  endforeach()
+endfunction()
+
+run(0 ${CLI} synth rotation --frames 12 --size 376x240 --motion rotation --seed 21 --no-noise)
+run(0 ${CLI} synth general --frames 12 --size 376x240 --motion general --seed 22 --no-noise)
+foreach(flow dis lk)
+  run(0 ${CLI} predict rotation --flow ${flow} -o rotation_${flow}.csv)
+  expect_rmse_within(rotation_${flow}.csv rotation 1.0 "--flow ${flow}, pure rotation")
+  run(0 ${CLI} predict general --flow ${flow} -o general_${flow}.csv)
+  expect_rmse_within(general_${flow}.csv general 3.0 "--flow ${flow}, general motion")
+endforeach()
+run(0 ${CLI} predict rotation --flow lk --max-pairs 1 -o one.csv)
+expect_match("no weights given: weight-free Lucas-Kanade optical flow \\+ geometric head")
+expect_match("Lucas-Kanade flow \\+ geometric head")
+
+# The saved flow: one file per pair, unknown (Middlebury's 1e10) away from the tracked points.
+run(0 ${CLI} predict rotation --flow lk --max-pairs 2 --save-flow flows -o saved.csv)
+file(GLOB flows "${WORK}/flows/*.flo")
+list(LENGTH flows flow_count)
+if(NOT flow_count EQUAL 2)
+  message(FATAL_ERROR "--flow lk --save-flow wrote ${flow_count} files, expected 2")
+endif()
+
+# Bad input: exit 2 and why.
+run(0 ${CLI} weights --synthetic InertialNetHead --size 376x240 -o head.safetensors)
+run(2 ${CLI} predict rotation --flow lk --head both -w head.safetensors -o both.csv)
+expect_match("inertialnet: error: --flow lk tracks the geometric head's sample points only")
+run(2 ${CLI} train --train rotation --val general --head-size 376x240 --flow lk --epochs 1 -o trained.safetensors)
+expect_match("--flow lk gives flow at the geometric head's sample points only")
