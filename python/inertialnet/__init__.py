@@ -204,6 +204,7 @@ def predict(
     progress: Optional[Callable[[int, int], object]] = None,
     max_sigma: float = 10.0,
     smooth: str = "lag:2",
+    fuse: bool = False,
 ):
     """Angular rates of every frame pair of a sequence, as ``inertialnet predict`` computes them.
 
@@ -228,8 +229,9 @@ def predict(
     geometric head, pixels at 752 columns; 0: off). ``max_sigma`` is ``--max-sigma`` (deg/s: a geometric rate whose standard deviation
     along its least certain direction exceeds it gets the status ``"uncertain"``; 0: no limit) and
     ``smooth`` is ``--smooth`` (``"lag:2"``, the default: a fixed-lag smoother over the pairs using
-    their σ; ``"off"``: the two-frame rates); ``rates.sigma`` holds each rate's σ. With
-    ``keep_flow=True`` returns ``(rates, flows)``, flows a
+    their σ; ``"off"``: the two-frame rates); ``rates.sigma`` holds each rate's σ. ``fuse`` is
+    ``--fuse`` (with ``head="both"``: a third estimator, ``rates.head("fused")``, the two heads'
+    rates weighted by their σ). With ``keep_flow=True`` returns ``(rates, flows)``, flows a
     list of ``(H, W, 2)`` arrays (as computed, without the check's marks).
 
     ``rate_hz``, ``fx`` and ``fy`` are 0 or None (not given) or what the CLI accepts for ``--rate``,
@@ -252,7 +254,7 @@ def predict(
         keep_flow, max_pairs, int(lanes), int(decode_threads), float(flow_check), progress,
         None if time_offset is None else float(time_offset), float(readout_time), camera,
         "" if calibration is None else os.fspath(calibration), calibration_camera, image_topic, camera_info_topic,
-        float(max_sigma), str(smooth))
+        float(max_sigma), str(smooth), bool(fuse))
     rates = _rates_of_predict(columns, t_ns, values, statuses, metadata, sigmas)
     return (rates, flows) if keep_flow else rates
 

@@ -75,7 +75,7 @@ def _predict_one(sequence: str, rates: str, weights: List[str], options: Dict[st
         rates, True, sequence, weights, o["model"], o["flow"], o["head"], o["solver"], o["fx"], o["fy"], o["cx"],
         o["cy"], o["rate_hz"], o["device"], False, o["max_pairs"], o["lanes"], o["decode_threads"], o["flow_check"],
         progress, o["time_offset"], o["readout_time"], o["camera"], o["calibration"], o["calibration_camera"],
-        o["image_topic"], o["camera_info_topic"], o["max_sigma"], o["smooth"]))
+        o["image_topic"], o["camera_info_topic"], o["max_sigma"], o["smooth"], o["fuse"]))
     result.update(sequence=sequence, rates=rates, name=name)
     return result
 
@@ -120,6 +120,7 @@ def predict(
     flow_check: float = 0.5,
     max_sigma: float = 10.0,
     smooth: str = "lag:2",
+    fuse: bool = False,
 ) -> List[Dict[str, object]]:
     """Rates of every sequence into ``out_dir/<name>.csv``, as ``inertialnet predict SEQ... -o
     OUT_DIR`` writes them; returns one dict per sequence, in order: ``name``, ``sequence``,
@@ -159,7 +160,7 @@ def predict(
         time_offset=None if time_offset is None else float(time_offset), readout_time=float(readout_time),
         camera=camera, calibration="" if calibration is None else os.fspath(calibration),
         calibration_camera=calibration_camera, image_topic=image_topic or "", camera_info_topic=camera_info_topic,
-        max_sigma=float(max_sigma), smooth=str(smooth))
+        max_sigma=float(max_sigma), smooth=str(smooth), fuse=bool(fuse))
     weight_files = [os.fspath(w) for w in weights]
     results: List[Dict[str, object]] = []
     if cluster is None:

@@ -37,12 +37,14 @@ def stream(
     flow_check: float = 0.5,
     max_sigma: float = 10.0,
     smooth: str = "lag:2",
+    fuse: bool = False,
 ) -> Iterator[Tuple[int, np.ndarray, Union[str, Tuple[str, ...]]]]:
     """Yields ``(timestamp_ns, rates, status)`` for each frame pair as soon as it is computed,
     in pair order: ``timestamp_ns`` the pair's second frame (int), ``rates`` float64 ``(3,)`` in
     rad/s (NaN when the pair has no answer), ``status`` ``"ok"`` or why not (e.g.
     ``"no_texture"``); with ``head="both"`` a ``(2, 3)`` array and a tuple of two statuses, the
-    InertialNet head's first. The numbers are ``predict()``'s, row for row.
+    InertialNet head's first; with ``fuse=True`` as well, ``(3, 3)`` and three statuses, the fused
+    estimate last. The numbers are ``predict()``'s, row for row.
 
     ``sequence`` is anything ``predict`` takes, or a live source: ``"/dev/video0"``,
     ``"camera:0"``, ``"gst:videotestsrc ! videoconvert ! appsink"`` (a GStreamer pipeline ending in
@@ -64,4 +66,4 @@ def stream(
         os.fspath(sequence), [os.fspath(w) for w in weights], model or "", flow or "", head or "", solver,
         number(fx), number(fy), number(cx), number(cy), "" if calibration is None else os.fspath(calibration),
         calibration_camera, camera, float(rate_hz), "" if device is None else str(device), int(max_pairs),
-        int(lanes), float(flow_check), float(max_sigma), str(smooth))
+        int(lanes), float(flow_check), float(max_sigma), str(smooth), bool(fuse))

@@ -1051,7 +1051,7 @@ PredictSettings python_predict_settings(const std::filesystem::path& sequence, c
                                         bool keep_flow, const py::object& max_pairs, int lanes, int decode_threads, double flow_check,
                                         const py::object& progress, const py::object& time_offset, double readout_time, const std::string& camera,
                                         const std::string& calibration, const std::string& calibration_camera, const std::string& image_topic,
-                                        const std::string& camera_info_topic, double max_sigma, const std::string& smooth) {
+                                        const std::string& camera_info_topic, double max_sigma, const std::string& smooth, bool fuse) {
   // The CLI's checks of --max-pairs, --rate, --fx, --fy: a value they refuse is a ValueError
   // here, not ignored (a negative rate or focal length was taken as "not given").
   const std::int64_t pairs = integer_of(max_pairs, "max_pairs");
@@ -1108,6 +1108,7 @@ PredictSettings python_predict_settings(const std::filesystem::path& sequence, c
   s.flow_check_px = flow_check;
   s.max_sigma_deg_s = max_sigma;  // predict --max-sigma, --smooth (issue 22)
   s.smooth = smooth;
+  s.fuse = fuse;  // predict --fuse (issue 23)
   if (lanes < 1 || decode_threads < 1) throw invalid_input("lanes and decode_threads must be at least 1");
   return s;
 }
@@ -1311,8 +1312,8 @@ PYBIND11_MODULE(_inertialnet, m) {
            bool keep_flow, const py::object& max_pairs, int lanes, int decode_threads, double flow_check,
            const py::object& progress, const py::object& time_offset, double readout_time, const std::string& camera,
            const std::string& calibration, const std::string& calibration_camera, const std::string& image_topic,
-           const std::string& camera_info_topic, double max_sigma, const std::string& smooth) {
-          const PredictSettings s = python_predict_settings(sequence, weights, model, flow, head, solver, fx, fy, cx, cy, rate_hz, device, keep_flow, max_pairs, lanes, decode_threads, flow_check, progress, time_offset, readout_time, camera, calibration, calibration_camera, image_topic, camera_info_topic, max_sigma, smooth);
+           const std::string& camera_info_topic, double max_sigma, const std::string& smooth, bool fuse) {
+          const PredictSettings s = python_predict_settings(sequence, weights, model, flow, head, solver, fx, fy, cx, cy, rate_hz, device, keep_flow, max_pairs, lanes, decode_threads, flow_check, progress, time_offset, readout_time, camera, calibration, calibration_camera, image_topic, camera_info_topic, max_sigma, smooth, fuse);
           return predict(s, static_cast<std::size_t>(integer_of(max_pairs, "max_pairs")), lanes, decode_threads, progress);
         });
   m.def("_evaluate_json", &evaluate_json);
@@ -1324,8 +1325,8 @@ PYBIND11_MODULE(_inertialnet, m) {
            bool keep_flow, const py::object& max_pairs, int lanes, int decode_threads, double flow_check,
            const py::object& progress, const py::object& time_offset, double readout_time, const std::string& camera,
            const std::string& calibration, const std::string& calibration_camera, const std::string& image_topic,
-           const std::string& camera_info_topic, double max_sigma, const std::string& smooth) {
-          const PredictSettings s = python_predict_settings(sequence, weights, model, flow, head, solver, fx, fy, cx, cy, rate_hz, device, keep_flow, max_pairs, lanes, decode_threads, flow_check, progress, time_offset, readout_time, camera, calibration, calibration_camera, image_topic, camera_info_topic, max_sigma, smooth);
+           const std::string& camera_info_topic, double max_sigma, const std::string& smooth, bool fuse) {
+          const PredictSettings s = python_predict_settings(sequence, weights, model, flow, head, solver, fx, fy, cx, cy, rate_hz, device, keep_flow, max_pairs, lanes, decode_threads, flow_check, progress, time_offset, readout_time, camera, calibration, calibration_camera, image_topic, camera_info_topic, max_sigma, smooth, fuse);
           return predict_rates_file_of(rates, skip_current, s, static_cast<std::size_t>(integer_of(max_pairs, "max_pairs")),
                                        lanes, decode_threads, progress);
         });

@@ -144,7 +144,7 @@ void register_stream(py::module_& m) {
                        std::optional<double> fx, std::optional<double> fy, std::optional<double> cx,
                        std::optional<double> cy, const std::string& calibration, const std::string& calibration_camera,
                        const std::string& camera, double rate_hz, const std::string& device, std::int64_t max_pairs,
-                       int lanes, double flow_check, double max_sigma, const std::string& smooth) {
+                       int lanes, double flow_check, double max_sigma, const std::string& smooth, bool fuse) {
         if (max_pairs < 0) {
           throw invalid_input("max_pairs must be a count of pairs (0 for all), got " + std::to_string(max_pairs));
         }
@@ -168,6 +168,7 @@ void register_stream(py::module_& m) {
         s.flow_check_px = flow_check;
         s.max_sigma_deg_s = max_sigma;  // predict --max-sigma, --smooth (issue 22)
         s.smooth = smooth;
+        s.fuse = fuse;  // predict --fuse (issue 23)
         return std::make_unique<Stream>(s, static_cast<std::size_t>(max_pairs), lanes);
       }))
       .def("__iter__", [](py::object self) { return self; })

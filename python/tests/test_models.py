@@ -114,3 +114,25 @@ def test_a_head_of_normalized_input_needs_camera_and_interval(cli, tmp_path):
         normalized.rates(flow)
     with pytest.raises(ValueError, match="trained on normalized input"):
         normalized.rates(flow, camera=camera)
+
+
+def test_fused_estimator_matches_the_cli(cli, sequence, tmp_path):
+    # predict(fuse=True) is predict --fuse (issue 23): a third estimator "fused" whose σ is at most
+    # the smaller of the two heads' wherever both answer; the stream yields it last.
+    head_weights = tmp_path / "head.safetensors"
+    cli("weights", "--synthetic", "InertialNetHead", "--size", "128x96", "-o", head_weights)
+    cli("predict", sequence, "-w", head_weights, "--flow", "dis", "--head", "both", "--fuse", "--smooth", "off",
+        "-o", tmp_path / "rates.csv")
+    header, expected = read_rates_csv(tmp_path / "rates.csv")
+    rates = inertialnet.predict(sequence, head_weights, flow="dis", head="both", fuse=True, smooth="off")
+    assert rates.columns == header and rates.heads == ["", "geometric", "fused"]
+    for i, name in enumerate(header[1:], start=1):
+        assert [csv_text(v) for v in rates[name]] == [csv_text(v) for v in expected[:, i]]
+    fused = rates.head("fused")
+    assert (fused.estimator, fused.frame) == ("inter_frame", "body")
+    both = (rates.status == "ok") & (rates.head("geometric").status == "ok")
+    assert both.any()
+    assert np.all(fused.sigma[both] <= np.minimum(rates.sigma[both], rates.head("geometric").sigma[both]))
+    stream = list(inertialnet.stream(sequence, head_weights, flow="dis", head="both", fuse=True, smooth="off"))
+    assert stream[0][1].shape == (3, 3) and len(stream[0][2]) == 3
+    np.testing.assert_array_equal(np.stack([s[1][2] for s in stream]), fused.w)

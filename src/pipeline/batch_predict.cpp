@@ -165,6 +165,7 @@ Provenance prediction_provenance(const PredictSettings& s, std::size_t max_pairs
   p.emplace_back("flow_check_px", number(s.flow_check_px));
   p.emplace_back("max_sigma_deg_s", number(s.max_sigma_deg_s));
   p.emplace_back("smooth", s.smooth);
+  p.emplace_back("fuse", s.fuse ? "yes" : "no");
   p.emplace_back("time_offset_s", optional_number(s.time_offset_s));
   p.emplace_back("max_pairs", std::to_string(max_pairs));
   return p;

@@ -252,6 +252,7 @@ Prediction::Prediction(const PredictSettings& s) : settings_(s) {
     processor_.camera_to_body = choice.camera_to_body;
   }
   processor_.keep_flow = s.keep_flow;
+  processor_.fuse = s.fuse;  // rates_processor() refuses it without both heads and the camera-to-body rotation
 
   // Devices and their weights (one set per device).
   infos_ = select_devices(device_spec_or_environment(s.device), discover_devices());
@@ -291,10 +292,12 @@ std::vector<std::string> Prediction::columns() const {
   if (processor_.inertialnet_head && processor_.geometric_head) {
     columns.insert(columns.end(), {"wx_geometric", "wy_geometric", "wz_geometric"});
   }
+  if (processor_.fuse) columns.insert(columns.end(), {"wx_fused", "wy_fused", "wz_fused"});
   return columns;
 }
 
 RatesLayout Prediction::layout() const {
+  if (processor_.fuse) return rates_layout({"", "_geometric", "_fused"});
   return processor_.inertialnet_head && processor_.geometric_head ? rates_layout({"", "_geometric"}) : rates_layout({""});
 }
 
@@ -312,6 +315,12 @@ std::vector<std::pair<std::string, std::string>> Prediction::csv_metadata() cons
     if (processor_.geometric_head) {
       metadata.push_back({"frame_geometric", geometric_frame});
       metadata.push_back({"estimator_geometric", "inter_frame"});
+    }
+    // Both heads in the body frame; the geometric head, which measures the interval's mean rate,
+    // carries the fused estimate wherever it is sure, so eval compares with the interval mean.
+    if (processor_.fuse) {
+      metadata.push_back({"frame_fused", "body"});
+      metadata.push_back({"estimator_fused", "inter_frame"});
     }
   } else {
     metadata = {{"frame", geometric_frame}, {"estimator", "inter_frame"}};

@@ -16,6 +16,7 @@
 #include "inertialnet/models/inertialnet_head.hpp"
 #include "inertialnet/models/lk_flow.hpp"
 #include "inertialnet/models/texture.hpp"
+#include "inertialnet/pipeline/rate_fusion.hpp"
 #include "inertialnet/pipeline/rates_processor.hpp"
 #include "inertialnet/runtime/queue.hpp"
 
@@ -57,7 +58,7 @@ std::array<double, 3> axis_sigma(const std::optional<Mat3>& r, const RotationEst
 class RatesProcessor : public PairProcessor {
  public:
   RatesProcessor(Device& device, const WeightSet* weights, const RatesProcessorOptions& options)
-      : options_(options), queue_(device.create_queue()) {
+      : options_(options), weights_(weights), queue_(device.create_queue()) {
     if (options.flow == FlowMethod::FlowNet) flownet_ = std::make_unique<FlowNet>(device, options.flow_model, *weights);
     if (options.flow == FlowMethod::DIS) dis_ = std::make_unique<DisFlow>();
     if (options.inertialnet_head) head_ = std::make_unique<InertialNetHead>(device, *weights);
@@ -76,6 +77,7 @@ class RatesProcessor : public PairProcessor {
                const std::atomic<bool>& stop) override {
     if (head_) result.rates.push_back({"inertialnet", unknown(), PairStatus::Ok, {}});
     if (geometric_) result.rates.push_back({"geometric", unknown(), PairStatus::Ok, {}});
+    if (options_.fuse) result.rates.push_back({kFusedEstimator, unknown(), PairStatus::Ok, {}});
     // Frames that cannot be measured answer the pair for every estimator, before any flow.
     if (!previous.error.empty() || !current.error.empty()) {
       const Frame& bad = previous.error.empty() ? current : previous;
@@ -158,6 +160,7 @@ class RatesProcessor : public PairProcessor {
       const auto omega = head_->compute(q, input, &stop).to_host(q);
       if (std::isfinite(omega[0]) && std::isfinite(omega[1]) && std::isfinite(omega[2])) {
         answer.w = {omega[0], omega[1], omega[2]};
+        if (options_.fuse) answer.sigma = head_sigma(q);
       } else {
         answer.status = PairStatus::NonFinite;
         answer.reason = "the InertialNet head's output is not finite (NaN or infinity)";
@@ -209,6 +212,7 @@ class RatesProcessor : public PairProcessor {
       }
       t = lap(result, "geometric_head", t);
     }
+    if (options_.fuse) result.rates[next] = fuse_rates(result.rates[0], result.rates[1]);
     if (options_.keep_flow) {
       result.flow = FlowField::from_planar(width, height, flow.to_host(q));
       lap(result, "download", t);
@@ -221,6 +225,12 @@ class RatesProcessor : public PairProcessor {
   static std::array<double, 3> unknown() {
     const double nan = std::numeric_limits<double>::quiet_NaN();
     return {nan, nan, nan};
+  }
+
+  // The InertialNet head's σ for the flow it has just seen (its features), rad/s.
+  std::array<double, 3> head_sigma(Queue& q) {
+    if (!uncertainty_) uncertainty_ = std::make_unique<HeadUncertainty>(q, *weights_, head_->config(), options_.head_sigma);
+    return uncertainty_->sigma(head_->features().to_host(q));
   }
 
   static std::string frame_name(const Frame& f) {
@@ -274,12 +284,14 @@ class RatesProcessor : public PairProcessor {
   }
 
   RatesProcessorOptions options_;
+  const WeightSet* weights_;
   std::unique_ptr<Queue> queue_;
   std::unique_ptr<FlowNet> flownet_;
   std::unique_ptr<DisFlow> dis_;
   std::unique_ptr<LkFlow> lk_;
   std::unique_ptr<InertialNetHead> head_;
   std::unique_ptr<GeometricHead> geometric_;
+  std::unique_ptr<HeadUncertainty> uncertainty_;  // with options_.fuse, made on the first pair
 };
 
 }  // namespace
@@ -316,6 +328,15 @@ ProcessorFactory rates_processor(const std::map<const Device*, const WeightSet*>
     throw invalid_input("--flow lk tracks the geometric head's sample points only; the InertialNet head needs a dense "
                         "flow field: use --flow flownet2 or dis with it");
   }
+  if (options.fuse && !(options.inertialnet_head && options.geometric_head)) {
+    throw invalid_input("--fuse combines the InertialNet and the geometric head: it needs --head both");
+  }
+  if (options.fuse && !options.camera_to_body) {
+    throw invalid_input("--fuse needs both heads' rates in the body frame, so the camera-to-body rotation (a EuRoC "
+                        "sequence's cam0 T_BS or --calibration): without it the geometric head answers in the camera "
+                        "frame and the InertialNet head in the body frame");
+  }
+  if (options.fuse) options.head_sigma.validate();
   const bool needs_weights = options.flow == FlowMethod::FlowNet || options.inertialnet_head;
   return [weights, options, needs_weights](Device& device, int) -> std::unique_ptr<PairProcessor> {
     const auto found = weights.find(&device);

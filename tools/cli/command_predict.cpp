@@ -77,6 +77,7 @@ struct PredictOptions {
   double flow_check_px = 0.5;  // PredictSettings' default
   double max_sigma_deg_s = 10.0;  // PredictSettings' default (issue 22)
   std::string smooth = "lag:2";   // PredictSettings' default (issue 22)
+  bool fuse = false;              // issue 23
   int lanes = 0;  // 0: default_lanes_per_device()
   int decode_threads = 2;
   std::size_t max_pairs = 0;
@@ -172,6 +173,7 @@ PredictSettings settings_of(const PredictOptions& options, const GlobalOptions& 
   settings.flow_check_px = o->flow_check_px;
   settings.max_sigma_deg_s = o->max_sigma_deg_s;
   settings.smooth = o->smooth;
+  settings.fuse = o->fuse;
   if (!o->readout_time.empty()) settings.readout_time_s = parse_seconds(o->readout_time, "--readout-time");
   if (!o->time_offset.empty()) settings.time_offset_s = parse_seconds(o->time_offset, "--time-offset");
   settings.device = global.device;
@@ -485,6 +487,11 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
                  "off (two-frame rates), or lag:L: a fixed-lag smoother over the pairs' rates weighted by their sigma, "
                  "each pair L frame intervals late (lag:L,q:Q sets its jerk density)")
       ->capture_default_str();
+  // Issue 23: the two heads combined by their confidence.
+  app.add_flag("--fuse", o->fuse,
+               "with --head both: a third estimator (wx_fused, ...) weighting each head's rates by its sigma (the "
+               "InertialNet head's from Monte-Carlo dropout over its fully connected layers); needs the camera-to-body "
+               "rotation");
   app.add_option("--lanes", o->lanes, "frame pairs in flight per device (default: 1 on CPU devices, 2 on others)")
       ->check(CLI::Range(1, 16));
   app.add_option("--decode-threads", o->decode_threads, "image decoding threads")->capture_default_str()->check(CLI::Range(1, 64));

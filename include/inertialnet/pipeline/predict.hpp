@@ -56,6 +56,10 @@ struct PredictSettings {
   // lag 2 by default, the best of the synthetic conditions (docs/real_cameras.md, "More than two frames").
   double max_sigma_deg_s = 10.0;
   std::string smooth = "lag:2";
+  // Issue 23: with head "both", a third estimator "fused" (columns wx_fused, …): the two heads'
+  // rates weighted by their σ, the InertialNet head's σ from Monte-Carlo dropout
+  // (RatesProcessorOptions::fuse; rate_fusion.hpp, head_uncertainty.hpp).
+  bool fuse = false;
   // Camera-IMU time offset (t_imu = t_cam + offset) stated in the CSV for eval; not applied here.
   std::optional<double> time_offset_s;
   std::string device;                // a --device spec; "": $INERTIALNET_DEVICE, else the default

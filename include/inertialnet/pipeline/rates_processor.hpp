@@ -15,6 +15,7 @@
 #include "inertialnet/io/camera.hpp"
 #include "inertialnet/models/geometric_head.hpp"
 #include "inertialnet/models/head_input.hpp"
+#include "inertialnet/models/head_uncertainty.hpp"
 #include "inertialnet/models/parameters.hpp"
 #include "inertialnet/models/weights.hpp"
 #include "inertialnet/pipeline/pipeline.hpp"
@@ -62,12 +63,18 @@ struct RatesProcessorOptions {
   // --max-sigma, in deg/s; docs/real_cameras.md, "Confidence per pair"). 0: no limit.
   double max_sigma_rad_s = kDefaultMaxSigmaRadS;
   static constexpr double kDefaultMaxSigmaRadS = 0.174532925199;  // 10 deg/s
+  // Issue 23 (predict --fuse): with both heads, the InertialNet head gets its own σ
+  // (head_uncertainty.hpp) and a third estimator "fused" follows the two (rate_fusion.hpp). Both
+  // heads must answer in the same frame: the geometric one needs camera_to_body.
+  bool fuse = false;
+  HeadSigmaOptions head_sigma;
 };
 
 // Each lane gets its own queue and model instances. `weights` holds one set per device, loaded
 // beforehand (needed by FlowNet and the InertialNet head; may be empty otherwise); they must
 // outlive the pipeline. Throws invalid_input for contradictory options (no head, a geometric
-// head without a camera, FlowNet without weights, LK flow for the InertialNet head).
+// head without a camera, FlowNet without weights, LK flow for the InertialNet head, fusion without both
+// heads and camera_to_body).
 ProcessorFactory rates_processor(const std::map<const Device*, const WeightSet*>& weights,
                                  const RatesProcessorOptions& options);
 
