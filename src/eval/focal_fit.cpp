@@ -62,9 +62,13 @@ bool FocalFit::control_failed() const {
   return std::isfinite(z_std_error) && off > kFocalControlTolerance && off > 3 * z_std_error;
 }
 
+bool FocalFit::recheck_failed() const {
+  return rechecked_scale && !(std::abs(std::log(*rechecked_scale)) <= 0.5 * std::abs(std::log(scale)));
+}
+
 std::string FocalFit::confidence() const {
   if (!determined) return "none";
-  if (control_failed() || !(std_error <= kLowFocalStdError)) return "low";
+  if (control_failed() || recheck_failed() || !unchecked_reason.empty() || !(std_error <= kLowFocalStdError)) return "low";
   return std_error < kHighFocalStdError ? "high" : "medium";
 }
 
@@ -78,6 +82,15 @@ std::string FocalFit::confidence_reason() const {
                   z_scale, z_std_error);
     return buf;
   }
+  if (recheck_failed()) {
+    std::snprintf(buf, sizeof buf,
+                  "predicted again with fx, fy x%.3f the x/y rates' scale came out x%.3f, not 1: this solver's rates do "
+                  "not follow the focal length as 1/f here (a wide field of view, or the general model's translation "
+                  "takes part), so the focal length is not determinable from them",
+                  scale, *rechecked_scale);
+    return buf;
+  }
+  if (!unchecked_reason.empty()) return unchecked_reason;
   if (!(std_error <= kLowFocalStdError)) {
     std::snprintf(buf, sizeof buf, "its 1 sigma %.3f is above %.2g: too little pan and tilt, or too noisy rates",
                   std_error, kLowFocalStdError);
@@ -98,7 +111,8 @@ std::string FocalFit::summary() const {
                 "with the scale)",
                 scale, std_error, confidence().c_str(), excitation_deg_s, z_scale, z_std_error, rmse_deg_s,
                 rmse_after_deg_s);
-  return buf;
+  const std::string why = confidence_reason();
+  return why.empty() ? std::string(buf) : std::string(buf) + "; low: " + why;
 }
 
 FocalFit fit_focal_scale(const std::vector<Vec3>& predicted, const std::vector<Vec3>& gyro) {

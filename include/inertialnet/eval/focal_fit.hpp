@@ -32,6 +32,7 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -50,9 +51,20 @@ struct FocalFit {
   std::size_t pairs = 0;
   double rmse_deg_s = 0;        // x and y residual (centred, per axis) with c = 1
   double rmse_after_deg_s = 0;  // and with the fitted c
+  // The scale fitted again on rates predicted with fx, fy × scale (calibrate does this when it
+  // predicts the rates itself). The model says 1; on the synthetic 188×120 frames (a 79° field of
+  // view) the default general-model solver's rates follow the focal length weakly and the other
+  // way (fx × 1.3 gave x/y rates × 1.08, the rotation-only solver × 0.84), so a scale is only
+  // trusted when predicting with it moves the rates at least half-way (in log) to the gyro's.
+  std::optional<double> rechecked_scale;
+  // Why no recheck could be made when one was needed (the scale more than 2σ from 1 and the rates
+  // from a file): the scale is then rated low, with this as the reason.
+  std::string unchecked_reason;
+  // Whether the recheck contradicts the model (see above).
+  bool recheck_failed() const;
   // Whether the z control disagrees: |z_scale − 1| above kFocalControlTolerance and 3 of its σ.
   bool control_failed() const;
-  // "none" (not determined); "low" (σ above kLowFocalStdError, or the control failed); "high"
+  // "none" (not determined); "low" (σ above kLowFocalStdError, the control or the recheck failed, or no recheck); "high"
   // (σ below kHighFocalStdError, so that 2σ stays within the 3 % a calibration check asks for);
   // else "medium".
   std::string confidence() const;
