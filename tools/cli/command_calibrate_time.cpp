@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include "calibrate_time_report.hpp"
 #include "commands.hpp"
@@ -129,23 +130,28 @@ Command register_calibration(CLI::App& app, const GlobalOptions& global, bool re
     const RatesTable rates = o->rates.empty() ? predict_weight_free(*o, seq, global, solved) : read_rates_csv(o->rates);
     CalibrationReport calibration;
     if (o->readout && o->no_readout) calibration.readout_skipped = "--no-readout";
-    // A rates file: the camera of the sequence's sensor.yaml and the default solver.
-    if (!o->rates.empty() && seq.camera) solved.camera = CameraIntrinsics::from_calibration(*seq.camera);
-    Mat3 camera_to_imu{};
+    // calibrate only (calibrate-time reads no more of the camera than before). A rates file: the
+    // camera of the sequence's sensor.yaml and the default solver.
+    if (o->readout && !o->rates.empty() && seq.camera) solved.camera = CameraIntrinsics::from_calibration(*seq.camera);
+    std::optional<Mat3> camera_to_imu;
     if (solved.camera_to_body) {
       camera_to_imu = *solved.camera_to_body;
-    } else {
+    } else if (o->readout) {
       // Rates in the camera frame, or from a file: eval rotates them into the IMU frame with this.
-      const Mat3 r = imu_to_camera_rotation(seq);
-      camera_to_imu = {r[0], r[3], r[6], r[1], r[4], r[7], r[2], r[5], r[8]};
+      // Without a camera calibration or extrinsic eval says what is missing; the fits need not.
+      try {
+        const Mat3 r = imu_to_camera_rotation(seq);
+        camera_to_imu = Mat3{r[0], r[3], r[6], r[1], r[4], r[7], r[2], r[5], r[8]};
+      } catch (const Error&) {
+      }
     }
     // The focal-length scale needs no device and no intrinsics (the scale is relative to whatever
     // the rates were predicted with); the intrinsics only turn it into fx, fy to give predict.
-    if (o->readout) options.time_offset_search.focal_camera_to_imu = camera_to_imu;
+    if (o->readout && camera_to_imu) options.time_offset_search.focal_camera_to_imu = *camera_to_imu;
     if (o->readout && !o->no_readout) {
-      if (solved.camera) {
+      if (solved.camera && camera_to_imu) {
         ReadoutModel model;
-        model.camera_to_imu = camera_to_imu;
+        model.camera_to_imu = *camera_to_imu;
         try {
           model.leak = readout_leak(*solved.camera, solved.head, global.device);
           options.time_offset_search.readout = model;
@@ -154,7 +160,8 @@ Command register_calibration(CLI::App& app, const GlobalOptions& global, bool re
           calibration.readout_skipped = std::string("the readout's leak model needs an OpenCL device: ") + error.what();
         }
       } else {
-        calibration.readout_skipped = "no camera intrinsics to fit it with (the sequence's sensor.yaml)";
+        calibration.readout_skipped = solved.camera ? "no camera-IMU rotation to fit it in (a sensor.yaml or an extrinsic)"
+                                                    : "no camera intrinsics to fit it with (the sequence's sensor.yaml)";
       }
     }
     const EvalReport report = evaluate(rates, seq, options);
