@@ -244,6 +244,22 @@ TimeOffsetEstimate estimate_time_offset(const std::vector<std::int64_t>& from, c
   } else if (!std::isfinite(e.std_error_s)) {
     not_determined("the alignment cost has no distinct minimum");
   }
+  if (e.determined && options.focal_camera_to_imu) {
+    // The focal-length scale at the final offset and rotation, in the camera frame the correction
+    // makes true (R·R_BS), as the readout below.
+    const bool rotated = e.rotation && e.rotation->determined;
+    const Mat3 correction = rotated ? e.rotation->rotation : Mat3{1, 0, 0, 0, 1, 0, 0, 0, 1};
+    const Mat3 r = product(correction, *options.focal_camera_to_imu);
+    std::vector<Vec3> p_cam(pred.size()), g_cam(pred.size());
+    for (std::size_t i = 0; i < pred.size(); ++i) {
+      Vec3 g{};
+      for (int k = 0; k < 3; ++k) g[k] = spline[k].mean(a[i] + e.offset_s, b[i] + e.offset_s);
+      // pred is in the IMU frame through the calibration's R_BS: corrected, then back by (R·R_BS)ᵀ.
+      p_cam[i] = mul_transposed(r, mul(correction, pred[i]));
+      g_cam[i] = mul_transposed(r, g);
+    }
+    e.focal = fit_focal_scale(p_cam, g_cam);
+  }
   if (!e.determined) {
     e.offset_s = 0;
     e.std_error_s = std::numeric_limits<double>::infinity();

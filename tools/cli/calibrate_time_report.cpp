@@ -70,6 +70,14 @@ std::string rotation_confidence(const TimeOffsetEstimate& e) {
   return rank(own) <= rank(offset) ? own : offset;
 }
 
+std::string focal_predict_options(const CalibrationReport& c) {
+  if (!c.focal || !c.focal->determined || c.focal->confidence() == "low" || !c.focal_given) return "";
+  char buf[120];
+  std::snprintf(buf, sizeof buf, "--fx %.1f --fy %.1f", (*c.focal_given)[0] * c.focal->scale,
+                (*c.focal_given)[1] * c.focal->scale);
+  return buf;
+}
+
 std::string calibrate_time_eval_options(const TimeOffsetEstimate& e) {
   if (!e.determined || e.confidence() == "low") return "";
   char buf[160];
@@ -128,6 +136,26 @@ std::string calibrate_text(const CalibrationReport& c) {
     s += buf;
     s += "readout_confidence " + r.confidence() + "\n";
   }
+  if (c.focal) {
+    const FocalFit& f = *c.focal;
+    char buf[200];
+    if (!f.determined) {
+      std::snprintf(buf, sizeof buf, "focal_scale none\n");
+    } else {
+      std::snprintf(buf, sizeof buf, "focal_scale %.4f\nfocal_std_error %.4f\n", f.scale, f.std_error);
+    }
+    s += buf;
+    if (f.rechecked_scale) {
+      std::snprintf(buf, sizeof buf, "focal_rechecked_scale %.4f\n", *f.rechecked_scale);
+      s += buf;
+    }
+    s += "focal_confidence " + f.confidence() + "\n";
+    if (f.determined && c.focal_given) {
+      std::snprintf(buf, sizeof buf, "focal_fx %.1f\nfocal_fy %.1f\n", (*c.focal_given)[0] * f.scale,
+                    (*c.focal_given)[1] * f.scale);
+      s += buf;
+    }
+  }
   return s;
 }
 
@@ -156,6 +184,31 @@ std::string calibrate_json(const CalibrationReport& c, const std::string& sequen
                          {"rmse_after_deg_s", r.rmse_after_deg_s}};
   } else {
     j["readout_time"] = {{"searched", false}, {"reason", c.readout_skipped}};
+  }
+  if (c.focal) {
+    const FocalFit& f = *c.focal;
+    const bool known = f.determined && c.focal_given;
+    nlohmann::json given = c.focal_given ? nlohmann::json((*c.focal_given)[0]) : nlohmann::json(nullptr);
+    j["focal_length"] = {{"determined", f.determined},
+                         {"scale", f.scale},
+                         {"std_error", number(f.std_error)},
+                         {"z_scale", f.z_scale},
+                         {"z_std_error", number(f.z_std_error)},
+                         {"control_failed", f.control_failed()},
+                         {"rechecked_scale", f.rechecked_scale ? nlohmann::json(*f.rechecked_scale) : nlohmann::json(nullptr)},
+                         {"confidence", f.confidence()},
+                         {"reason", f.confidence_reason()},
+                         {"excitation_deg_s", f.excitation_deg_s},
+                         {"pairs", f.pairs},
+                         {"rmse_deg_s", f.rmse_deg_s},
+                         {"rmse_after_deg_s", f.rmse_after_deg_s},
+                         {"fx_given", given},
+                         {"fy_given", c.focal_given ? nlohmann::json((*c.focal_given)[1]) : nlohmann::json(nullptr)},
+                         {"fx", known ? nlohmann::json((*c.focal_given)[0] * f.scale) : nlohmann::json(nullptr)},
+                         {"fy", known ? nlohmann::json((*c.focal_given)[1] * f.scale) : nlohmann::json(nullptr)},
+                         {"predict", focal_predict_options(c)}};
+  } else {
+    j["focal_length"] = nullptr;
   }
   j["apply"] = calibrate_time_eval_options(c.offset);
   j["warnings"] = warnings;

@@ -38,13 +38,28 @@
 //         "confidence", "reason" (why "none" or "low"; "" otherwise), "pairs",
 //         "leak_excitation_deg_s2", "rmse_deg_s", "rmse_after_deg_s"}
 //     (readout_fit.hpp: what they mean).
+//   Added later under the same name (an optional block: readers of the first version ignore it):
+//     "focal_length": null (the offset not determined) or {"determined", "scale" (c = f_true /
+//         f_given: multiply fx and fy by it), "std_error" (1σ of c; null when not determined),
+//         "z_scale", "z_std_error" (the control about the optical axis, ≈ 1; null: no roll to judge
+//         by), "control_failed", "rechecked_scale" (the scale on rates predicted again with fx, fy ×
+//         scale; null when not rechecked), "confidence", "reason" (why "none" or "low"; "" otherwise),
+//         "excitation_deg_s", "pairs", "rmse_deg_s", "rmse_after_deg_s", "fx_given", "fy_given",
+//         "fx", "fy" (the four null when the intrinsics predicted with are not known, a rates file
+//         on a sequence without sensor.yaml), "predict" (the predict options that apply it, "" when
+//         not determined or rated low)}
+//     (focal_fit.hpp). eval --calibration-from never applies it: rates scale with the focal length
+//     through the whole solve, so they are predicted again with the new fx, fy.
+//   Text: focal_scale (or "none"), focal_std_error, focal_confidence, and focal_fx / focal_fy when
+//   the intrinsics are known.
 #pragma once
 
+#include <array>
 #include <optional>
-
 #include <string>
 #include <vector>
 
+#include "inertialnet/eval/focal_fit.hpp"
 #include "inertialnet/eval/readout_fit.hpp"
 #include "inertialnet/eval/time_offset.hpp"
 
@@ -59,7 +74,13 @@ struct CalibrationReport {
   double rates_readout_time_s = 0;          // the rates' own readout (their CSV's readout_time_s)
   std::optional<ReadoutEstimate> readout;   // when searched
   std::string readout_skipped;              // why not searched ("" when searched)
+  std::optional<FocalFit> focal;            // calibrate, when the offset is determined
+  std::optional<std::array<double, 2>> focal_given;  // the fx, fy the rates were predicted with, when known
 };
+
+// "--fx 1234.5 --fy 1234.5": the given fx, fy times the fitted scale, for predict; "" when the
+// scale is not determined or rated low, or the intrinsics predicted with are not known.
+std::string focal_predict_options(const CalibrationReport& c);
 
 // The rotation's rating, no higher than the offset's it was fitted at ("none" when there is none).
 std::string rotation_confidence(const TimeOffsetEstimate& e);

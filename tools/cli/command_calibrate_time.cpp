@@ -7,9 +7,11 @@
 // weight-free path (DIS flow + geometric head) predicts them first.
 // `inertialnet calibrate-time` is the same without the readout search (the command's first name;
 // its --json keeps the schema inertialnet.calibrate-time/1).
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include "calibrate_time_report.hpp"
 #include "commands.hpp"
@@ -128,18 +130,28 @@ Command register_calibration(CLI::App& app, const GlobalOptions& global, bool re
     const RatesTable rates = o->rates.empty() ? predict_weight_free(*o, seq, global, solved) : read_rates_csv(o->rates);
     CalibrationReport calibration;
     if (o->readout && o->no_readout) calibration.readout_skipped = "--no-readout";
+    // calibrate only (calibrate-time reads no more of the camera than before). A rates file: the
+    // camera of the sequence's sensor.yaml and the default solver.
+    if (o->readout && !o->rates.empty() && seq.camera) solved.camera = CameraIntrinsics::from_calibration(*seq.camera);
+    std::optional<Mat3> camera_to_imu;
+    if (solved.camera_to_body) {
+      camera_to_imu = *solved.camera_to_body;
+    } else if (o->readout) {
+      // Rates in the camera frame, or from a file: eval rotates them into the IMU frame with this.
+      // Without a camera calibration or extrinsic eval says what is missing; the fits need not.
+      try {
+        const Mat3 r = imu_to_camera_rotation(seq);
+        camera_to_imu = Mat3{r[0], r[3], r[6], r[1], r[4], r[7], r[2], r[5], r[8]};
+      } catch (const Error&) {
+      }
+    }
+    // The focal-length scale needs no device and no intrinsics (the scale is relative to whatever
+    // the rates were predicted with); the intrinsics only turn it into fx, fy to give predict.
+    if (o->readout && camera_to_imu) options.time_offset_search.focal_camera_to_imu = *camera_to_imu;
     if (o->readout && !o->no_readout) {
-      // A rates file: the camera of the sequence's sensor.yaml and the default solver.
-      if (!o->rates.empty() && seq.camera) solved.camera = CameraIntrinsics::from_calibration(*seq.camera);
-      if (solved.camera) {
+      if (solved.camera && camera_to_imu) {
         ReadoutModel model;
-        if (solved.camera_to_body) {
-          model.camera_to_imu = *solved.camera_to_body;
-        } else {
-          // Rates in the camera frame, or from a file: eval rotates them into the IMU frame with this.
-          const Mat3 r = imu_to_camera_rotation(seq);
-          model.camera_to_imu = {r[0], r[3], r[6], r[1], r[4], r[7], r[2], r[5], r[8]};
-        }
+        model.camera_to_imu = *camera_to_imu;
         try {
           model.leak = readout_leak(*solved.camera, solved.head, global.device);
           options.time_offset_search.readout = model;
@@ -148,7 +160,8 @@ Command register_calibration(CLI::App& app, const GlobalOptions& global, bool re
           calibration.readout_skipped = std::string("the readout's leak model needs an OpenCL device: ") + error.what();
         }
       } else {
-        calibration.readout_skipped = "no camera intrinsics to fit it with (the sequence's sensor.yaml)";
+        calibration.readout_skipped = solved.camera ? "no camera-IMU rotation to fit it in (a sensor.yaml or an extrinsic)"
+                                                    : "no camera intrinsics to fit it with (the sequence's sensor.yaml)";
       }
     }
     const EvalReport report = evaluate(rates, seq, options);
@@ -156,6 +169,35 @@ Command register_calibration(CLI::App& app, const GlobalOptions& global, bool re
     calibration.offset = e;
     calibration.rates_readout_time_s = rates.meta_number("readout_time_s").value_or(0.0);
     calibration.readout = e.readout;
+    calibration.focal = e.focal;
+    if (solved.camera) calibration.focal_given = std::array<double, 2>{solved.camera->fx, solved.camera->fy};
+    if (!o->rates.empty() && e.focal && e.focal->determined && std::abs(e.focal->scale - 1) > 2 * e.focal->std_error) {
+      calibration.focal->unchecked_reason =
+          "the rates come from a file, so calibrate cannot predict them again to check that they follow the focal "
+          "length (they do not always: docs/real_cameras.md, \"Focal length\"); predict again with focal_fx, "
+          "focal_fy and calibrate those rates: the scale should come out 1";
+    }
+    if (o->rates.empty() && e.focal && e.focal->determined && calibration.focal_given &&
+        std::abs(e.focal->scale - 1) > 2 * e.focal->std_error) {
+      // The recheck (focal_fit.hpp): predict again with fx, fy × scale, the camera otherwise the
+      // same (the sequence's sensor.yaml as a calibration file, so that its T_BS and distortion stay).
+      CalibrateTimeOptions again = *o;
+      again.camera.fx = (*calibration.focal_given)[0] * e.focal->scale;
+      again.camera.fy = (*calibration.focal_given)[1] * e.focal->scale;
+      const bool own = again.camera.calibration.file.empty() && !o->camera.fx && !o->camera.fy;
+      if (own && !seq.mav0.empty()) again.camera.calibration.file = (seq.mav0 / o->input.camera / "sensor.yaml").string();
+      if (!own || !seq.mav0.empty()) {
+        info("checking the focal-length scale: predicting again with fx, fy x" + std::to_string(e.focal->scale));
+        SolvedWith unused;
+        EvalOptions recheck = options;
+        recheck.time_offset_search.readout.reset();
+        const EvalReport second = evaluate(predict_weight_free(again, seq, global, unused), seq, recheck);
+        if (second.time_offset_estimate && second.time_offset_estimate->focal &&
+            second.time_offset_estimate->focal->determined) {
+          calibration.focal->rechecked_scale = second.time_offset_estimate->focal->scale;
+        }
+      }
+    }
     if (o->readout && !o->no_readout && !e.readout && calibration.readout_skipped.empty()) {
       calibration.readout_skipped = "the time offset is not determined";
     }
@@ -166,6 +208,7 @@ Command register_calibration(CLI::App& app, const GlobalOptions& global, bool re
       std::cout << e.summary() << "\n";
       if (e.determined && e.rotation) std::cout << e.rotation->summary() << "\n";
       if (calibration.readout) std::cout << calibration.readout->summary() << "\n";
+      if (calibration.focal) std::cout << calibration.focal->summary() << "\n";
     }
     if (!e.determined) {
       // No number to apply: a range edge or an infinitely uncertain offset is not an estimate.
@@ -200,6 +243,30 @@ Command register_calibration(CLI::App& app, const GlobalOptions& global, bool re
       } else {
         std::cout << "apply it with: inertialnet eval RATES.csv " << o->sequence << input << " "
                   << calibrate_time_eval_options(e) << "\n";
+      }
+      const std::string fxfy = focal_predict_options(calibration);
+      if (!fxfy.empty()) {
+        // Rates scale with the focal length through the whole solve (flow, translation, outlier
+        // tests): they are predicted again with the new intrinsics, never rescaled (eval
+        // --calibration-from leaves the focal length alone). The camera's other values stay: its
+        // calibration file with fx, fy replaced, or the pinhole given.
+        std::string camera;
+        if (o->input.camera != "cam0") camera += " --camera " + o->input.camera;
+        if (!o->input.bag.image.empty()) camera += " --image-topic " + o->input.bag.image;
+        if (!o->camera.calibration.file.empty()) {
+          camera += " --calibration " + o->camera.calibration.file;
+          if (!o->camera.calibration.camera.empty()) camera += " --calibration-camera " + o->camera.calibration.camera;
+        } else if (o->camera.fx || o->camera.fy) {
+          char buf[80];
+          std::snprintf(buf, sizeof buf, " --cx %.10g --cy %.10g", solved.camera->cx, solved.camera->cy);
+          camera += buf;
+        } else if (!seq.mav0.empty()) {
+          camera += " --calibration " + (seq.mav0 / o->input.camera / "sensor.yaml").string();
+        } else {
+          camera += " --calibration FILE";  // a bag's CameraInfo: its values written to a file
+        }
+        std::cout << "apply the focal length by predicting again: inertialnet predict " << o->sequence << camera << " "
+                  << fxfy << " -o RATES.csv (then calibrate again: the rotation goes with the new rates)\n";
       }
     }
     if (o->readout && !o->no_readout && !calibration.readout_skipped.empty()) {

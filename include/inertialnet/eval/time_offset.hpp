@@ -39,6 +39,9 @@
 //
 // With a `readout` model (calibrate) the rolling-shutter readout time is then fitted on the
 // residual left at the final offset and rotation (readout_fit.hpp).
+//
+// With `focal_camera_to_imu` (calibrate) the focal-length scale is fitted at the final offset and
+// rotation, in sequence, in the camera frame the rotation correction makes true (focal_fit.hpp).
 #pragma once
 
 #include <cstddef>
@@ -48,6 +51,7 @@
 #include <vector>
 
 #include "inertialnet/core/vec3.hpp"
+#include "inertialnet/eval/focal_fit.hpp"
 #include "inertialnet/eval/readout_fit.hpp"
 #include "inertialnet/eval/rotation_fit.hpp"
 #include "inertialnet/io/euroc.hpp"
@@ -59,6 +63,8 @@ struct TimeOffsetOptions {
   double step_s = 0.001;   // grid step before the parabolic refinement
   bool fit_rotation = false;  // also fit the camera–IMU rotation correction (see above)
   std::optional<ReadoutModel> readout;  // also fit the readout time (see above)
+  // Also fit the focal-length scale (see above): R_BS, camera-frame vectors into the IMU frame.
+  std::optional<Mat3> focal_camera_to_imu;
 };
 
 struct TimeOffsetEstimate {
@@ -75,6 +81,7 @@ struct TimeOffsetEstimate {
   std::string undetermined_reason;  // why not, in words ("the gyro shows no rotation …")
   std::optional<RotationFit> rotation;  // with fit_rotation (unset when the offset search ended on the edge)
   std::optional<ReadoutEstimate> readout;  // with a readout model, when the offset is determined
+  std::optional<FocalFit> focal;           // with focal_camera_to_imu, when the offset is determined
   std::string summary() const; // one line for reports
   // The verdict: "none" (not determined); "low" (on the range edge, no curvature, contrast > 0.9,
   // under kLowExplained explained or under kLowExcitationDegS of gyro motion); "high" (σ < 2 ms,
