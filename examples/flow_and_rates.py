@@ -35,8 +35,10 @@ for k in range(1, len(seq)):
     print(f"{t[k]}  wx {w[0]:+.4f}  wy {w[1]:+.4f}  wz {w[2]:+.4f} rad/s")
     previous = frame
 
-# The same in one call (what `inertialnet predict` does): Rates (.w is (N, 3) rad/s).
-rates = inertialnet.predict(sequence)
+# The same in one call (what `inertialnet predict` does): Rates (.w is (N, 3) rad/s, .sigma each
+# rate's standard deviation). The loop above gives two-frame rates; predict() by default smooths
+# them over the next two pairs (smooth="lag:2"), so the comparison asks for the two-frame ones.
+rates = inertialnet.predict(sequence, smooth="off")
 print("predict() agrees with the loop:", np.allclose([rates[c][-1] for c in ("wx", "wy", "wz")], w))
 
 report = inertialnet.evaluate(rates, sequence, target="mean")

@@ -178,7 +178,7 @@ TEST(Pipeline, CancellationLeavesAValidPartialCsv) {
   const fs::path csv = fixture().root / "partial.csv";
   std::atomic<bool> cancel{false};
   {
-    RatesCsvWriter writer(csv);
+    RatesCsvWriter writer(csv, rates_layout({""}));  // one estimator: its rates, status and σ
     auto source = open_frame_source(fixture().sequence);
     RatesProcessorOptions processor;
     processor.flow_model = ModelKind::FlowNet2C;
