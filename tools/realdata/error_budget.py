@@ -4,7 +4,8 @@
 
 Runs the `inertialnet` CLI on EuRoC-layout sequences and attributes the squared error of the
 default path (DIS + geometric head, interval-mean target, `eval --time-offset auto`) to its causes.
-Not run in CI: real recordings stay outside the repository (../shared/realdata converts them).
+Not run in CI: real recordings stay outside the repository (docs/real_cameras.md, "Error budget",
+names them and how they were converted).
 Needs Python 3 with numpy, opencv-python-headless and pyyaml (the same venv as the conversion
 scripts); the CLI does the estimating, this script only runs it and measures the frames.
 
