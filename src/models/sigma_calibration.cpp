@@ -142,29 +142,39 @@ SigmaCalibration fit_sigma_calibration(const std::vector<SigmaFitSample>& sample
   c.pairs = samples.size();
   const double n = static_cast<double>(samples.size());
   for (std::size_t a = 0; a < 3; ++a) {
-    // Least squares of y = e² on x = s²: y ≈ A·x + B, the variance model σ² = A·s² + B.
-    double mx = 0, my = 0;
-    for (const auto& s : samples) {
-      mx += s.spread[a] * s.spread[a];
-      my += s.learned_error[a] * s.learned_error[a];
-    }
-    mx /= n;
+    // Least squares of y = e² on x = s²: y ≈ A·x + B, the variance model σ² = A·s² + B. e² of a
+    // Gaussian error has variance 2σ⁴, so the fit is reweighted by 1/σ⁴ of the previous one
+    // (iteratively reweighted least squares; the first is unweighted): otherwise the pairs with
+    // a large spread decide the floor.
+    double my = 0;
+    for (const auto& s : samples) my += s.learned_error[a] * s.learned_error[a];
     my /= n;
-    double sxx = 0, sxy = 0, sx4 = 0, sx2y = 0;
-    for (const auto& s : samples) {
-      const double x = s.spread[a] * s.spread[a], y = s.learned_error[a] * s.learned_error[a];
-      sxx += (x - mx) * (x - mx);
-      sxy += (x - mx) * (y - my);
-      sx4 += x * x;
-      sx2y += x * y;
-    }
-    double A = sxx > 0 ? sxy / sxx : 0, B = my - A * mx;
-    if (A < 0) {  // the spread does not follow the error here: a constant σ
-      A = 0;
-      B = my;
-    } else if (B < 0) {  // a line through the origin
-      A = sx4 > 0 ? sx2y / sx4 : 0;
-      B = 0;
+    double A = 0, B = my;
+    for (int iteration = 0; iteration < 6; ++iteration) {
+      double sw = 0, swx = 0, swy = 0, swxx = 0, swxy = 0;
+      for (const auto& s : samples) {
+        const double x = s.spread[a] * s.spread[a], y = s.learned_error[a] * s.learned_error[a];
+        const double v = A * x + B;
+        const double w = iteration == 0 || !(v > 0) ? 1.0 : 1 / (v * v);
+        sw += w;
+        swx += w * x;
+        swy += w * y;
+        swxx += w * x * x;
+        swxy += w * x * y;
+      }
+      const double mx = swx / sw, mwy = swy / sw;
+      const double sxx = swxx - sw * mx * mx, sxy = swxy - sw * mx * mwy;
+      A = sxx > 1e-300 ? sxy / sxx : 0;
+      B = mwy - A * mx;
+      if (A < 0) {  // the spread does not follow the error here: a constant σ
+        A = 0;
+        B = mwy;
+      } else if (B < 0) {  // a line through the origin
+        A = swxx > 0 ? swxy / swxx : 0;
+        B = 0;
+      }
+      B = std::max(B, 1e-4 * my);
+      if (!(my > 0)) break;
     }
     // A floor keeps σ > 0 where the passes agree exactly (all features dropped alike).
     B = std::max(B, 1e-4 * my);
