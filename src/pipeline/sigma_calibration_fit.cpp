@@ -24,7 +24,10 @@ struct Measured {
 Measured measure(const fs::path& csv, const fs::path& sequence, const std::string& suffix) {
   EvalOptions options;
   options.head_suffix = suffix;
-  options.choose_target = true;  // an inter-frame estimator: the gyro's mean over the interval
+  // Both heads measure the rotation between the two frames (the learned head trained with --target
+  // mean, train's default): the gyro's mean over the interval, as eval --target mean. The rates
+  // file calls the learned head a network, for which eval's own choice would be the spline at t_k.
+  options.sync.target = SyncTarget::Mean;
   const EvalReport report = evaluate(csv, sequence, options);
   if (!report.corrected) {
     throw invalid_input(sequence.string() + ": the σ calibration needs the gyro bias (ground truth or a static start); "
