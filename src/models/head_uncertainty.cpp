@@ -37,6 +37,7 @@ void HeadSigmaOptions::validate() const {
   if (!(scale >= 0) || !(floor_rad_s >= 0) || !std::isfinite(scale) || !std::isfinite(floor_rad_s)) {
     throw invalid_input("the head's σ model needs a finite scale and floor ≥ 0");
   }
+  if (calibration) calibration->validate();
 }
 
 HeadUncertainty::HeadUncertainty(Queue& queue, const WeightSet& weights, const HeadConfig& config,
@@ -109,6 +110,7 @@ std::array<double, 3> HeadUncertainty::spread(const std::vector<float>& features
 
 std::array<double, 3> HeadUncertainty::sigma(const std::vector<float>& features) const {
   const std::array<double, 3> s = spread(features);
+  if (options_.calibration) return options_.calibration->sigma(s);
   std::array<double, 3> out{};
   for (std::size_t a = 0; a < 3; ++a) out[a] = std::hypot(options_.scale * s[a], options_.floor_rad_s);
   return out;

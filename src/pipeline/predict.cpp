@@ -15,6 +15,7 @@
 #include "inertialnet/io/camera.hpp"
 #include "inertialnet/models/flow_consistency.hpp"
 #include "inertialnet/models/head_input.hpp"
+#include "inertialnet/models/sigma_calibration.hpp"
 #include "inertialnet/runtime/device_selection.hpp"
 #include "inertialnet/runtime/error.hpp"
 
@@ -253,6 +254,19 @@ Prediction::Prediction(const PredictSettings& s) : settings_(s) {
   }
   processor_.keep_flow = s.keep_flow;
   processor_.fuse = s.fuse;  // rates_processor() refuses it without both heads and the camera-to-body rotation
+  if (processor_.fuse && processor_.inertialnet_head) {
+    // The head's own σ calibration (models/sigma_calibration.hpp; invalid_input naming the file and
+    // the key when malformed); a head without one keeps the built-in σ model and plain weights.
+    if (const auto calibration = read_sigma_calibration(s.weights)) {
+      processor_.head_sigma.calibration = calibration;
+      processor_.fusion.geometric_scale = calibration->geometric_scale;
+      processor_.fusion.correlation = calibration->correlation;
+    }
+    if (s.head_sigma_override) {
+      processor_.head_sigma = *s.head_sigma_override;
+      processor_.fusion = {};
+    }
+  }
 
   // Devices and their weights (one set per device).
   infos_ = select_devices(device_spec_or_environment(s.device), discover_devices());

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "inertialnet/pipeline/rate_fusion.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -24,16 +25,19 @@ std::string why_not(const EstimatorRates& r) {
 
 }  // namespace
 
-EstimatorRates fuse_rates(const EstimatorRates& learned, const EstimatorRates& geometric) {
+EstimatorRates fuse_rates(const EstimatorRates& learned, const EstimatorRates& geometric, const FusionWeights& weights) {
   EstimatorRates fused;
   fused.name = kFusedEstimator;
   const bool use_learned = weighable(learned), use_geometric = weighable(geometric);
   if (use_learned && use_geometric) {
     for (std::size_t a = 0; a < 3; ++a) {
-      const double p1 = 1 / (learned.sigma[a] * learned.sigma[a]);
-      const double p2 = 1 / (geometric.sigma[a] * geometric.sigma[a]);
-      fused.w[a] = (p1 * learned.w[a] + p2 * geometric.w[a]) / (p1 + p2);
-      fused.sigma[a] = 1 / std::sqrt(p1 + p2);
+      const double s1 = learned.sigma[a], s2 = weights.geometric_scale[a] * geometric.sigma[a];
+      const double v1 = s1 * s1, v2 = s2 * s2, c = weights.correlation[a] * s1 * s2;
+      // (σ₁ − σ₂)² + 2σ₁σ₂(1 − ρ) > 0 for |ρ| < 1: never a division by zero.
+      const double denominator = v1 + v2 - 2 * c;
+      const double share = (v2 - c) / denominator;  // the learned head's weight
+      fused.w[a] = share * learned.w[a] + (1 - share) * geometric.w[a];
+      fused.sigma[a] = std::sqrt(std::max(0.0, (v1 * v2 - c * c) / denominator));
     }
     return fused;
   }
@@ -41,6 +45,9 @@ EstimatorRates fuse_rates(const EstimatorRates& learned, const EstimatorRates& g
     const EstimatorRates& one = use_learned ? learned : geometric;
     fused.w = one.w;
     fused.sigma = one.sigma;
+    if (!use_learned) {
+      for (std::size_t a = 0; a < 3; ++a) fused.sigma[a] *= weights.geometric_scale[a];
+    }
     return fused;
   }
   const double nan = std::numeric_limits<double>::quiet_NaN();

@@ -212,7 +212,7 @@ class RatesProcessor : public PairProcessor {
       }
       t = lap(result, "geometric_head", t);
     }
-    if (options_.fuse) result.rates[next] = fuse_rates(result.rates[0], result.rates[1]);
+    if (options_.fuse) result.rates[next] = fuse_rates(result.rates[0], result.rates[1], options_.fusion);
     if (options_.keep_flow) {
       result.flow = FlowField::from_planar(width, height, flow.to_host(q));
       lap(result, "download", t);

@@ -34,5 +34,7 @@ Command register_viz(CLI::App& app, const GlobalOptions& global);
 Command register_train(CLI::App& app, const GlobalOptions& global);
 Command register_tune(CLI::App& app, const GlobalOptions& global);
 Command register_export(CLI::App& app, const GlobalOptions& global);
+// Issue 23: the learned head's σ calibration, in its metadata.
+Command register_calibrate_sigma(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace inertialnet::cli

@@ -36,6 +36,9 @@ std::string help_examples(const std::string& subcommand) {
        "  inertialnet eval rates.csv data/seq --calibration-from calib.json  # calibrate --json's offset and rotation\n"
        "  inertialnet eval rates.csv clip.mp4 --imu imu.csv --camchain camchain-imucam.yaml  # Kalibr's calibration\n"
        "  inertialnet eval rates.csv frames/ --imu imu.csv --T-cam-imu '0 -1 0 0  1 0 0 0  0 0 1 0  0 0 0 1'\n"},
+      {"calibrate-sigma",
+       "  inertialnet calibrate-sigma head.safetensors --val val1 val2            # fit, and write into the head\n"
+       "  inertialnet calibrate-sigma head.safetensors --val val1 --dry-run       # print the fit only\n"},
       {"export",
        "  inertialnet export rates.csv --format gyroflow -o clip.gcsv            # Gyroflow's gyro log\n"
        "  inertialnet export rates.csv --format euroc-imu -o virtual/imu0/data.csv # a gyro for a VIO to replay\n"

@@ -68,6 +68,8 @@ int main(int argc, char** argv) {
       {"tune", "measure and store this device's GEMM parameters, applied at every later start", cli::register_tune},
       {"weights", "write synthetic weights, or describe a weight file", cli::register_weights},
       {"train", "train the InertialNet head on sequences with an IMU", cli::register_train},
+      {"calibrate-sigma", "fit a trained head's σ on validation sequences for predict --fuse, into its metadata",
+       cli::register_calibrate_sigma},
   };
   std::map<CLI::App*, cli::Command> commands;
   for (const Subcommand& s : kSubcommands) {

@@ -16,9 +16,11 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "inertialnet/models/parameters.hpp"
+#include "inertialnet/models/sigma_calibration.hpp"
 #include "inertialnet/models/weights.hpp"
 #include "inertialnet/runtime/queue.hpp"
 
@@ -33,6 +35,9 @@ struct HeadSigmaOptions {
   double scale = 2.58;
   double floor_rad_s = 0.0475;  // 2.72 deg/s
   std::uint64_t seed = 23;
+  // A head's own calibration per axis (its metadata "inertialnet.sigma_calibration",
+  // sigma_calibration.hpp); when set it replaces scale and floor_rad_s.
+  std::optional<SigmaCalibration> calibration;
   void validate() const;   // invalid_input for passes outside 2..1000, p outside (0, 1), scale/floor < 0
 };
 
@@ -43,7 +48,7 @@ class HeadUncertainty {
   // The raw spread s (rad/s, per output) of the passes for one sample's flattened conv3
   // features (fc1_inputs values).
   std::array<double, 3> spread(const std::vector<float>& features) const;
-  // The calibrated σ (rad/s) for the same features.
+  // The calibrated σ (rad/s) for the same features: the options' calibration when they have one.
   std::array<double, 3> sigma(const std::vector<float>& features) const;
 
  private:

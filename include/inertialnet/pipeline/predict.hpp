@@ -60,6 +60,10 @@ struct PredictSettings {
   // rates weighted by their σ, the InertialNet head's σ from Monte-Carlo dropout
   // (RatesProcessorOptions::fuse; rate_fusion.hpp, head_uncertainty.hpp).
   bool fuse = false;
+  // With fuse: the learned head's σ model to use instead of the head's calibration (its metadata
+  // "inertialnet.sigma_calibration") or the built-in one, with plain inverse-variance weights. The
+  // σ calibration fit (sigma_calibration_fit.hpp) sets scale 1, floor 0 to read the raw spread.
+  std::optional<HeadSigmaOptions> head_sigma_override;
   // Camera-IMU time offset (t_imu = t_cam + offset) stated in the CSV for eval; not applied here.
   std::optional<double> time_offset_s;
   std::string device;                // a --device spec; "": $INERTIALNET_DEVICE, else the default

@@ -19,6 +19,7 @@
 #include "inertialnet/models/parameters.hpp"
 #include "inertialnet/models/weights.hpp"
 #include "inertialnet/pipeline/pipeline.hpp"
+#include "inertialnet/pipeline/rate_fusion.hpp"
 #include "inertialnet/core/vec3.hpp"
 
 namespace inertialnet {
@@ -68,6 +69,9 @@ struct RatesProcessorOptions {
   // heads must answer in the same frame: the geometric one needs camera_to_body.
   bool fuse = false;
   HeadSigmaOptions head_sigma;
+  // The geometric σ factor and the heads' error correlation of the head's σ calibration
+  // (sigma_calibration.hpp; defaults: plain inverse-variance weights).
+  FusionWeights fusion;
 };
 
 // Each lane gets its own queue and model instances. `weights` holds one set per device, loaded
