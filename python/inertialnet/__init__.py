@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import dataclasses
 import os
-from typing import Callable, Iterable, List, Optional, Sequence as _Seq, Union
+from typing import Iterable, List, Optional, Sequence as _Seq, Union
 
 import numpy as np
 

@@ -6,7 +6,7 @@ predictor (python/src/stream_bindings.cpp)."""
 from __future__ import annotations
 
 import os
-from typing import Iterable, Iterator, Optional, Tuple, Union
+from typing import Iterable, Iterator, Tuple, Union
 
 import numpy as np
 
