@@ -163,17 +163,8 @@ def build_parser():
         prog="convert_checkpoint.py",
         description="Convert a FlowNet2-family checkpoint (flownet2-pytorch .pth.tar, ptlflow .ckpt) or an "
                     "InertialNet head state_dict to a validated float32 safetensors file.",
-        epilog="Exit codes: 0 success, 1 runtime failure (I/O, --check mismatch), 2 bad usage "
-               "or input (unreadable checkpoint, unknown model, missing/extra/mis-shaped "
-               "tensors, checksum mismatch). docs/weights.md lists where to download checkpoints.")
-    ap.add_argument("input", help="checkpoint (.pth.tar / .ckpt / .pth / .pt)")
-    ap.add_argument("output", help="safetensors file to write")
-    ap.add_argument("--model", choices=MODEL_CHOICES,
-                    help="model kind; detected from the tensor names when omitted")
-    ap.add_argument("--check", action="store_true",
-                    help="reload the written file and compare every tensor bit for bit")
-    ap.add_argument("--sha256", metavar="HEX",
-                    help="refuse the checkpoint unless its SHA-256 begins with HEX (8 or more hex digits)")
+        epilog=cv.EXIT_CODES_EPILOG)
+    cv.add_checkpoint_arguments(ap, MODEL_CHOICES)
     ap.add_argument("--head-input", metavar="WxH",
                     help="head only: width x height of the flow the head takes, e.g. 752x480")
     ap.add_argument("--head-config", metavar="JSON",
@@ -201,33 +192,18 @@ def run(args) -> int:
         if head_options:
             raise InputError(f"--head-* options apply to InertialNetHead, not {kind}")
         done = cv.convert(args.input, args.output, kind, args.check, args.sha256)
-    if not args.quiet:
-        for note in done["notes"]:
-            print(f"note: {note}", file=sys.stderr)
-    if done["problems"]:
-        print(f"error: {args.output} does not read back as written:\n  " + "\n  ".join(done["problems"]),
-              file=sys.stderr)
-        return EXIT_RUNTIME
-    if not args.quiet:
-        print(f"{args.output}: {done['kind']}, {done['tensors']} tensors, {done['parameters']:,} parameters"
-              + (", verified bit for bit" if args.check else ""))
+    code = cv.report(done, args.output, args.check, args.quiet, note="note: ", error="error: ")
+    if code == EXIT_OK and not args.quiet:
         meta = done.get("metadata")
         if meta:
             print(f"  published checkpoint: {meta['inertialnet.checkpoint.published']} (checksum: "
                   f"{meta['inertialnet.checkpoint.checksum']})")
-    return EXIT_OK
+    return code
 
 
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
-    try:
-        return run(args)
-    except InputError as e:
-        print(f"error: {e}", file=sys.stderr)
-        return EXIT_INPUT
-    except OSError as e:
-        print(f"error: {e}", file=sys.stderr)
-        return EXIT_RUNTIME
+    return cv.exit_code(lambda: run(args), "error: ")
 
 
 if __name__ == "__main__":

@@ -20,8 +20,9 @@ batches) within a pair or a layer: ``KeyboardInterrupt``.
 
 from __future__ import annotations
 
+import dataclasses
 import os
-from typing import Callable, Iterable, List, Optional, Sequence as _Seq, Union
+from typing import Iterable, List, Optional, Sequence as _Seq, Union
 
 import numpy as np
 
@@ -43,6 +44,7 @@ from ._inertialnet import (  # noqa: F401  (re-exported)
     write_flow_png,
     write_kitti_flow,
 )
+from ._options import PredictOptions, takes_predict_options
 from ._rates import Rates, read_rates, _rates_of_predict
 from ._sequence import Sequence
 from . import _inertialnet as _native
@@ -162,50 +164,8 @@ class InertialNetHead:
         return f"<inertialnet.InertialNetHead {c['input_width']}x{c['input_height']}>"
 
 
-def _device_spec(device: DeviceLike) -> str:
-    """``device=`` of predict as the spec string the library takes: None, a spec, an index or a
-    :class:`Device` (its global index), as the model constructors take it."""
-    if device is None:
-        return ""
-    if isinstance(device, Device):
-        return str(device.info["index"])
-    if isinstance(device, bool) or not isinstance(device, (str, int)):
-        raise TypeError(f"device must be None, a device spec string, an index or an inertialnet.Device, "
-                        f"not {type(device).__name__}")
-    return str(device)
-
-
-def predict(
-    sequence: SequenceLike,
-    weights: Weights = (),
-    *,
-    flow: Optional[str] = None,
-    head: Optional[str] = None,
-    model: Optional[str] = None,
-    solver: str = "motion-field",
-    fx: Optional[float] = None,
-    fy: Optional[float] = None,
-    cx: Optional[float] = None,
-    cy: Optional[float] = None,
-    calibration: Optional[PathLike] = None,
-    calibration_camera: str = "",
-    image_topic: Optional[str] = None,
-    camera_info_topic: str = "",
-    rate_hz: float = 0.0,
-    camera: str = "cam0",
-    time_offset: Optional[float] = None,
-    readout_time: float = 0.0,
-    device: DeviceLike = None,
-    max_pairs: int = 0,
-    lanes: int = 2,
-    decode_threads: int = 2,
-    keep_flow: bool = False,
-    flow_check: float = 0.5,
-    progress: Optional[Callable[[int, int], object]] = None,
-    max_sigma: float = 10.0,
-    smooth: str = "lag:2",
-    fuse: bool = False,
-):
+@takes_predict_options()
+def predict(sequence: SequenceLike, weights: Weights = (), *, options: PredictOptions):
     """Angular rates of every frame pair of a sequence, as ``inertialnet predict`` computes them.
 
     ``sequence`` is a path (EuRoC folder, image folder, video, ROS bag) or a :class:`Sequence` (its
@@ -243,20 +203,15 @@ def predict(
     most every 50 ms, and once at the end): ``done`` pairs of ``total``. An exception it raises
     stops the run and propagates. Ctrl-C stops the run within a pair or two and raises
     ``KeyboardInterrupt``; the pairs computed so far are dropped."""
-    if isinstance(sequence, Sequence) and not rate_hz:
-        rate_hz = sequence.rate_hz
-    image_topic = _image_topic_of(sequence, image_topic)
+    if isinstance(sequence, Sequence) and not options.rate_hz:
+        options = dataclasses.replace(options, rate_hz=sequence.rate_hz)
+    options = dataclasses.replace(options, image_topic=_image_topic_of(sequence, options.image_topic))
     if isinstance(weights, (str, os.PathLike)):
         weights = [weights]
     columns, t_ns, values, flows, statuses, metadata, sigmas = _native._predict(
-        os.fspath(sequence), [os.fspath(w) for w in weights], model or "", flow or "", head or "", solver,
-        *(None if v is None else float(v) for v in (fx, fy, cx, cy)), float(rate_hz), _device_spec(device),
-        keep_flow, max_pairs, int(lanes), int(decode_threads), float(flow_check), progress,
-        None if time_offset is None else float(time_offset), float(readout_time), camera,
-        "" if calibration is None else os.fspath(calibration), calibration_camera, image_topic, camera_info_topic,
-        float(max_sigma), str(smooth), bool(fuse))
+        os.fspath(sequence), [os.fspath(w) for w in weights], **options.native())
     rates = _rates_of_predict(columns, t_ns, values, statuses, metadata, sigmas)
-    return (rates, flows) if keep_flow else rates
+    return (rates, flows) if options.keep_flow else rates
 
 
 def write_rates_csv(path: PathLike, rates: Union[Rates, np.ndarray]) -> None:

@@ -96,12 +96,9 @@ def synth(out: _Path, frames: int = 40, motion: str = "rotation", seed: Supports
           height: int = 480, noise: bool = True, overwrite: bool = False) -> int: ...
 
 # The native halves of inertialnet.predict, evaluate, Rates.to_csv and read_rates.
-def _predict(sequence: _Path, weights: list[str], model: str, flow: str, head: str, solver: str,
-             fx: Optional[float], fy: Optional[float], cx: Optional[float], cy: Optional[float], rate_hz: float,
-             device: str, keep_flow: bool, max_pairs: SupportsIndex, lanes: int, decode_threads: int,
-             flow_check: float, progress: Optional[Callable[[int, int], object]], time_offset: Optional[float],
-             readout_time: float, camera: str, calibration: str, calibration_camera: str, image_topic: str,
-             camera_info_topic: str, max_sigma: float, smooth: str, fuse: bool) -> tuple[list[str], npt.NDArray[np.int64], npt.NDArray[np.float64], list[npt.NDArray[np.float32]],
+# predict(), batch.predict() and stream() pass their shared keywords as **options (_options.py:
+# PredictOptions.native()).
+def _predict(sequence: str, weights: list[str], **options: object) -> tuple[list[str], npt.NDArray[np.int64], npt.NDArray[np.float64], list[npt.NDArray[np.float32]],
                         list[list[str]], list[tuple[str, str]], npt.NDArray[np.float64]]: ...
 def _evaluate_json(rates: _Path, sequence: _Path, target: str, head: str, gyro_bias: Union[None, str, list[float]],
                    camera_frame: bool, plot: str, series: bool, time_offset: Union[None, float, str],
@@ -115,23 +112,15 @@ def _read_rates_csv(path: _Path) -> tuple[list[str], npt.NDArray[np.int64], npt.
                                           list[list[str]], list[tuple[str, str]]]: ...
 
 # The native halves of inertialnet.batch (batch.py): the CLI's batch files, names and table.
-def _predict_rates_file(rates: _Path, skip_current: bool, sequence: _Path, weights: list[str], model: str, flow: str,
-                        head: str, solver: str, fx: Optional[float], fy: Optional[float], cx: Optional[float],
-                        cy: Optional[float], rate_hz: float, device: str, keep_flow: bool, max_pairs: SupportsIndex,
-                        lanes: int, decode_threads: int, flow_check: float,
-                        progress: Optional[Callable[[int, int], object]], time_offset: Optional[float],
-                        readout_time: float, camera: str, calibration: str, calibration_camera: str,
-                        image_topic: str, camera_info_topic: str, max_sigma: float, smooth: str, fuse: bool) -> dict[str, Union[str, int]]: ...
+def _predict_rates_file(rates: _Path, skip_current: bool, sequence: str, weights: list[str],
+                        **options: object) -> dict[str, Union[str, int]]: ...
 def _batch_rates_paths(sequences: list[_Path], folder: _Path) -> list[str]: ...
 def _read_batch_manifest(manifest: _Path) -> list[str]: ...
 def _eval_table(rates: list[_Path], sequences: list[_Path], format: str, plot: _Path, target: str, head: str) -> str: ...
 
 # python/src/stream_bindings.cpp: what inertialnet.stream() returns (streaming.py has the arguments).
 class _Stream:
-    def __init__(self, sequence: str, weights: list[str], model: str, flow: str, head: str, solver: str,
-                 fx: Optional[float], fy: Optional[float], cx: Optional[float], cy: Optional[float],
-                 calibration: str, calibration_camera: str, camera: str, rate_hz: float, device: str,
-                 max_pairs: int, lanes: int, flow_check: float, max_sigma: float, smooth: str) -> None: ...
+    def __init__(self, sequence: str, weights: list[str], **options: object) -> None: ...
     def __iter__(self) -> "_Stream": ...
     # (timestamp_ns, rates (3,) or (2, 3) rad/s, status or a tuple of statuses)
     def __next__(self) -> tuple[int, npt.NDArray[np.float64], Union[str, tuple[str, ...]]]: ...

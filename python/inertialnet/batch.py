@@ -19,6 +19,7 @@ import sys
 from typing import Callable, Dict, Iterable, List, Optional, Sequence as _Seq, Union
 
 from . import _inertialnet as _native
+from ._options import PredictOptions, takes_predict_options
 
 PathLike = Union[str, "os.PathLike[str]"]
 
@@ -70,12 +71,7 @@ def _predict_one(sequence: str, rates: str, weights: List[str], options: Dict[st
     if task_progress is not None:
         def progress(done, total):
             task_progress(name, done, total)
-    o = options
-    result = dict(_native._predict_rates_file(
-        rates, True, sequence, weights, o["model"], o["flow"], o["head"], o["solver"], o["fx"], o["fy"], o["cx"],
-        o["cy"], o["rate_hz"], o["device"], False, o["max_pairs"], o["lanes"], o["decode_threads"], o["flow_check"],
-        progress, o["time_offset"], o["readout_time"], o["camera"], o["calibration"], o["calibration_camera"],
-        o["image_topic"], o["camera_info_topic"], o["max_sigma"], o["smooth"], o["fuse"]))
+    result = dict(_native._predict_rates_file(rates, True, sequence, weights, **dict(options, progress=progress)))
     result.update(sequence=sequence, rates=rates, name=name)
     return result
 
@@ -87,6 +83,11 @@ def _print_progress(name: str, done: int, total: int) -> None:
         print(f"inertialnet: {name}: {done} of {total} pairs", file=sys.stderr, flush=True)
 
 
+# inertialnet.predict()'s keywords but keep_flow (the batch writes files) and its progress (the
+# batch's own, per sequence), with a spec string for device and one lane per task.
+@takes_predict_options(
+    omit=("keep_flow", "progress"), defaults={"image_topic": "", "lanes": 1},
+    annotations={"image_topic": "str", "device": "Optional[str]"})
 def predict(
     sequences: Union[PathLike, Iterable[PathLike]],
     out_dir: PathLike,
@@ -97,30 +98,7 @@ def predict(
     num_gpus: Optional[float] = None,
     progress: Optional[Callable[[Dict[str, object]], object]] = None,
     task_progress: Optional[Callable[[str, int, int], object]] = _print_progress,
-    flow: Optional[str] = None,
-    head: Optional[str] = None,
-    model: Optional[str] = None,
-    solver: str = "motion-field",
-    fx: Optional[float] = None,
-    fy: Optional[float] = None,
-    cx: Optional[float] = None,
-    cy: Optional[float] = None,
-    calibration: Optional[PathLike] = None,
-    calibration_camera: str = "",
-    image_topic: str = "",
-    camera_info_topic: str = "",
-    rate_hz: float = 0.0,
-    camera: str = "cam0",
-    time_offset: Optional[float] = None,
-    readout_time: float = 0.0,
-    device: Optional[str] = None,
-    max_pairs: int = 0,
-    lanes: int = 1,
-    decode_threads: int = 2,
-    flow_check: float = 0.5,
-    max_sigma: float = 10.0,
-    smooth: str = "lag:2",
-    fuse: bool = False,
+    options: PredictOptions,
 ) -> List[Dict[str, object]]:
     """Rates of every sequence into ``out_dir/<name>.csv``, as ``inertialnet predict SEQ... -o
     OUT_DIR`` writes them; returns one dict per sequence, in order: ``name``, ``sequence``,
@@ -151,16 +129,8 @@ def predict(
     os.makedirs(out_dir, exist_ok=True)
     if isinstance(weights, (str, os.PathLike)):
         weights = [weights]
-    options = dict(
-        model=model or "", flow=flow or "", head=head or "", solver=solver,
-        fx=None if fx is None else float(fx), fy=None if fy is None else float(fy),
-        cx=None if cx is None else float(cx), cy=None if cy is None else float(cy),
-        rate_hz=float(rate_hz), device=device or "", max_pairs=max_pairs, lanes=int(lanes),
-        decode_threads=int(decode_threads), flow_check=float(flow_check),
-        time_offset=None if time_offset is None else float(time_offset), readout_time=float(readout_time),
-        camera=camera, calibration="" if calibration is None else os.fspath(calibration),
-        calibration_camera=calibration_camera, image_topic=image_topic or "", camera_info_topic=camera_info_topic,
-        max_sigma=float(max_sigma), smooth=str(smooth), fuse=bool(fuse))
+    # What each task passes to the native module (picklable for Ray; the progress is the task's own).
+    native = options.native()
     weight_files = [os.fspath(w) for w in weights]
     results: List[Dict[str, object]] = []
     if cluster is None:
@@ -170,12 +140,12 @@ def predict(
             initialised = False
         if not initialised:
             for sequence, rates in zip(seqs, outputs):
-                result = _predict_one(sequence, rates, weight_files, options, task_progress)
+                result = _predict_one(sequence, rates, weight_files, native, task_progress)
                 if progress is not None:
                     progress(result)
                 results.append(result)
             return results
-    return _predict_on_ray(seqs, outputs, weight_files, options, cluster, max_retries, num_gpus, progress,
+    return _predict_on_ray(seqs, outputs, weight_files, native, cluster, max_retries, num_gpus, progress,
                            task_progress)
 
 

@@ -44,7 +44,7 @@ import sys
 import tempfile
 import zipfile
 import zlib
-from typing import Dict, Iterable, List, Optional, Tuple
+from typing import Callable, Dict, Iterable, List, Optional, Tuple
 
 import numpy as np
 
@@ -800,20 +800,60 @@ def list_published() -> str:
     return "\n".join(lines)
 
 
+# What `python -m inertialnet.convert` and tools/convert_checkpoint.py (which adds heads) share:
+# the arguments, the exit codes and what a conversion prints.
+EXIT_CODES_EPILOG = ("Exit codes: 0 success, 1 runtime failure (I/O, --check mismatch), 2 bad usage or input "
+                     "(unreadable checkpoint, unknown model, missing/extra/mis-shaped tensors, checksum mismatch). "
+                     "docs/weights.md lists where to download each checkpoint.")
+
+
+def add_checkpoint_arguments(ap: argparse.ArgumentParser, models, *, optional: bool = False) -> None:
+    """CHECKPOINT OUTPUT --model --check --sha256 (``optional``: the two paths may be left out)."""
+    nargs = "?" if optional else None
+    ap.add_argument("input", nargs=nargs, help="checkpoint (.pth.tar, .ckpt, .pth, .pt)")
+    ap.add_argument("output", nargs=nargs, help="safetensors file to write")
+    ap.add_argument("--model", choices=models, help="model kind; detected from the tensor names when omitted")
+    ap.add_argument("--check", action="store_true", help="reload the written file and compare every tensor bit for bit")
+    ap.add_argument("--sha256", metavar="HEX", help="refuse the checkpoint unless its SHA-256 begins with HEX "
+                                                    "(8 or more hex digits)")
+
+
+def exit_code(work: Callable[[], int], prefix: str) -> int:
+    """``work()``'s exit code; bad input is exit 2 and an I/O failure exit 1, the message on standard
+    error after ``prefix``."""
+    try:
+        return work()
+    except InputError as e:
+        print(f"{prefix}{e}", file=sys.stderr)
+        return EXIT_INPUT
+    except OSError as e:
+        print(f"{prefix}{e}", file=sys.stderr)
+        return EXIT_RUNTIME
+
+
+def report(done: Dict[str, object], output: str, check: bool, quiet: bool, *, note: str, error: str) -> int:
+    """A conversion's notes (each after ``note``), problems (after ``error``; exit 1) and first
+    summary line; EXIT_OK when it read back."""
+    if not quiet:
+        for text in done["notes"]:
+            print(f"{note}{text}", file=sys.stderr)
+    if done["problems"]:
+        print(f"{error}{output} does not read back as written:\n  " + "\n  ".join(done["problems"]),
+              file=sys.stderr)
+        return EXIT_RUNTIME
+    if not quiet:
+        print(f"{output}: {done['kind']}, {done['tensors']} tensors, {done['parameters']:,} parameters"
+              + (", verified bit for bit" if check else ""))
+    return EXIT_OK
+
+
 def build_parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(
         prog="python -m inertialnet.convert",
         description="Convert a FlowNet2-family checkpoint (NVIDIA flownet2-pytorch .pth.tar or ptlflow "
                     "Lightning .ckpt) to the safetensors file `inertialnet -w` loads, without torch.",
-        epilog="Exit codes: 0 success, 1 runtime failure (I/O, --check mismatch), 2 bad usage or input "
-               "(unreadable checkpoint, unknown model, missing/extra/mis-shaped tensors, checksum mismatch). "
-               "docs/weights.md lists where to download each checkpoint.")
-    ap.add_argument("input", nargs="?", help="checkpoint (.pth.tar, .ckpt, .pth, .pt)")
-    ap.add_argument("output", nargs="?", help="safetensors file to write")
-    ap.add_argument("--model", choices=FLOWNET2_KINDS, help="model kind; detected from the tensor names when omitted")
-    ap.add_argument("--check", action="store_true", help="reload the written file and compare every tensor bit for bit")
-    ap.add_argument("--sha256", metavar="HEX", help="refuse the checkpoint unless its SHA-256 begins with HEX "
-                                                    "(8 or more hex digits)")
+        epilog=EXIT_CODES_EPILOG)
+    add_checkpoint_arguments(ap, FLOWNET2_KINDS, optional=True)
     ap.add_argument("--list", action="store_true", help="list the published checkpoints this tool knows and exit")
     ap.add_argument("-q", "--quiet", action="store_true", help="print nothing on success")
     return ap
@@ -829,29 +869,19 @@ def main(argv=None) -> int:
         ap.print_usage(sys.stderr)
         print("inertialnet: convert needs CHECKPOINT and OUTPUT (or --list)", file=sys.stderr)
         return EXIT_INPUT
-    try:
+
+    def work() -> int:
         done = convert(args.input, args.output, args.model, args.check, args.sha256)
-    except InputError as e:
-        print(f"inertialnet: {e}", file=sys.stderr)
-        return EXIT_INPUT
-    except OSError as e:
-        print(f"inertialnet: {e}", file=sys.stderr)
-        return EXIT_RUNTIME
-    if not args.quiet:
-        for note in done["notes"]:
-            print(f"inertialnet: note: {note}", file=sys.stderr)
-    if done["problems"]:
-        print(f"inertialnet: {args.output} does not read back as written:\n  " + "\n  ".join(done["problems"]),
-              file=sys.stderr)
-        return EXIT_RUNTIME
-    if not args.quiet:
-        meta = done["metadata"]
-        print(f"{args.output}: {done['kind']}, {done['tensors']} tensors, {done['parameters']:,} parameters"
-              + (", verified bit for bit" if args.check else ""))
-        print(f"  from a {meta['inertialnet.checkpoint.layout']} checkpoint ({meta['inertialnet.checkpoint.format']}); "
-              f"published checkpoint: {meta['inertialnet.checkpoint.published']} (checksum: "
-              f"{meta['inertialnet.checkpoint.checksum']})")
-    return EXIT_OK
+        code = report(done, args.output, args.check, args.quiet, note="inertialnet: note: ",
+                      error="inertialnet: ")
+        if code == EXIT_OK and not args.quiet:
+            meta = done["metadata"]
+            print(f"  from a {meta['inertialnet.checkpoint.layout']} checkpoint "
+                  f"({meta['inertialnet.checkpoint.format']}); published checkpoint: "
+                  f"{meta['inertialnet.checkpoint.published']} (checksum: {meta['inertialnet.checkpoint.checksum']})")
+        return code
+
+    return exit_code(work, "inertialnet: ")
 
 
 if __name__ == "__main__":

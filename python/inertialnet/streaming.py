@@ -6,38 +6,26 @@ predictor (python/src/stream_bindings.cpp)."""
 from __future__ import annotations
 
 import os
-from typing import Iterable, Iterator, Optional, Tuple, Union
+from typing import Iterable, Iterator, Tuple, Union
 
 import numpy as np
 
 from . import _inertialnet as _native
+from ._options import PredictOptions, takes_predict_options
 
 PathLike = Union[str, "os.PathLike[str]"]
 
 
+# predict()'s keywords but those of a finished sequence's file (topics, time offset, readout time),
+# of decoding ahead and of predict()'s own returns.
+@takes_predict_options(
+    omit=("image_topic", "camera_info_topic", "time_offset", "readout_time", "decode_threads", "keep_flow", "progress"),
+    annotations={"device": "Union[None, str, int]"})
 def stream(
     sequence: PathLike,
     weights: Union[PathLike, Iterable[PathLike]] = (),
     *,
-    flow: Optional[str] = None,
-    head: Optional[str] = None,
-    model: Optional[str] = None,
-    solver: str = "motion-field",
-    fx: Optional[float] = None,
-    fy: Optional[float] = None,
-    cx: Optional[float] = None,
-    cy: Optional[float] = None,
-    calibration: Optional[PathLike] = None,
-    calibration_camera: str = "",
-    rate_hz: float = 0.0,
-    camera: str = "cam0",
-    device: Union[None, str, int] = None,
-    max_pairs: int = 0,
-    lanes: int = 2,
-    flow_check: float = 0.5,
-    max_sigma: float = 10.0,
-    smooth: str = "lag:2",
-    fuse: bool = False,
+    options: PredictOptions,
 ) -> Iterator[Tuple[int, np.ndarray, Union[str, Tuple[str, ...]]]]:
     """Yields ``(timestamp_ns, rates, status)`` for each frame pair as soon as it is computed,
     in pair order: ``timestamp_ns`` the pair's second frame (int), ``rates`` float64 ``(3,)`` in
@@ -59,11 +47,4 @@ def stream(
     stops the computation when the iterator is dropped."""
     if isinstance(weights, (str, os.PathLike)):
         weights = [weights]
-    def number(value):
-        return None if value is None else float(value)
-
-    return _native._Stream(
-        os.fspath(sequence), [os.fspath(w) for w in weights], model or "", flow or "", head or "", solver,
-        number(fx), number(fy), number(cx), number(cy), "" if calibration is None else os.fspath(calibration),
-        calibration_camera, camera, float(rate_hz), "" if device is None else str(device), int(max_pairs),
-        int(lanes), float(flow_check), float(max_sigma), str(smooth), bool(fuse))
+    return _native._Stream(os.fspath(sequence), [os.fspath(w) for w in weights], **options.native())

@@ -38,6 +38,7 @@
 #include "inertialnet/io/calibration_file.hpp"
 #include "inertialnet/eval/eval_table.hpp"
 #include "inertialnet/pipeline/batch_predict.hpp"
+#include "predict_options.hpp"
 
 namespace py = pybind11;
 using namespace inertialnet;
@@ -1043,21 +1044,26 @@ py::tuple read_rates(const std::filesystem::path& path) {
 
 }  // namespace
 
-// The settings of predict() from its arguments, checked as the CLI checks its options (predict and
-// the batch's _predict_rates_file share them).
-PredictSettings python_predict_settings(const std::filesystem::path& sequence, const std::vector<std::string>& weights, const std::string& model,
-                                        const std::string& flow, const std::string& head, const std::string& solver, const py::object& fx,
-                                        const py::object& fy, const py::object& cx, const py::object& cy, double rate_hz, const std::string& device,
-                                        bool keep_flow, const py::object& max_pairs, int lanes, int decode_threads, double flow_check,
-                                        const py::object& progress, const py::object& time_offset, double readout_time, const std::string& camera,
-                                        const std::string& calibration, const std::string& calibration_camera, const std::string& image_topic,
-                                        const std::string& camera_info_topic, double max_sigma, const std::string& smooth, bool fuse) {
+namespace inertialnet {
+
+PythonPredictOptions python_predict_options(const std::string& sequence, const std::vector<std::string>& weights,
+                                            const py::kwargs& options, bool live) {
+  // Every keyword _options.py passes, by name; one it does not know is a programming error there.
+  std::vector<std::string> taken;
+  const auto take = [&](const char* key) -> py::object {
+    if (!options.contains(key)) throw py::type_error(std::string("missing predict keyword ") + key);
+    taken.emplace_back(key);
+    return options[key];
+  };
+  const auto text = [&](const char* key) { return take(key).cast<std::string>(); };
+  const auto real = [&](const char* key) { return take(key).cast<double>(); };
   // The CLI's checks of --max-pairs, --rate, --fx, --fy: a value they refuse is a ValueError
   // here, not ignored (a negative rate or focal length was taken as "not given").
-  const std::int64_t pairs = integer_of(max_pairs, "max_pairs");
+  const std::int64_t pairs = integer_of(take("max_pairs"), "max_pairs");
   if (pairs < 0) {
     throw invalid_input("max_pairs must be a count of pairs (0 for all), got " + std::to_string(pairs));
   }
+  const double rate_hz = real("rate_hz");
   rate_of(rate_hz);
   // None: not given. fx, fy: 0 is "not given" too (never a focal length); cx, cy: any
   // coordinate within 1e6 pixels, 0 included (a principal point at the corner), as
@@ -1075,43 +1081,55 @@ PredictSettings python_predict_settings(const std::filesystem::path& sequence, c
     }
     return std::optional<double>(x);
   };
-  const auto given_fx = focal(fx, "fx", "the calibration's focal length");
-  const auto given_fy = focal(fy, "fy", "fx");
-  const auto given_cx = coordinate(cx, "cx"), given_cy = coordinate(cy, "cy");
-  if (!progress.is_none() && !PyCallable_Check(progress.ptr())) {
+  PythonPredictOptions out;
+  PredictSettings& s = out.settings;
+  s.fx = focal(take("fx"), "fx", "the calibration's focal length");
+  s.fy = focal(take("fy"), "fy", "fx");
+  s.cx = coordinate(take("cx"), "cx");
+  s.cy = coordinate(take("cy"), "cy");
+  out.progress = take("progress");
+  if (!out.progress.is_none() && !PyCallable_Check(out.progress.ptr())) {
     throw py::type_error("progress must be a callable taking (done, total), or None, not " +
-                         type_name(progress));
+                         type_name(out.progress));
   }
-  PredictSettings s;
-  s.sequence = existing_sequence(sequence);
+  s.sequence = live ? std::filesystem::path(sequence) : existing_sequence(sequence);
   // Stated in the rates' metadata for evaluate(), as predict --time-offset/--readout-time
   // state them in the CSV; the Prediction checks their ranges.
+  const py::object time_offset = take("time_offset");
   if (!time_offset.is_none()) s.time_offset_s = time_offset.cast<double>();
-  s.readout_time_s = readout_time;
-  s.camera = camera;
+  s.readout_time_s = real("readout_time");
+  s.camera = text("camera");
   s.weights = weights;
-  s.model = model;
-  s.flow = flow;
-  s.head = head;
-  s.solver = solver;
-  s.fx = given_fx;
-  s.fy = given_fy;
-  s.cx = given_cx;
-  s.cy = given_cy;
+  s.model = text("model");
+  s.flow = text("flow");
+  s.head = text("head");
+  s.solver = text("solver");
+  const std::string calibration = text("calibration");
   s.calibration = calibration.empty() ? std::filesystem::path() : existing(calibration, "the calibration file");
-  s.calibration_camera = calibration_camera;
-  s.bag.image = image_topic;
-  s.bag.camera_info = camera_info_topic;
+  s.calibration_camera = text("calibration_camera");
+  s.bag.image = text("image_topic");
+  s.bag.camera_info = text("camera_info_topic");
   s.rate_hz = rate_hz;
-  s.device = device;
-  s.keep_flow = keep_flow;
-  s.flow_check_px = flow_check;
-  s.max_sigma_deg_s = max_sigma;  // predict --max-sigma, --smooth (issue 22)
-  s.smooth = smooth;
-  s.fuse = fuse;  // predict --fuse (issue 23)
-  if (lanes < 1 || decode_threads < 1) throw invalid_input("lanes and decode_threads must be at least 1");
-  return s;
+  s.device = text("device");
+  s.keep_flow = take("keep_flow").cast<bool>();
+  s.flow_check_px = real("flow_check");
+  s.max_sigma_deg_s = real("max_sigma");  // predict --max-sigma, --smooth (issue 22)
+  s.smooth = text("smooth");
+  s.fuse = take("fuse").cast<bool>();  // predict --fuse (issue 23)
+  out.max_pairs = static_cast<std::size_t>(pairs);
+  out.lanes = take("lanes").cast<int>();
+  out.decode_threads = take("decode_threads").cast<int>();
+  if (out.lanes < 1 || out.decode_threads < 1) throw invalid_input("lanes and decode_threads must be at least 1");
+  for (const auto& item : options) {
+    const auto key = item.first.cast<std::string>();
+    if (std::find(taken.begin(), taken.end(), key) == taken.end()) {
+      throw py::type_error("unexpected predict keyword " + key);
+    }
+  }
+  return out;
 }
+
+}  // namespace inertialnet
 
 // Batches (inertialnet.batch, one Ray task per sequence): one sequence into its rates file as
 // `inertialnet predict SEQ... -o FOLDER` writes it, byte for byte, with the same provenance, and
@@ -1305,31 +1323,18 @@ PYBIND11_MODULE(_inertialnet, m) {
   m.def("read_image", [](const std::filesystem::path& path) { return to_uint8_rgb(load_rgb_image(existing(path, "the image"))); },
         py::arg("path"), "An image file as uint8 RGB (H, W, 3), gray replicated, as the CLI reads frames.");
 
-  m.def("_predict",
-        [](const std::filesystem::path& sequence, const std::vector<std::string>& weights, const std::string& model,
-           const std::string& flow, const std::string& head, const std::string& solver, const py::object& fx,
-           const py::object& fy, const py::object& cx, const py::object& cy, double rate_hz, const std::string& device,
-           bool keep_flow, const py::object& max_pairs, int lanes, int decode_threads, double flow_check,
-           const py::object& progress, const py::object& time_offset, double readout_time, const std::string& camera,
-           const std::string& calibration, const std::string& calibration_camera, const std::string& image_topic,
-           const std::string& camera_info_topic, double max_sigma, const std::string& smooth, bool fuse) {
-          const PredictSettings s = python_predict_settings(sequence, weights, model, flow, head, solver, fx, fy, cx, cy, rate_hz, device, keep_flow, max_pairs, lanes, decode_threads, flow_check, progress, time_offset, readout_time, camera, calibration, calibration_camera, image_topic, camera_info_topic, max_sigma, smooth, fuse);
-          return predict(s, static_cast<std::size_t>(integer_of(max_pairs, "max_pairs")), lanes, decode_threads, progress);
-        });
+  // predict(), batch.predict() and stream() pass their shared keywords as **options (_options.py).
+  m.def("_predict", [](const std::string& sequence, const std::vector<std::string>& weights, const py::kwargs& options) {
+    const PythonPredictOptions o = python_predict_options(sequence, weights, options);
+    return predict(o.settings, o.max_pairs, o.lanes, o.decode_threads, o.progress);
+  });
   m.def("_evaluate_json", &evaluate_json);
   // Batches (inertialnet/batch.py).
-  m.def("_predict_rates_file",
-        [](const std::filesystem::path& rates, bool skip_current, const std::filesystem::path& sequence, const std::vector<std::string>& weights, const std::string& model,
-           const std::string& flow, const std::string& head, const std::string& solver, const py::object& fx,
-           const py::object& fy, const py::object& cx, const py::object& cy, double rate_hz, const std::string& device,
-           bool keep_flow, const py::object& max_pairs, int lanes, int decode_threads, double flow_check,
-           const py::object& progress, const py::object& time_offset, double readout_time, const std::string& camera,
-           const std::string& calibration, const std::string& calibration_camera, const std::string& image_topic,
-           const std::string& camera_info_topic, double max_sigma, const std::string& smooth, bool fuse) {
-          const PredictSettings s = python_predict_settings(sequence, weights, model, flow, head, solver, fx, fy, cx, cy, rate_hz, device, keep_flow, max_pairs, lanes, decode_threads, flow_check, progress, time_offset, readout_time, camera, calibration, calibration_camera, image_topic, camera_info_topic, max_sigma, smooth, fuse);
-          return predict_rates_file_of(rates, skip_current, s, static_cast<std::size_t>(integer_of(max_pairs, "max_pairs")),
-                                       lanes, decode_threads, progress);
-        });
+  m.def("_predict_rates_file", [](const std::filesystem::path& rates, bool skip_current, const std::string& sequence,
+                                  const std::vector<std::string>& weights, const py::kwargs& options) {
+    const PythonPredictOptions o = python_predict_options(sequence, weights, options);
+    return predict_rates_file_of(rates, skip_current, o.settings, o.max_pairs, o.lanes, o.decode_threads, o.progress);
+  });
   m.def("_batch_rates_paths", [](const std::vector<std::filesystem::path>& sequences, const std::filesystem::path& folder) {
     std::vector<std::string> paths;
     for (const auto& p : batch_rates_paths(sequences, folder)) paths.push_back(p.string());

@@ -19,6 +19,7 @@
 #include "inertialnet/pipeline/predict.hpp"
 #include "inertialnet/pipeline/streaming_predictor.hpp"
 #include "inertialnet/runtime/error.hpp"
+#include "predict_options.hpp"
 
 namespace py = pybind11;
 
@@ -139,37 +140,11 @@ class Stream {
 void register_stream(py::module_& m) {
   using namespace inertialnet;
   py::class_<Stream>(m, "_Stream")
-      .def(py::init([](const std::string& sequence, const std::vector<std::string>& weights, const std::string& model,
-                       const std::string& flow, const std::string& head, const std::string& solver,
-                       std::optional<double> fx, std::optional<double> fy, std::optional<double> cx,
-                       std::optional<double> cy, const std::string& calibration, const std::string& calibration_camera,
-                       const std::string& camera, double rate_hz, const std::string& device, std::int64_t max_pairs,
-                       int lanes, double flow_check, double max_sigma, const std::string& smooth, bool fuse) {
-        if (max_pairs < 0) {
-          throw invalid_input("max_pairs must be a count of pairs (0 for all), got " + std::to_string(max_pairs));
-        }
-        if (lanes < 1) throw invalid_input("lanes must be at least 1");
-        PredictSettings s;
-        s.sequence = sequence;
-        s.weights = weights;
-        s.model = model;
-        s.flow = flow;
-        s.head = head;
-        s.solver = solver;
-        s.fx = fx;
-        s.fy = fy;
-        s.cx = cx;
-        s.cy = cy;  // None: not given (cx = 0 is a principal point, as predict() takes it)
-        s.calibration = calibration;
-        s.calibration_camera = calibration_camera;
-        s.camera = camera;
-        s.rate_hz = rate_hz;
-        s.device = device;
-        s.flow_check_px = flow_check;
-        s.max_sigma_deg_s = max_sigma;  // predict --max-sigma, --smooth (issue 22)
-        s.smooth = smooth;
-        s.fuse = fuse;  // predict --fuse (issue 23)
-        return std::make_unique<Stream>(s, static_cast<std::size_t>(max_pairs), lanes);
+      // stream()'s keywords are predict()'s (_options.py), read by the same code; the sequence may be
+      // a live source that is no file.
+      .def(py::init([](const std::string& sequence, const std::vector<std::string>& weights, const py::kwargs& options) {
+        const PythonPredictOptions o = python_predict_options(sequence, weights, options, /*live=*/true);
+        return std::make_unique<Stream>(o.settings, o.max_pairs, o.lanes);
       }))
       .def("__iter__", [](py::object self) { return self; })
       .def("__next__", &Stream::next)

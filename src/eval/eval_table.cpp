@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "inertialnet/core/text_table.hpp"
 #include "inertialnet/eval/metrics.hpp"
 #include "inertialnet/eval/plots.hpp"
 
@@ -89,19 +90,23 @@ EvalTable eval_table(std::vector<EvalTableRow> rows) {
 std::string EvalTable::text() const {
   std::size_t name_w = 8;
   for (const auto& r : rows) name_w = std::max(name_w, r.name.size());
-  const int w = static_cast<int>(name_w);
-  char buf[512];
-  std::snprintf(buf, sizeof buf, "%-*s  %7s  %11s  %9s  %10s  %10s  %10s  %24s  %6s  %s\n", w, "sequence", "images",
-                "IMU samples", "evaluated", "wx [deg/s]", "wy [deg/s]", "wz [deg/s]", "zero predictor x/y/z", "non-ok",
-                "truth");
-  std::string out = buf;
+  const TextTable table({{"sequence", name_w, true},
+                         {"images", 7},
+                         {"IMU samples", 11},
+                         {"evaluated", 9},
+                         {"wx [deg/s]", 10},
+                         {"wy [deg/s]", 10},
+                         {"wz [deg/s]", 10},
+                         {"zero predictor x/y/z", 24},
+                         {"non-ok", 6},
+                         {"truth", 0, true}});
+  std::string out = table.header();
   const auto line = [&](const EvalTableRow& r) {
-    char zero[64];
-    std::snprintf(zero, sizeof zero, "%.2f/%.2f/%.2f", r.zero_rmse_deg_s[0], r.zero_rmse_deg_s[1], r.zero_rmse_deg_s[2]);
-    std::snprintf(buf, sizeof buf, "%-*s  %7zu  %11zu  %9zu  %10.2f  %10.2f  %10.2f  %24s  %6zu  %s\n", w, r.name.c_str(),
-                  r.images, r.imu_samples, r.evaluated, r.rmse_deg_s[0], r.rmse_deg_s[1], r.rmse_deg_s[2], zero,
-                  r.not_ok, r.truth.c_str());
-    out += buf;
+    out += table.row({r.name, std::to_string(r.images), std::to_string(r.imu_samples), std::to_string(r.evaluated),
+                      text_cell("%.2f", r.rmse_deg_s[0]), text_cell("%.2f", r.rmse_deg_s[1]),
+                      text_cell("%.2f", r.rmse_deg_s[2]),
+                      text_cell("%.2f/%.2f/%.2f", r.zero_rmse_deg_s[0], r.zero_rmse_deg_s[1], r.zero_rmse_deg_s[2]),
+                      std::to_string(r.not_ok), r.truth});
   };
   for (const auto& r : rows) line(r);
   line(total);

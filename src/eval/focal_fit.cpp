@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "eval/fit_samples.hpp"
 #include "inertialnet/eval/metrics.hpp"
 #include "inertialnet/runtime/error.hpp"
 
@@ -13,14 +14,11 @@ namespace inertialnet {
 
 namespace {
 
-// Axis k of `values` minus its mean: a gyro bias, which images cannot see, is not a scale.
-std::vector<double> centred_axis(const std::vector<Vec3>& values, int k) {
-  double mean = 0;
-  for (const auto& v : values) mean += v[static_cast<std::size_t>(k)];
-  mean /= static_cast<double>(values.size());
+// Axis k of `values`.
+std::vector<double> axis(const std::vector<Vec3>& values, int k) {
   std::vector<double> out;
   out.reserve(values.size());
-  for (const auto& v : values) out.push_back(v[static_cast<std::size_t>(k)] - mean);
+  for (const auto& v : values) out.push_back(v[static_cast<std::size_t>(k)]);
   return out;
 }
 
@@ -116,16 +114,13 @@ std::string FocalFit::summary() const {
 }
 
 FocalFit fit_focal_scale(const std::vector<Vec3>& predicted, const std::vector<Vec3>& gyro) {
-  if (predicted.size() != gyro.size() || predicted.size() < 3) {
-    throw invalid_input("Focal-length fit: " + std::to_string(predicted.size()) + " predictions and " +
-                        std::to_string(gyro.size()) + " gyro targets; at least 3 of each, as many of one as of the other.");
-  }
+  // A gyro bias, which images cannot see, is not a scale: both sides centred.
+  const detail::CentredSamples c = detail::centred_samples(predicted, gyro, "Focal-length fit");
   FocalFit fit;
   fit.pairs = predicted.size();
   const double n = static_cast<double>(predicted.size());
-  const Slope xy = slope_over({centred_axis(predicted, 0), centred_axis(predicted, 1)},
-                              {centred_axis(gyro, 0), centred_axis(gyro, 1)});
-  const Slope z = slope_over({centred_axis(predicted, 2)}, {centred_axis(gyro, 2)});
+  const Slope xy = slope_over({axis(c.predicted, 0), axis(c.predicted, 1)}, {axis(c.gyro, 0), axis(c.gyro, 1)});
+  const Slope z = slope_over({axis(c.predicted, 2)}, {axis(c.gyro, 2)});
   fit.excitation_deg_s = std::sqrt(xy.gg / (2 * n)) * kDegreesPerRadian;
   fit.rmse_deg_s = std::sqrt(xy.cost_one / (2 * n)) * kDegreesPerRadian;
   // The control needs some roll to say anything; without it it stays 1 ± infinity (no verdict).

@@ -8,6 +8,7 @@
 #include <Eigen/Dense>
 
 #include "core/so3.hpp"
+#include "eval/fit_samples.hpp"
 #include "inertialnet/eval/metrics.hpp"
 #include "inertialnet/runtime/error.hpp"
 
@@ -16,17 +17,6 @@ namespace inertialnet {
 namespace {
 
 Eigen::Vector3d eigen(const Vec3& v) { return {v[0], v[1], v[2]}; }
-
-// Each side minus its mean: the constant offset (a gyro bias) the fit must not see.
-std::vector<Eigen::Vector3d> centred(const std::vector<Vec3>& values) {
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (const auto& v : values) mean += eigen(v);
-  mean /= static_cast<double>(values.size());
-  std::vector<Eigen::Vector3d> out;
-  out.reserve(values.size());
-  for (const auto& v : values) out.push_back(eigen(v) - mean);
-  return out;
-}
 
 double rms(const std::vector<Eigen::Vector3d>& p, const std::vector<Eigen::Vector3d>& g, const Eigen::Matrix3d& r) {
   double cost = 0;
@@ -69,11 +59,12 @@ std::string RotationFit::confidence() const {
 }
 
 RotationFit fit_rotation(const std::vector<Vec3>& predicted, const std::vector<Vec3>& gyro) {
-  if (predicted.size() != gyro.size() || predicted.size() < 3) {
-    throw invalid_input("Rotation fit: " + std::to_string(predicted.size()) + " predictions and " +
-                        std::to_string(gyro.size()) + " gyro targets; at least 3 of each, as many of one as of the other.");
+  const detail::CentredSamples samples = detail::centred_samples(predicted, gyro, "Rotation fit");
+  std::vector<Eigen::Vector3d> p, g;
+  for (std::size_t i = 0; i < samples.predicted.size(); ++i) {
+    p.push_back(eigen(samples.predicted[i]));
+    g.push_back(eigen(samples.gyro[i]));
   }
-  const std::vector<Eigen::Vector3d> p = centred(predicted), g = centred(gyro);
   RotationFit fit;
   fit.pairs = p.size();
   const double n = static_cast<double>(p.size());

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "inertialnet/io/live_source.hpp"
+#include "inertialnet/pipeline/rate_settings.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/runtime/version.hpp"
 #include "runtime/hash.hpp"
@@ -23,13 +24,6 @@ namespace {
 std::string hex64(std::uint64_t v) {
   char text[24];
   std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(v));
-  return text;
-}
-
-// %.17g: a setting's exact value, so that 0.5 and 0.50000001 are different settings.
-std::string number(double v) {
-  char text[40];
-  std::snprintf(text, sizeof text, "%.17g", v);
   return text;
 }
 
@@ -73,8 +67,6 @@ std::string inputs_fingerprint(const fs::path& sequence) {
   for (const auto& line : lines) hash = detail::fnv1a64(line + "\n", hash);
   return std::to_string(lines.size()) + " files, fnv1a64 " + hex64(hash);
 }
-
-std::string optional_number(const std::optional<double>& v) { return v ? number(*v) : std::string("none"); }
 
 }  // namespace
 
@@ -146,27 +138,9 @@ Provenance prediction_provenance(const PredictSettings& s, std::size_t max_pairs
   p.emplace_back("weights", weights.empty() ? "none" : weights);
   p.emplace_back("calibration",
                  s.calibration.empty() ? "none" : "fnv1a64 " + hex64(file_hash(s.calibration, "the calibration file")));
-  // Every setting of PredictSettings that changes a rate or the file's metadata; not the device,
-  // the lanes or the decoding threads (the header says why).
-  p.emplace_back("model", s.model);
-  p.emplace_back("flow", s.flow);
-  p.emplace_back("head", s.head);
-  p.emplace_back("solver", s.solver);
-  p.emplace_back("fx", optional_number(s.fx));
-  p.emplace_back("fy", optional_number(s.fy));
-  p.emplace_back("cx", optional_number(s.cx));
-  p.emplace_back("cy", optional_number(s.cy));
-  p.emplace_back("calibration_camera", s.calibration_camera);
-  p.emplace_back("rate_hz", number(s.rate_hz));
-  p.emplace_back("camera", s.camera);
-  p.emplace_back("image_topic", s.bag.image);
-  p.emplace_back("camera_info_topic", s.bag.camera_info);
-  p.emplace_back("readout_time_s", number(s.readout_time_s));
-  p.emplace_back("flow_check_px", number(s.flow_check_px));
-  p.emplace_back("max_sigma_deg_s", number(s.max_sigma_deg_s));
-  p.emplace_back("smooth", s.smooth);
-  p.emplace_back("fuse", s.fuse ? "yes" : "no");
-  p.emplace_back("time_offset_s", optional_number(s.time_offset_s));
+  // Every setting of PredictSettings that changes a rate or the file's metadata (rate_settings.hpp);
+  // not the device, the lanes or the decoding threads (the header says why).
+  for (const RateSetting& setting : rate_settings()) p.emplace_back(setting.name, setting.text(s));
   p.emplace_back("max_pairs", std::to_string(max_pairs));
   return p;
 }

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common.hpp"
+#include "inertialnet/core/text_table.hpp"
 
 namespace inertialnet::cli {
 
@@ -61,19 +62,18 @@ std::string format_bench_text(const BenchResult& r, bool layers) {
   out += format_kind_table(group_by_kind(r.layers));
   if (!r.gemm_references.empty()) {
     out += "\nthe packed GEMM alone on each kind's heaviest product (operands packed beforehand):\n";
-    char row[256];
-    std::snprintf(row, sizeof row, "%-22s %9s %9s  %-24s %s\n", "kind", "GFLOP/s", "of GEMM", "M×N×K", "layer");
-    out += row;
+    const TextTable table({{"kind", 22, true, 0}, {"GFLOP/s", 9, false, 1}, {"of GEMM", 9, false, 1},
+                           {"M×N×K", 24, true, 2}, {"layer", 0, true, 1}});
+    out += table.header();
     for (const auto& k : group_by_kind(r.layers)) {
       const KindGemmReference* reference = reference_of(r, k.kind);
       if (!reference) continue;
       const double gflops = k.seconds > 0 ? k.flops * 1e-9 / k.seconds : 0;
       const std::string product =
           std::to_string(reference->m) + "×" + std::to_string(reference->n) + "×" + std::to_string(reference->k);
-      std::snprintf(row, sizeof row, "%-22s %9.1f %8.0f%%  %-24s %s\n", k.kind.c_str(), reference->gflops,
-                    reference->gflops > 0 ? 100 * gflops / reference->gflops : 0, product.c_str(),
-                    reference->layer.c_str());
-      out += row;
+      out += table.row({k.kind, text_cell("%.1f", reference->gflops),
+                        text_cell("%.0f%%", reference->gflops > 0 ? 100 * gflops / reference->gflops : 0), product,
+                        reference->layer});
     }
   }
   if (layers) out += "\nper layer:\n" + format_layer_table(r.layers);

@@ -25,6 +25,8 @@
 
 namespace inertialnet {
 
+// A new field goes into rate_settings.cpp too (a batch's provenance, or the list of fields outside
+// it with why); test_rate_settings fails until it is there.
 struct PredictSettings {
   std::filesystem::path sequence;    // EuRoC folder, image folder, video or live source (io/live_source.hpp)
   std::vector<std::string> weights;  // safetensors files; empty: the weight-free path
