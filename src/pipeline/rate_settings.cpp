@@ -49,6 +49,8 @@ const std::vector<SettingOutside>& settings_outside_rate_settings() {
       {"sequence", "recorded by its files' names, sizes and times (provenance \"inputs\")"},
       {"weights", "recorded by each file's bytes (provenance \"weights\")"},
       {"calibration", "recorded by the file's bytes (provenance \"calibration\")"},
+      {"head_sigma_override",
+       "set only by calibrate-sigma's fit to read the raw spread; predict and batches never set it"},
       {"device", "two devices' rates agree to float rounding; a batch over mixed devices must stay current"},
       {"no_cache", "the program cache changes how fast kernels load, not what they compute"},
       {"keep_flow", "keeps each pair's flow in memory; the rates are the same"},

@@ -24,17 +24,18 @@ namespace {
 // as outside.
 auto fields(PredictSettings& s) {
   auto& [sequence, weights, model, flow, head, solver, calibration, calibration_camera, fx, fy, cx, cy, rate_hz, camera,
-         bag, readout_time_s, flow_check_px, max_sigma_deg_s, smooth, fuse, time_offset_s, device, no_cache, keep_flow,
-         profiler] = s;
+         bag, readout_time_s, flow_check_px, max_sigma_deg_s, smooth, fuse, head_sigma_override, time_offset_s, device,
+         no_cache, keep_flow, profiler] = s;
   return std::tie(sequence, weights, model, flow, head, solver, calibration, calibration_camera, fx, fy, cx, cy, rate_hz,
-                  camera, bag, readout_time_s, flow_check_px, max_sigma_deg_s, smooth, fuse, time_offset_s, device,
-                  no_cache, keep_flow, profiler);
+                  camera, bag, readout_time_s, flow_check_px, max_sigma_deg_s, smooth, fuse, head_sigma_override,
+                  time_offset_s, device, no_cache, keep_flow, profiler);
 }
 
 const std::vector<std::string> kFieldNames = {
     "sequence", "weights",       "model",           "flow",   "head",  "solver",        "calibration",
     "calibration_camera", "fx",  "fy",              "cx",     "cy",    "rate_hz",       "camera",
-    "bag",      "readout_time_s", "flow_check_px",  "max_sigma_deg_s", "smooth", "fuse", "time_offset_s",
+    "bag",      "readout_time_s", "flow_check_px",  "max_sigma_deg_s", "smooth", "fuse", "head_sigma_override",
+    "time_offset_s",
     "device",   "no_cache",      "keep_flow",       "profiler"};
 
 LayerProfiler some_profiler;
@@ -46,6 +47,7 @@ void change(std::string& v) { v += "_changed"; }
 void change(std::optional<double>& v) { v = v ? *v + 1 : 1.25; }
 void change(double& v) { v += 1; }
 void change(bool& v) { v = !v; }
+void change(std::optional<HeadSigmaOptions>& v) { v = v ? std::nullopt : std::optional<HeadSigmaOptions>(HeadSigmaOptions{}); }
 void change(BagTopics& v) {
   v.image += "_changed";
   v.camera_info += "_changed";
