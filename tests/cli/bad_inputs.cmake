@@ -450,3 +450,6 @@ expect_match("--manifest missing_manifest.txt: it lists the sequence .*no_such_s
 if(EXISTS "${WORK}/missing_batch/seq.csv")
   message(FATAL_ERROR "the batch computed seq before refusing the manifest")
 endif()
+# The readout time quoted as given (std::to_string wrote -1.000000).
+run(2 ${CLI} predict seq --readout-time -1)
+expect_match("the readout time should be between 0 and 1 s, got -1[\r\n]")
