@@ -453,3 +453,11 @@ endif()
 # The readout time quoted as given (std::to_string wrote -1.000000).
 run(2 ${CLI} predict seq --readout-time -1)
 expect_match("the readout time should be between 0 and 1 s, got -1[\r\n]")
+# train --dropout and --augment-rotation, named at parse (the library's checks named no option and
+# quoted 1 as 1.000000).
+run(2 ${CLI} train --train seq --val seq -o head.safetensors --dropout 1)
+expect_match("--dropout: must be below 1 \\(1 drops every unit\\), got 1")
+run(2 ${CLI} train --train seq --val seq -o head.safetensors --dropout nan)
+expect_match("--dropout: must be a finite number from 0 up, got nan")
+run(2 ${CLI} train --train seq --val seq -o head.safetensors --augment-rotation 1e6)
+expect_match("--augment-rotation: must be at most 1000 deg/s, got 1e6")
