@@ -388,7 +388,9 @@ expect_no_match("time_offset_s")
 # 2 with one message naming the option, file or key and the value, before anything is computed.
 # Numbers that CLI11's Range let through by other names ("Value abc not in range"):
 run(2 ${CLI} predict seq --max-sigma abc)
-expect_match("--max-sigma: must be a finite number from 0 up, got abc")
+# CLI11's messages too start with `inertialnet: error:` (docs/cli.md, "Output"), one line with
+# the subcommand's help named (they came bare, with "Run with --help …" on a second line).
+expect_match("^inertialnet: error: --max-sigma: must be a finite number from 0 up, got abc \\(see inertialnet predict --help\\)\n$")
 run(2 ${CLI} predict seq --flow-check nan)
 expect_match("--flow-check: must be a finite number from 0 up, got nan")
 # --smooth: q read by strtod (0x10 was 16), q's value and the option named, a lag of four digits.
