@@ -6,8 +6,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
+#include <regex>
 
 #include "inertialnet/runtime/error.hpp"
+#include "inertialnet/runtime/excerpt.hpp"
 #include "inertialnet/eval/mocap_bias.hpp"
 #include "inertialnet/eval/spline.hpp"
 
@@ -120,24 +122,31 @@ SyncTarget parse_sync_target(const std::string& text) {
 }
 
 Vec3 parse_vec3(const std::string& text, const std::string& what) {
-  Vec3 v{};
-  std::size_t pos = 0;
-  for (int k = 0; k < 3; ++k) {
-    const std::size_t comma = k < 2 ? text.find(',', pos) : text.size();
-    if (comma == std::string::npos) break;
-    std::string field = text.substr(pos, comma - pos);
+  std::vector<std::string> fields;
+  for (std::size_t pos = 0;;) {
+    const std::size_t comma = text.find(',', pos);
+    std::string field = text.substr(pos, comma == std::string::npos ? std::string::npos : comma - pos);
     const auto b = field.find_first_not_of(" \t");
     const auto e = field.find_last_not_of(" \t");
-    field = b == std::string::npos ? "" : field.substr(b, e - b + 1);
-    char* end = nullptr;
-    v[k] = std::strtod(field.c_str(), &end);
-    if (field.empty() || *end != '\0' || !std::isfinite(v[k])) {
-      throw invalid_input(what + " should be three numbers x,y,z; \"" + field + "\" is not a number.");
-    }
+    fields.push_back(b == std::string::npos ? "" : field.substr(b, e - b + 1));
+    if (comma == std::string::npos) break;
     pos = comma + 1;
-    if (k == 2) return v;
   }
-  throw invalid_input(what + " should be three comma-separated numbers x,y,z, found \"" + text + "\".");
+  if (fields.size() != 3) {
+    throw invalid_input(what + " should be three comma-separated numbers x,y,z, found \"" + excerpt(text) + "\"" +
+                        (fields.size() > 3 ? " (" + std::to_string(fields.size()) + " fields)" : std::string()) + ".");
+  }
+  // Decimal only, as parse_seconds: strtod alone would also read "0x1" as 1, "inf" and "nan".
+  static const std::regex decimal(R"(^[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?$)");
+  Vec3 v{};
+  for (int k = 0; k < 3; ++k) {
+    const std::string& field = fields[static_cast<std::size_t>(k)];
+    v[k] = std::regex_match(field, decimal) ? std::strtod(field.c_str(), nullptr) : std::nan("");
+    if (!std::isfinite(v[k])) {
+      throw invalid_input(what + " should be three decimal numbers x,y,z; \"" + excerpt(field) + "\" is not one.");
+    }
+  }
+  return v;
 }
 
 std::vector<Vec3> GyroTruth::corrected() const {

@@ -118,7 +118,10 @@ TimeOffsetEstimate estimate_time_offset(const std::vector<std::int64_t>& from, c
   }
   if (!(options.range_s > 0) || !(options.step_s > 0) || !std::isfinite(options.range_s) ||
       options.step_s > options.range_s) {
-    throw invalid_input("Time offset: the search range and step should be positive, with the step below the range.");
+    char values[96];
+    std::snprintf(values, sizeof values, " (range +-%g s, step %g s)", options.range_s, options.step_s);
+    throw invalid_input(std::string("Time offset: the search range and step should be positive, with the step below "
+                                    "the range") + values + ".");
   }
   if (imu.size() < 2) throw invalid_input("Time offset: the IMU has fewer than 2 samples.");
 

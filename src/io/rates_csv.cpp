@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "inertialnet/runtime/error.hpp"
+#include "inertialnet/runtime/excerpt.hpp"
 #include "io/csv_util.hpp"
 #include "runtime/atomic_file.hpp"
 #include "runtime/hash.hpp"
@@ -257,6 +258,10 @@ void read_sidecar(const fs::path& path, RatesTable& table) {
   } catch (const nlohmann::json::parse_error& e) {
     throw invalid_input(sidecar.string() + " (the sidecar of " + path.string() +
                         ") is not valid JSON (at byte " + std::to_string(e.byte) + ").");
+  } catch (const nlohmann::json::exception&) {
+    // A number beyond a double (1e400) is out_of_range 406, not a parse_error: bad input all the same.
+    throw invalid_input(sidecar.string() + " (the sidecar of " + path.string() +
+                        ") holds a number beyond the range of a double (such as 1e400).");
   }
   const auto wrong = [&](const std::string& what) {
     return invalid_input(sidecar.string() + " (the sidecar of " + path.string() + "): " + what);
@@ -412,7 +417,16 @@ RatesTable read_rates_csv(const fs::path& path) {
     // An empty cell is an unknown rate, allowed where the column's status says why.
     const auto value = [&](std::string_view field, const std::string& column, int status, bool rate) {
       if (field.empty() && is_sigma_column(column)) return std::nan("");
-      if (is_sigma_column(column)) return csv::parse_double(field, path, ln, column);
+      if (is_sigma_column(column)) {
+        // A standard deviation: never negative, and bounded as the rates are (its square is a
+        // weight's denominator in fusion and smoothing).
+        const double sigma = csv::parse_bounded(field, path, ln, column, 1e3, "rad/s");
+        if (sigma < 0) {
+          throw invalid_input(path.string() + " line " + std::to_string(ln) + ": " + column + " is \"" +
+                              excerpt(std::string(field)) + "\"; a standard deviation cannot be negative.");
+        }
+        return sigma;
+      }
       if (field.empty() && status >= 0 && !ok[static_cast<std::size_t>(status)]) return std::nan("");
       if (field.empty() && status >= 0) {
         throw invalid_input(path.string() + " line " + std::to_string(ln) + ": " + column + " is empty but " +

@@ -230,18 +230,20 @@ Prediction::Prediction(const PredictSettings& s) : settings_(s) {
     throw invalid_input("unknown solver '" + s.solver + "'; expected motion-field or opengv");
   }
   if (!std::isfinite(s.readout_time_s) || s.readout_time_s < 0 || s.readout_time_s > 1) {
-    throw invalid_input("the readout time should be between 0 and 1 s, got " + std::to_string(s.readout_time_s));
+    // pixels_text: the number as given (std::to_string wrote -1 as -1.000000 and 1e-9 as 0.000000).
+    throw invalid_input("the readout time should be between 0 and 1 s, got " + pixels_text(s.readout_time_s));
   }
   if (s.time_offset_s && (!std::isfinite(*s.time_offset_s) || std::abs(*s.time_offset_s) > 3600)) {
     throw invalid_input("the time offset should be a finite number of seconds within an hour, got " +
-                        std::to_string(*s.time_offset_s));
+                        pixels_text(*s.time_offset_s));
   }
   processor_.geometric.readout_time_s = s.readout_time_s;
   require_flow_check_setting(s.flow_check_px);
   processor_.flow_check_px = s.flow_check_px;
-  if (!std::isfinite(s.max_sigma_deg_s) || s.max_sigma_deg_s < 0) {
-    throw invalid_input("--max-sigma must be a non-negative number of deg/s (0: no limit), got " +
-                        std::to_string(s.max_sigma_deg_s));
+  // The CLI's bound too (Python's max_sigma= takes this check): beyond it no σ is ever refused.
+  if (!std::isfinite(s.max_sigma_deg_s) || s.max_sigma_deg_s < 0 || s.max_sigma_deg_s > 1e6) {
+    throw invalid_input("--max-sigma must be a non-negative number of deg/s (0: no limit) up to 1e+06, got " +
+                        pixels_text(s.max_sigma_deg_s));
   }
   processor_.max_sigma_rad_s = s.max_sigma_deg_s * kPi / 180;
   smoother_ = parse_rate_smoother(s.smooth);

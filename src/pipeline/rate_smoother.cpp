@@ -8,10 +8,12 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <regex>
 #include <string>
 #include <utility>
 
 #include "inertialnet/runtime/error.hpp"
+#include "inertialnet/runtime/excerpt.hpp"
 
 namespace inertialnet {
 namespace {
@@ -53,8 +55,12 @@ Eigen::Matrix2d transition(double dt) {
 
 void RateSmootherOptions::validate() const {
   if (lag < 0 || lag > 100) throw invalid_input("the smoother's lag must be 0 to 100 pairs, got " + std::to_string(lag));
-  if (!(jerk_density > 0) || !std::isfinite(jerk_density)) {
-    throw invalid_input("the smoother's q (spectral density of the rate's acceleration change) must be a positive number");
+  if (!(jerk_density >= kMinJerkDensity && jerk_density <= kMaxJerkDensity)) {
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "the smoother's q (spectral density of the rate's acceleration change) must be from %g to %g, got %g",
+                  kMinJerkDensity, kMaxJerkDensity, jerk_density);
+    throw invalid_input(text);
   }
 }
 
@@ -69,17 +75,30 @@ RateSmootherOptions parse_rate_smoother(const std::string& text) {
   const std::string rest = text.substr(4);
   const auto comma = rest.find(',');
   const std::string lag = rest.substr(0, comma);
-  if (lag.empty() || lag.size() > 3 || lag.find_first_not_of("0123456789") != std::string::npos) throw bad();
+  if (lag.empty() || lag.find_first_not_of("0123456789") != std::string::npos) throw bad();
+  const std::string where = "--smooth \"" + excerpt(text) + "\": ";
+  // Digits only, so that a lag of any length is named, not thrown out of std::stoi.
+  if (lag.find_first_not_of('0') != std::string::npos && lag.size() - lag.find_first_not_of('0') > 3) {
+    throw invalid_input(where + "the lag must be 0 to 100 pairs, got " + excerpt(lag));
+  }
   o.lag = std::stoi(lag);
   if (comma != std::string::npos) {
     const std::string q = rest.substr(comma + 1);
     if (q.rfind("q:", 0) != 0 || q.size() == 2) throw bad();
-    char* end = nullptr;
-    o.jerk_density = std::strtod(q.c_str() + 2, &end);
-    if (*end != '\0') throw bad();
+    // Decimal only: strtod alone would also read "0x10", "inf" and "nan".
+    static const std::regex decimal(R"(^[+-]?([0-9]+\.?[0-9]*|\.[0-9]+)([eE][+-]?[0-9]+)?$)");
+    const std::string value = q.substr(2);
+    if (!std::regex_match(value, decimal)) {
+      throw invalid_input(where + "q must be a positive decimal number, got " + excerpt(value));
+    }
+    o.jerk_density = std::strtod(value.c_str(), nullptr);
   }
   o.enabled = true;
-  o.validate();
+  try {
+    o.validate();
+  } catch (const Error& e) {
+    throw invalid_input(where + e.what());  // the option and what was given, beside the rule
+  }
   return o;
 }
 

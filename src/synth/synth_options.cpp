@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "inertialnet/core/constants.hpp"
@@ -70,8 +71,11 @@ void SynthOptions::validate() const {
     const auto& e = o.extrinsic_error_deg;
     const double angle = std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
     if (!(std::isfinite(angle) && angle <= 30)) {
+      // The vector as given: its length overflows to inf for a component of 1e300.
+      char given[96];
+      std::snprintf(given, sizeof given, "(%g, %g, %g)", e[0], e[1], e[2]);
       throw invalid_input("synth: the camera-IMU rotation error should be a rotation vector of at most 30 degrees, found " +
-                          std::to_string(angle) + " degrees.");
+                          std::string(given) + " degrees.");
     }
   }
   if (!(std::isfinite(o.drop_fraction) && o.drop_fraction >= 0 && o.drop_fraction <= 0.5)) {

@@ -383,3 +383,83 @@ run(1 ${CLI} calibrate-time still)
 expect_match("time offset not determined: the predicted rates show no rotation")
 expect_no_match("apply it with")
 expect_no_match("time_offset_s")
+
+# --- The options and files of the last wave (issues 22-25), audited for bad input: each is exit
+# 2 with one message naming the option, file or key and the value, before anything is computed.
+# Numbers that CLI11's Range let through by other names ("Value abc not in range"):
+run(2 ${CLI} predict seq --max-sigma abc)
+# CLI11's messages too start with `inertialnet: error:` (docs/cli.md, "Output"), one line with
+# the subcommand's help named (they came bare, with "Run with --help …" on a second line).
+expect_match("^inertialnet: error: --max-sigma: must be a finite number from 0 up, got abc \\(see inertialnet predict --help\\)\n$")
+run(2 ${CLI} predict seq --flow-check nan)
+expect_match("--flow-check: must be a finite number from 0 up, got nan")
+# --smooth: q read by strtod (0x10 was 16), q's value and the option named, a lag of four digits.
+run(2 ${CLI} predict seq --smooth lag:2,q:0x10)
+expect_match("--smooth \"lag:2,q:0x10\": q must be a positive decimal number, got 0x10")
+run(2 ${CLI} predict seq --smooth lag:2,q:nan)
+expect_match("--smooth \"lag:2,q:nan\": q must be a positive decimal number, got nan")
+run(2 ${CLI} predict seq --smooth lag:2,q:1e300)
+expect_match("--smooth \"lag:2,q:1e300\": .*must be from 1e-06 to 1e\\+06, got 1e\\+300")
+run(2 ${CLI} predict seq --smooth lag:1000)
+expect_match("--smooth \"lag:1000\": the lag must be 0 to 100 pairs, got 1000")
+# calibrate --range and eval --time-offset-range: named and refused at parse (calibrate refused a
+# NaN only after predicting every pair, without naming it; 1e300 was echoed in 300 digits).
+run(2 ${CLI} calibrate seq --range nan)
+expect_match("--range: must be a finite positive number, got nan")
+expect_no_match("predicting")
+run(2 ${CLI} eval rates.csv seq --time-offset auto --time-offset-range 1e300)
+expect_match("--time-offset-range: must be at most 3600 s, got 1e300")
+# Three numbers x,y,z (--extrinsic-error, --gyro-bias, --rotation-correction): decimal only (0x1
+# was read as 1), a bias no gyro has refused (1e300 ran to exit 0).
+run(2 ${CLI} synth hex_extrinsic --frames 2 --size 64x48 --extrinsic-error 0x1,0,0)
+expect_match("--extrinsic-error should be three decimal numbers x,y,z; \"0x1\" is not one")
+run(2 ${CLI} synth huge_extrinsic --frames 2 --size 64x48 --extrinsic-error 1e300,0,0)
+expect_match("rotation vector of at most 30 degrees, found \\(1e\\+300, 0, 0\\) degrees")
+run(2 ${CLI} eval rates.csv seq --gyro-bias 1e300,0,0)
+expect_match("--gyro-bias: each component should be within \\+-1000 rad/s, found \"1e300,0,0\"")
+run(2 ${CLI} eval rates.csv seq --rotation-correction 0x1,0,0)
+expect_match("--rotation-correction should be three decimal numbers x,y,z; \"0x1\" is not one")
+# eval --calibration-from: a report with a number beyond a double (exit 1 with the JSON library's
+# text before), a readout the rates cannot have, a rotation or rating of another schema (taken
+# silently before). A minimal good report first, so that each case differs from it by one key.
+set(report_head "{\"schema\": \"inertialnet.calibrate/1\", ")
+set(good_offset "\"time_offset\": {\"determined\": true, \"confidence\": \"high\", \"offset_s\": 0.001}")
+file(WRITE "${WORK}/calib_good.json" "${report_head}\"rates_readout_time_s\": 0, ${good_offset}}")
+run(0 ${CLI} eval rates.csv seq --calibration-from calib_good.json)
+file(WRITE "${WORK}/calib_overflow.json" "${report_head}\"rates_readout_time_s\": 1e400, ${good_offset}}")
+run(2 ${CLI} eval rates.csv seq --calibration-from calib_overflow.json)
+expect_match("--calibration-from calib_overflow.json: holds a number beyond the range of a double")
+expect_no_match("json.exception")
+file(WRITE "${WORK}/calib_readout.json" "${report_head}\"rates_readout_time_s\": -5, ${good_offset}}")
+run(2 ${CLI} eval rates.csv seq --calibration-from calib_readout.json)
+expect_match("calib_readout.json: key \"rates_readout_time_s\" should be a readout time from 0 to 1 s, found -5")
+file(WRITE "${WORK}/calib_rotation.json" "${report_head}${good_offset}, \"rotation_correction\": [1, 2, 3]}")
+run(2 ${CLI} eval rates.csv seq --calibration-from calib_rotation.json)
+expect_match("calib_rotation.json: key \"rotation_correction\" should be an object, found \\[1,2,3\\]")
+file(WRITE "${WORK}/calib_rating.json"
+     "${report_head}\"time_offset\": {\"determined\": true, \"confidence\": \"great\", \"offset_s\": 0.001}}")
+run(2 ${CLI} eval rates.csv seq --calibration-from calib_rating.json)
+expect_match("calib_rating.json: key \"time_offset.confidence\" should be high, medium, low or none, found \"great\"")
+file(WRITE "${WORK}/calib_offset.json"
+     "${report_head}\"time_offset\": {\"determined\": true, \"confidence\": \"high\", \"offset_s\": \"0.001\"}}")
+run(2 ${CLI} eval rates.csv seq --calibration-from calib_offset.json)
+expect_match("calib_offset.json: key \"time_offset.offset_s\" should be a number, found \"0.001\"")
+# A batch whose manifest lists a sequence that is not there: refused before the first sequence is
+# computed (it stopped the batch at its turn, naming neither the manifest nor the line's path).
+file(WRITE "${WORK}/missing_manifest.txt" "seq\n\nno_such_sequence\n")
+run(2 ${CLI} predict --manifest missing_manifest.txt -o missing_batch/)
+expect_match("--manifest missing_manifest.txt: it lists the sequence .*no_such_sequence, which does not exist; nothing was computed")
+if(EXISTS "${WORK}/missing_batch/seq.csv")
+  message(FATAL_ERROR "the batch computed seq before refusing the manifest")
+endif()
+# The readout time quoted as given (std::to_string wrote -1.000000).
+run(2 ${CLI} predict seq --readout-time -1)
+expect_match("the readout time should be between 0 and 1 s, got -1[\r\n]")
+# train --dropout and --augment-rotation, named at parse (the library's checks named no option and
+# quoted 1 as 1.000000).
+run(2 ${CLI} train --train seq --val seq -o head.safetensors --dropout 1)
+expect_match("--dropout: must be below 1 \\(1 drops every unit\\), got 1")
+run(2 ${CLI} train --train seq --val seq -o head.safetensors --dropout nan)
+expect_match("--dropout: must be a finite number from 0 up, got nan")
+run(2 ${CLI} train --train seq --val seq -o head.safetensors --augment-rotation 1e6)
+expect_match("--augment-rotation: must be at most 1000 deg/s, got 1e6")

@@ -198,7 +198,7 @@ expect_match("\"augment_rotation_deg_s\":30")
 run(2 ${CLI} train --train a --val b --head-size 64x48 --head-input pixels -o x.safetensors)
 expect_match("unknown head input 'pixels'; expected normalized or paper")
 run(2 ${CLI} train --train a --val b --head-size 64x48 --augment-rotation -5 -o x.safetensors)
-expect_match("the rotation augmentation's largest rate must be from 0 to 1000 deg/s, got -5")
+expect_match("--augment-rotation: must be a finite number from 0 up, got -5")  # named at parse
 
 # FlowNet flows (FlowNet2-C with synthetic weights, the lightest family member): the flow method
 # and the weights' identity key the cache apart from DIS's.

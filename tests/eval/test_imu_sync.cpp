@@ -283,5 +283,10 @@ TEST(ImuSync, ParsersAndNames) {
   EXPECT_TRUE(contains(invalid_input_message([] { parse_vec3("1,2", "--gyro-bias"); }), "--gyro-bias"));
   EXPECT_TRUE(contains(invalid_input_message([] { parse_vec3("1,2,x", "--gyro-bias"); }), "\"x\""));
   EXPECT_TRUE(contains(invalid_input_message([] { parse_vec3("1,2,3,4", "--gyro-bias"); }), "--gyro-bias"));
+  // Decimal only (strtod read "0x1" as 1); a fourth number is counted, not blamed on "3,4".
+  EXPECT_TRUE(contains(invalid_input_message([] { parse_vec3("0x1,0,0", "--extrinsic-error"); }),
+                       "--extrinsic-error should be three decimal numbers x,y,z; \"0x1\" is not one"));
+  EXPECT_TRUE(contains(invalid_input_message([] { parse_vec3("1,2,3,4", "--gyro-bias"); }), "\"1,2,3,4\" (4 fields)"));
+  EXPECT_TRUE(contains(invalid_input_message([] { parse_vec3("inf,0,0", "--gyro-bias"); }), "\"inf\" is not one"));
   EXPECT_EQ(to_string(BiasSource::GroundTruth), "ground_truth");
 }

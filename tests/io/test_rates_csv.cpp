@@ -239,6 +239,24 @@ TEST(RatesCsv, StatusErrorsNameTheLine) {
   EXPECT_TRUE(contains(m, "expected inertialnet.rates/4")) << m;
 }
 
+// Schema 4's σ columns: a standard deviation is never negative and is bounded as the rates are
+// (both were read as given, to be squared into weights).
+TEST(RatesCsv, SigmaColumnsAreStandardDeviations) {
+  te::TempDir dir("rates_sigma_err");
+  auto msg = [&](const std::string& text) { return invalid_input_message([&] { read_rates_csv(write_text(dir, text)); }); };
+  const std::string header = "timestamp_ns,wx,wy,wz,status,sigma_wx,sigma_wy,sigma_wz\n";
+  std::string m = msg(header + "1,0,0,0,ok,0.1,-0.2,0.1\n");
+  EXPECT_TRUE(contains(m, "line 2: sigma_wy is \"-0.2\"; a standard deviation cannot be negative")) << m;
+  m = msg(header + "1,0,0,0,ok,0.1,0.1,1e300\n");
+  EXPECT_TRUE(contains(m, "line 2: sigma_wz is \"1e300\", beyond ±1000 rad/s")) << m;
+  m = msg(header + "1,0,0,0,ok,nan,0.1,0.1\n");
+  EXPECT_TRUE(contains(m, "line 2: sigma_wx is \"nan\", expected a finite number")) << m;
+  // An empty σ (not known) and a σ of 0 are values.
+  const RatesTable r = read_rates_csv(write_text(dir, header + "1,0,0,0,ok,,0,0.5\n"));
+  EXPECT_TRUE(std::isnan(r.column("sigma_wx")[0]));
+  EXPECT_EQ(r.column("sigma_wy")[0], 0.0);
+}
+
 // A run's rows go to <name>.partial, one write each, and replace <name> only when the run
 // completes: a run that fails (or is killed) leaves a complete earlier file untouched and its
 // own rows readable in the journal (issue: a failed rerun replaced a good CSV).
@@ -327,6 +345,10 @@ TEST(RatesCsv, SidecarHoldsTheMetadata) {
   EXPECT_TRUE(contains(invalid_input_message([&] { read_rates_csv(path); }), "neither a string nor a number"));
   std::ofstream(rates_sidecar_path(path)) << "{\"schema\": ";
   EXPECT_TRUE(contains(invalid_input_message([&] { read_rates_csv(path); }), "is not valid JSON"));
+  // A number beyond a double is the JSON library's out_of_range, not its parse_error: it escaped
+  // as exit 1 with the library's own text.
+  std::ofstream(rates_sidecar_path(path)) << "{\"schema\": \"inertialnet.rates/4\", \"metadata\": {\"x\": 1e400}}";
+  EXPECT_TRUE(contains(invalid_input_message([&] { read_rates_csv(path); }), "beyond the range of a double"));
   // Without a sidecar: no metadata, and a note saying so.
   std::filesystem::remove(rates_sidecar_path(path));
   const RatesTable bare = read_rates_csv(path);

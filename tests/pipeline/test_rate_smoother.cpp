@@ -11,6 +11,7 @@
 
 #include "inertialnet/pipeline/rate_smoother.hpp"
 #include "inertialnet/runtime/error.hpp"
+#include "support/testing.hpp"
 
 namespace inertialnet {
 namespace {
@@ -145,6 +146,31 @@ TEST(RateSmoother, SettingsAreReadOrRefusedByName) {
       EXPECT_EQ(e.kind(), ErrorKind::InvalidInput) << bad;
     }
   }
+}
+
+// Each refusal names --smooth and what was given: q was read by strtod (0x10 taken as 16, nan
+// refused without naming it), a lag of four digits got the generic message, and q = 1e300 ran.
+TEST(RateSmoother, BadNumbersAreNamed) {
+  const auto message = [](const std::string& text) {
+    return testing::invalid_input_message([&] { parse_rate_smoother(text); });
+  };
+  std::string m = message("lag:2,q:0x10");
+  EXPECT_TRUE(testing::contains(m, "--smooth \"lag:2,q:0x10\": q must be a positive decimal number, got 0x10")) << m;
+  m = message("lag:2,q:nan");
+  EXPECT_TRUE(testing::contains(m, "--smooth \"lag:2,q:nan\": q must be a positive decimal number, got nan")) << m;
+  m = message("lag:2,q:1e300");
+  EXPECT_TRUE(testing::contains(m, "--smooth \"lag:2,q:1e300\": the smoother's q")) << m;
+  EXPECT_TRUE(testing::contains(m, "must be from 1e-06 to 1e+06, got 1e+300")) << m;
+  m = message("lag:2,q:0");
+  EXPECT_TRUE(testing::contains(m, "got 0")) << m;
+  m = message("lag:1000");
+  EXPECT_TRUE(testing::contains(m, "--smooth \"lag:1000\": the lag must be 0 to 100 pairs, got 1000")) << m;
+  m = message("lag:99999999999999999999");
+  EXPECT_TRUE(testing::contains(m, "the lag must be 0 to 100 pairs")) << m;
+  // Leading zeros are the same lag; the ends of q's range are accepted.
+  EXPECT_EQ(parse_rate_smoother("lag:0002").lag, 2);
+  EXPECT_EQ(parse_rate_smoother("lag:2,q:1e6").jerk_density, kMaxJerkDensity);
+  EXPECT_EQ(parse_rate_smoother("lag:2,q:1e-6").jerk_density, kMinJerkDensity);
 }
 
 }  // namespace

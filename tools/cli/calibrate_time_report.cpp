@@ -227,6 +227,11 @@ CalibrationToApply read_calibration_json(const std::string& path) {
   } catch (const nlohmann::json::parse_error& e) {
     throw invalid_input(where + ": not JSON (byte " + std::to_string(e.byte) +
                         "); expected the --json report of inertialnet calibrate or calibrate-time.");
+  } catch (const nlohmann::json::exception&) {
+    // A number beyond a double (1e400) is out_of_range 406, not a parse_error: bad input all the
+    // same, never the library's own text and exit 1.
+    throw invalid_input(where + ": holds a number beyond the range of a double (such as 1e400); expected the --json "
+                        "report of inertialnet calibrate or calibrate-time.");
   }
   const auto* schema = j.is_object() && j.contains("schema") && j["schema"].is_string() ? j["schema"].get_ptr<const std::string*>() : nullptr;
   if (!schema || (*schema != kCalibrateJsonSchema && *schema != kCalibrateTimeJsonSchema)) {
@@ -234,21 +239,38 @@ CalibrationToApply read_calibration_json(const std::string& path) {
                         kCalibrateTimeJsonSchema + "\", found " + (schema ? "\"" + excerpt(*schema) + "\"" : "none") +
                         " (the --json report of inertialnet calibrate).");
   }
-  // A number at j[a][b], or invalid_input naming the key.
+  // What the file holds at a key, as the message quotes it (at most 40 characters).
+  const auto found = [](const nlohmann::json& value) { return excerpt(value.dump()); };
+  // A number at j[a][b], or invalid_input naming the key and what is there instead.
   const auto number_at = [&](const nlohmann::json& parent, const std::string& key, const std::string& name) {
     if (!parent.is_object() || !parent.contains(key) || !parent[key].is_number()) {
-      throw invalid_input(where + ": key \"" + name + "\" should be a number.");
+      const bool present = parent.is_object() && parent.contains(key);
+      throw invalid_input(where + ": key \"" + name + "\" should be a number, found " +
+                          (present ? found(parent[key]) : std::string("none")) + ".");
     }
     return parent[key].get<double>();
   };
   CalibrationToApply c;
-  if (j.contains("rates_readout_time_s")) c.rates_readout_time_s = number_at(j, "rates_readout_time_s", "rates_readout_time_s");
+  if (j.contains("rates_readout_time_s")) {
+    // The readout the rates were predicted with (predict --readout-time: 0 to 1 s); half of it
+    // enters the offset applied, so a wild value would move every gyro sample.
+    c.rates_readout_time_s = number_at(j, "rates_readout_time_s", "rates_readout_time_s");
+    if (!(c.rates_readout_time_s >= 0 && c.rates_readout_time_s <= 1)) {
+      throw invalid_input(where + ": key \"rates_readout_time_s\" should be a readout time from 0 to 1 s, found " +
+                          found(j["rates_readout_time_s"]) + ".");
+    }
+  }
   const nlohmann::json& t = j.contains("time_offset") ? j["time_offset"] : nlohmann::json();
   if (!t.is_object() || !t.contains("determined") || !t["determined"].is_boolean() || !t.contains("confidence") ||
       !t["confidence"].is_string()) {
     throw invalid_input(where + ": key \"time_offset\" should be an object with \"determined\" and \"confidence\".");
   }
   const std::string confidence = t["confidence"].get<std::string>();
+  // The ratings calibrate writes (TimeOffsetEstimate::confidence()); another word is another schema.
+  if (confidence != "high" && confidence != "medium" && confidence != "low" && confidence != "none") {
+    throw invalid_input(where + ": key \"time_offset.confidence\" should be high, medium, low or none, found " +
+                        found(t["confidence"]) + ".");
+  }
   if (!t["determined"].get<bool>() || confidence == "low" || confidence == "none") {
     // As with --time-offset auto: an offset the calibration itself did not trust is not applied.
     const std::string why = t.contains("undetermined_reason") && t["undetermined_reason"].is_string()
@@ -260,7 +282,14 @@ CalibrationToApply read_calibration_json(const std::string& path) {
   }
   c.time_offset_s = number_at(t, "offset_s", "time_offset.offset_s");
   if (!std::isfinite(c.time_offset_s) || std::abs(c.time_offset_s) > 3600) {
-    throw invalid_input(where + ": key \"time_offset.offset_s\" should be within an hour.");
+    throw invalid_input(where + ": key \"time_offset.offset_s\" should be within an hour, found " +
+                        found(t["offset_s"]) + ".");
+  }
+  // calibrate-time/1 may have no rotation (null); anything else but an object is another schema,
+  // not a correction to leave out silently.
+  if (j.contains("rotation_correction") && !j["rotation_correction"].is_object() && !j["rotation_correction"].is_null()) {
+    throw invalid_input(where + ": key \"rotation_correction\" should be an object, found " +
+                        found(j["rotation_correction"]) + ".");
   }
   if (j.contains("rotation_correction") && j["rotation_correction"].is_object()) {
     const nlohmann::json& r = j["rotation_correction"];
@@ -279,7 +308,7 @@ CalibrationToApply read_calibration_json(const std::string& path) {
       }
       if (!(std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) <= 180)) {
         throw invalid_input(where + ": key \"rotation_correction.rotation_vector_deg\" should be a rotation vector "
-                            "of at most 180 degrees.");
+                            "of at most 180 degrees, found " + found(v) + ".");
       }
       c.rotation_correction_deg = w;
     }

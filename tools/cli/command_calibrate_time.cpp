@@ -107,7 +107,10 @@ Command register_calibration(CLI::App& app, const GlobalOptions& global, bool re
       ->check(CLI::ExistingPath);
   app.add_option("rates", o->rates, "rates CSV written by predict (default: predict weight-free now)")
       ->check(CLI::ExistingFile);
-  app.add_option("--range", o->range, "search +-this many seconds")->capture_default_str();
+  // Checked here, not after the weight-free prediction: an offset is within an hour (sync_gyro).
+  app.add_option("--range", o->range, "search +-this many seconds")
+      ->capture_default_str()
+      ->check(finite_positive_up_to(3600, "s"));
   app.add_option("--head", o->head, "use columns wx<_HEAD>…, e.g. --head geometric");
   app.add_flag("--json", o->json,
                std::string("machine-readable report (schema ") +

@@ -133,7 +133,8 @@ Command register_eval(CLI::App& app, const GlobalOptions&) {
                  "camera-IMU time offset in seconds (t_imu = t_cam + offset), or auto to estimate it from the data; "
                  "default: what the rates file states, else 0");
   app.add_option("--time-offset-range", o->offset_range, "with --time-offset auto: search +-this many seconds")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(finite_positive_up_to(3600, "s"));  // an offset is within an hour (sync_gyro)
   app.add_option("--rotation-correction", o->rotation_correction,
                  "camera-IMU rotation correction rx,ry,rz in degrees (a rotation vector in the IMU frame, as "
                  "calibrate-time prints it): predictions are rotated by it before the comparison");
@@ -188,6 +189,13 @@ Command register_eval(CLI::App& app, const GlobalOptions&) {
     } else if (!o->gyro_bias.empty()) {
       options.sync.bias = BiasSource::Given;
       options.sync.gyro_bias = parse_vec3(o->gyro_bias, "--gyro-bias");
+      // The bound of every gyro value read (csv::parse_bounded): a bias no gyro has is a typo.
+      for (int k = 0; k < 3; ++k) {
+        if (std::abs(options.sync.gyro_bias[k]) > 1e3) {
+          throw invalid_input("--gyro-bias: each component should be within +-1000 rad/s, found \"" +
+                              excerpt(o->gyro_bias) + "\".");
+        }
+      }
     }
     options.input = imu_sequence_options(o->input);
     // Several rates files, --seq, or a folder of rates: a batch and its table.

@@ -387,6 +387,15 @@ int predict_batch(const PredictOptions& options, const GlobalOptions& global) {
   }
   const std::vector<fs::path> outputs = batch_rates_paths(sequences, options.output);
   std::error_code ec;
+  // Every sequence is there before the first is computed: a missing one would otherwise stop the
+  // batch only when its turn comes, after the others' hours, named without its manifest.
+  for (std::size_t i = 0; i < sequences.size(); ++i) {
+    if (fs::exists(sequences[i], ec)) continue;
+    const bool listed = i >= options.sequences.size();
+    throw invalid_input((listed ? "--manifest " + options.manifest + ": it lists the sequence " : "the sequence ") +
+                        sequences[i].string() + (listed ? ", which does not exist" : " does not exist") +
+                        (ec ? " (" + ec.message() + ")" : std::string()) + "; nothing was computed.");
+  }
   if (fs::exists(options.output, ec) && !fs::is_directory(options.output, ec)) {
     throw invalid_input("-o " + options.output + ": it exists and is not a folder; a batch writes one rates file per "
                         "sequence into a folder.");
@@ -476,13 +485,13 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
                  "DIS and LK: also compute the backward flow and leave out vectors whose round trip misses by more than "
                  "this many pixels (at 752 columns, scaled with the width); 0: off")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 1e6));
+      ->check(finite_non_negative_up_to(1e6, "pixels"));
   // Issue 22: confidence per pair and more than two frames.
   app.add_option("--max-sigma", o->max_sigma_deg_s,
                  "geometric head: a pair whose rates' standard deviation exceeds this many deg/s (along the least "
                  "certain axis) gets the status uncertain instead of rates; 0: no limit")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 1e6));
+      ->check(finite_non_negative_up_to(1e6, "deg/s"));
   app.add_option("--smooth", o->smooth,
                  "off (two-frame rates), or lag:L: a fixed-lag smoother over the pairs' rates weighted by their sigma, "
                  "each pair L frame intervals late (lag:L,q:Q sets its jerk density)")

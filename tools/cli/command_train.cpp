@@ -11,6 +11,7 @@
 #include <charconv>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -148,11 +149,23 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
                  "normalized (flow per second in normalised camera coordinates: any camera, frame rate and size) "
                  "or paper (pixels at the head's size, the paper's)")
       ->capture_default_str();
-  app.add_option("--dropout", o->dropout, "dropout before fc1 during training (the paper's: 0.3)")->capture_default_str();
+  // Both named at parse, with the value as given (the library's checks said "head configuration:
+  // dropout is 1.000000" and "training: …", naming no option).
+  app.add_option("--dropout", o->dropout, "dropout before fc1 during training (the paper's: 0.3)")
+      ->capture_default_str()
+      ->check(finite_non_negative_up_to(1, "(a probability)"))
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            // After the check above: a decimal number from 0 to 1, of which 1 drops every unit.
+            return std::strtod(text.c_str(), nullptr) < 1 ? std::string()
+                                                          : "must be below 1 (1 drops every unit), got " + text;
+          },
+          "PROBABILITY"));
   app.add_option("--augment-rotation", o->augment_rotation,
                  "add to each training flow the exact flow of a random rotation up to this many deg/s per axis, and "
                  "its rate to the target (0: off)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(finite_non_negative_up_to(1000, "deg/s"));  // the Trainer's bound (trainer.cpp)
   app.add_flag("--resume", o->resume, "continue from <stem>.state.safetensors beside -o");
   app.add_option("--log", o->log, "per-epoch CSV");
   app.add_option("--plot", o->plot, "loss curves (PNG)");

@@ -44,6 +44,22 @@ CLI::Validator finite_positive_up_to(double limit, const char* unit) {
       "POSITIVE");
 }
 
+CLI::Validator finite_non_negative_up_to(double limit, const char* unit) {
+  return CLI::Validator(
+      [limit, unit](std::string& text) {
+        double value = 0;
+        if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || !(value >= 0)) {
+          return "must be a finite number from 0 up, got " + excerpt(text);
+        }
+        if (!is_decimal(text)) return "must be written in decimal, got " + excerpt(text);
+        if (value <= limit) return std::string();
+        std::ostringstream s;
+        s << "must be at most " << limit << " " << unit << ", got " << excerpt(text);
+        return s.str();
+      },
+      "NUMBER");
+}
+
 CLI::Validator finite_pixel_coordinate() {
   return CLI::Validator(
       [](std::string& text) {

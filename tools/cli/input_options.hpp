@@ -23,6 +23,7 @@ namespace inertialnet::cli {
 inline constexpr double kMinimumPositive = 1e-6;
 CLI::Validator finite_positive_up_to(double limit, const char* unit);  // "must be a finite positive number, got …"
 CLI::Validator finite_pixel_coordinate();                              // within 1e6 pixels of the origin
+CLI::Validator finite_non_negative_up_to(double limit, const char* unit);  // 0 included (often "off")
 
 // --calibration FILE [--calibration-camera camN]: a calibration file (calibration_file.hpp).
 // Added by add_intrinsics_options; eval, which needs only its extrinsic, adds it alone.

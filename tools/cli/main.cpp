@@ -95,8 +95,14 @@ int main(int argc, char** argv) {
   }
 
   // CLI11's own messages quote a value whole: a pasted 300-digit number is cut (issue 20, item 9).
+  // And every line on stderr starts with `inertialnet: ` (docs/cli.md, "Output"): CLI11's own
+  // "--max-sigma: must be …\nRun with --help …" gets the prefix and the help hint that the
+  // unknown-word messages (suggest.cpp) give.
   app.failure_message([](const CLI::App* failed, const CLI::Error& e) {
-    return cli::excerpt_long_numbers(CLI::FailureMessage::simple(failed, e));
+    // `failed` is the app exit() is called on (the root); the subcommand is the one parsed.
+    const auto parsed = failed->get_subcommands();
+    const std::string command = parsed.empty() ? std::string("inertialnet") : "inertialnet " + parsed.back()->get_name();
+    return "inertialnet: error: " + cli::excerpt_long_numbers(e.what()) + " (see " + command + " --help)\n";
   });
   try {
     app.parse(argc, argv);

@@ -24,13 +24,18 @@
 
 namespace inertialnet {
 
+// The range of q accepted: 40 (the default) times 1e-7 to 1e5 is far beyond any fitted value,
+// and beyond it the covariances' squares leave a double (q = 1e300 ended in NaN rates).
+inline constexpr double kMinJerkDensity = 1e-6;
+inline constexpr double kMaxJerkDensity = 1e6;
+
 struct RateSmootherOptions {
   bool enabled = false;  // false: two-frame rates, as computed
   int lag = 2;           // pairs of look-ahead (latency in frame intervals)
   // Spectral density of the angular acceleration's change, (rad/s²)²·s per axis. Fitted on the
   // synthetic conditions (docs/real_cameras.md, "More than two frames").
   double jerk_density = 40.0;
-  void validate() const;  // invalid_input for a negative lag (or above 100) or a density ≤ 0
+  void validate() const;  // invalid_input for a negative lag (or above 100) or a density outside the range
 };
 
 // "off" (or "none", "two-frame"), "lag:L" or "lag:L,q:Q"; invalid_input naming the text otherwise.
