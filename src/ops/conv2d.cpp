@@ -118,10 +118,14 @@ void conv2d(Queue& queue, const Tensor& input, const Tensor& weight, const Tenso
 
   Device& device = queue.device();
   const GemmBackend backend = options.prepared ? options.prepared->backend : gemm_backend(device.info());
-  if (backend == GemmBackend::Winograd && detail::winograd_eligible(weight.shape(), options.stride)) {
+  // Prepared weights say which form the layer runs (prepare_conv2d_weights applied the shape
+  // rule); without them the rule decides here.
+  const bool winograd = backend == GemmBackend::Winograd &&
+                        (options.prepared ? !options.prepared->winograd.empty()
+                                          : detail::winograd_preferred(input.shape(), weight.shape(), options.stride));
+  if (winograd) {
     detail::report_backend(queue, to_string(backend));
-    const bool prepared = options.prepared && !options.prepared->winograd.empty();
-    detail::conv2d_winograd(queue, input, prepared ? options.prepared->winograd : detail::winograd_weights(queue, weight, nullptr),
+    detail::conv2d_winograd(queue, input, options.prepared ? options.prepared->winograd : detail::winograd_weights(queue, weight, nullptr),
                             bias, output, options);
     return;
   }

@@ -72,7 +72,7 @@ void expect_conv_matches(const ConvCase& c, const Placement& p) {
   // The winograd plan's F(4×4, 3×3) layers have a measured bound of their own (op_testing.hpp).
   const double floor = std::sqrt(static_cast<double>(c.ci) * c.k * c.k);
   const bool winograd = gemm_backend(queue.device().info()) == GemmBackend::Winograd &&
-                        detail::winograd_eligible(w.shape(), c.stride);
+                        detail::winograd_preferred(in.view.shape(), w.shape(), c.stride);
   EXPECT_TRUE(testing::all_close(got, expected, winograd ? testing::kWinogradRelativeTolerance : 1e-5, floor));
 }
 
