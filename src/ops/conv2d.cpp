@@ -49,14 +49,18 @@ void conv2d_packed(Queue& queue, const Tensor& input, const Tensor& weight, cons
   }
 }
 
-// Few output channels: each work-item computes 16 output pixels of a row for all of them from
-// the input window, with bias and activation; no column matrix.
+// Few output channels: each work-item computes a block of output rows × 32 pixels for all of
+// them from the input window, with bias and activation; no column matrix.
 void conv2d_direct(Queue& queue, const Tensor& input, const Tensor& weight, const Tensor& bias, const Tensor& output,
                    const Conv2dOptions& options) {
   const bool has_bias = bias.defined();
+  // Output rows per work-item (ROWS of conv2d_direct.cl): 2·ROWS·COUT float16 accumulators, at
+  // most 16 of AVX-512's 32 registers.
+  const std::int64_t rows = weight.dim(0) <= 2 ? 4 : 2;
   Kernel& kernel = queue.kernel("conv2d_direct", "conv2d_direct",
                                 KernelDefines()
                                     .add("COUT", weight.dim(0))
+                                    .add("ROWS", rows)
                                     .add("KH", weight.dim(2))
                                     .add("KW", weight.dim(3))
                                     .add("STRIDE", options.stride)
@@ -64,12 +68,13 @@ void conv2d_direct(Queue& queue, const Tensor& input, const Tensor& weight, cons
                                     .add("HAS_BIAS", has_bias)
                                     .add(activation_defines(options.activation)));
   const auto out_h = static_cast<std::size_t>(output.h()), out_w = static_cast<std::size_t>(output.w());
-  constexpr std::size_t kLanes = 16;  // output pixels per work-item: LANES of conv2d_direct.cl
+  constexpr std::size_t kLanes = 32;  // output pixels per work-item: LANES of conv2d_direct.cl
+  const auto row_block = static_cast<std::size_t>(rows);
   for (std::int64_t n = 0; n < input.n(); ++n) {
     // Without a bias the kernel never reads its bias argument; any valid buffer will do.
     kernel.set_args(input.sample(n), weight, has_bias ? bias : weight, output.sample(n), input.c(), input.h(),
                     input.w(), out_h, out_w);
-    queue.launch(kernel, Range((out_w + kLanes - 1) / kLanes, out_h), Range(1, 1));
+    queue.launch(kernel, Range((out_w + kLanes - 1) / kLanes, (out_h + row_block - 1) / row_block), Range(1, 1));
   }
 }
 
@@ -113,10 +118,14 @@ void conv2d(Queue& queue, const Tensor& input, const Tensor& weight, const Tenso
 
   Device& device = queue.device();
   const GemmBackend backend = options.prepared ? options.prepared->backend : gemm_backend(device.info());
-  if (backend == GemmBackend::Winograd && detail::winograd_eligible(weight.shape(), options.stride)) {
+  // Prepared weights say which form the layer runs (prepare_conv2d_weights applied the shape
+  // rule); without them the rule decides here.
+  const bool winograd = backend == GemmBackend::Winograd &&
+                        (options.prepared ? !options.prepared->winograd.empty()
+                                          : detail::winograd_preferred(input.shape(), weight.shape(), options.stride));
+  if (winograd) {
     detail::report_backend(queue, to_string(backend));
-    const bool prepared = options.prepared && !options.prepared->winograd.empty();
-    detail::conv2d_winograd(queue, input, prepared ? options.prepared->winograd : detail::winograd_weights(queue, weight, nullptr),
+    detail::conv2d_winograd(queue, input, options.prepared ? options.prepared->winograd : detail::winograd_weights(queue, weight, nullptr),
                             bias, output, options);
     return;
   }

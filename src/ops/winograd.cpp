@@ -30,6 +30,12 @@ bool winograd_eligible(const Shape& weight, int stride) {
          weight[2] == 3 && weight[3] == 3 && stride == 1;
 }
 
+bool winograd_preferred(const Shape& input, const Shape& weight, int stride) {
+  if (!winograd_eligible(weight, stride)) return false;
+  if (input.size() != 4) return true;
+  return ((input[2] + 3) / 4) * ((input[3] + 3) / 4) >= kWinogradMinTiles;
+}
+
 std::vector<PackedPanels> winograd_weights(Queue& queue, const Tensor& weight, Device* long_lived) {
   if (!winograd_eligible(weight.shape(), 1) || !weight.contiguous()) {
     throw invalid_input("winograd: the weights must be a contiguous [co ≥ 16, ci ≥ 32, 3, 3] tensor, got " +

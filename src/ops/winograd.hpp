@@ -35,6 +35,16 @@ inline constexpr std::int64_t kWinogradMinInputChannels = 32;
 // Whether a convolution with weights [co, ci, kh, kw] and `stride` runs Winograd on that plan.
 bool winograd_eligible(const Shape& weight, int stride);
 
+// 4×4 output tiles from which an eligible layer runs Winograd on that plan: one whole 32-tile B
+// panel. Below it the panel's columns are mostly padding and the 36 products of a few tiles cost
+// more than the taps save (at 512×384: FlowNetC/S/SD conv6_1, 6×8 outputs in 4 tiles, ran 1.8–2.5×
+// slower than the packed GEMM, conv5_1, 12×16 in 12 tiles, 0.7–1.0×; conv4_1, 48 tiles, 0.5×).
+inline constexpr std::int64_t kWinogradMinTiles = 32;
+
+// Eligible, and on an NCHW `input` (3×3, stride 1: the output is about the input's size) with at
+// least kWinogradMinTiles tiles. An empty `input` (size unknown) counts as large enough.
+bool winograd_preferred(const Shape& input, const Shape& weight, int stride);
+
 // The 36 transformed weight matrices U_e [co × ci], packed as A panels (long-lived on `long_lived`
 // when given, else temporaries of `queue`).
 std::vector<PackedPanels> winograd_weights(Queue& queue, const Tensor& weight, Device* long_lived);

@@ -11,6 +11,7 @@
 
 #include "inertialnet/ops/conv2d.hpp"
 #include "inertialnet/ops/gemm/backend.hpp"
+#include "inertialnet/ops/gemm/plan.hpp"
 #include "reference/conv.hpp"
 #include "ops/op_testing.hpp"
 #include "ops/winograd.hpp"
@@ -71,7 +72,7 @@ void expect_conv_matches(const ConvCase& c, const Placement& p) {
   // The winograd plan's F(4×4, 3×3) layers have a measured bound of their own (op_testing.hpp).
   const double floor = std::sqrt(static_cast<double>(c.ci) * c.k * c.k);
   const bool winograd = gemm_backend(queue.device().info()) == GemmBackend::Winograd &&
-                        detail::winograd_eligible(w.shape(), c.stride);
+                        detail::winograd_preferred(in.view.shape(), w.shape(), c.stride);
   EXPECT_TRUE(testing::all_close(got, expected, winograd ? testing::kWinogradRelativeTolerance : 1e-5, floor));
 }
 
@@ -119,6 +120,36 @@ TEST(Conv2d, SmallColumnBudgetProcessesPixelRanges) {
   expect_conv_matches({"chunked", 5, 7, 37, 23, 3, 1, 1, true, ActivationSpec::leaky_relu(0.1f)}, p);
   p.max_column_floats = 1;  // one pixel at a time
   expect_conv_matches({"one_pixel", 2, 3, 5, 4, 3, 2, 1, true, ActivationSpec::relu()}, p);
+}
+
+// The direct kernel (≤ kDirectConvMaxChannels outputs, packed plans): blocks of 2 or 4 output
+// rows × 32 pixels per work-item, vector loads with a lane shift at the left and right padding
+// column. Widths around the 16/32-lane edges (15, 16, 17, 31, 33), a height that leaves a partial
+// row block, every COUT it takes, strides 2 and 3, 5×5 and 1×1, no padding, batches.
+TEST(Conv2d, FewOutputChannelsDirectKernelAtOddSizes) {
+  const auto leaky = ActivationSpec::leaky_relu(0.1f);
+  for (int w : {15, 16, 17, 31, 33, 64}) {
+    for (int co : {1, 2, 3, 4}) {
+      expect_conv_matches({"direct_w" + std::to_string(w) + "_co" + std::to_string(co), 5, co, 7, w, 3, 1, 1,
+                           co % 2 == 0, leaky},
+                          {co == 3 ? 2 : 1});
+    }
+  }
+  expect_conv_matches({"direct_k5s2", 6, 2, 37, 23, 5, 2, 2, true, ActivationSpec::relu()}, {3});
+  expect_conv_matches({"direct_k3s3p0", 4, 2, 37, 41, 3, 3, 0, true, ActivationSpec::none()}, {1});
+  expect_conv_matches({"direct_k1", 7, 3, 9, 50, 1, 1, 0, true, leaky}, {1});
+  expect_conv_matches({"direct_k3p2", 3, 2, 11, 35, 3, 1, 2, false, ActivationSpec::none()}, {1});
+  expect_conv_matches({"direct_slices", 6, 2, 13, 40, 3, 1, 1, true, leaky}, {3, 2, 3, 1, 4, 0});
+}
+
+// FlowNet2's predict_flow layers at the real 512×384 input (FlowNetFusion's predict_flow0 at
+// full resolution, FlowNetC/S/SD's predict_flow2…6 at 1/4…1/64): the shapes the direct kernel
+// runs in a pair. predict_flow has no activation.
+TEST(Conv2d, PredictFlowAtFlowNet2sRealSize) {
+  for (const auto& layer : flownet_layers::flownet2_layers(384, 512, flownet_layers::LayerKind::Conv)) {
+    if (layer.co > kDirectConvMaxChannels) continue;
+    expect_conv_matches(from_layer(layer), Placement{});
+  }
 }
 
 TEST(Conv2d, InertialNetHeadShapes) {

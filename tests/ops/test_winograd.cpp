@@ -42,8 +42,10 @@ struct Placement {
 };
 
 // Runs the case on the winograd plan with its weights prepared as a network prepares them;
-// `expect_winograd`: whether the layer is eligible (Winograd matrices, else packed panels).
-void expect_winograd_matches(const Case& c, const Placement& p, bool expect_winograd = true) {
+// `expect_winograd`: whether the layer is eligible (Winograd matrices, else packed panels);
+// `with_input_shape`: prepared knowing the input's size, as a network's graph prepares them.
+void expect_winograd_matches(const Case& c, const Placement& p, bool expect_winograd = true,
+                             bool with_input_shape = false) {
   SCOPED_TRACE(c.name);
   Queue& queue = testing::test_queue();
   const reference::ConvShape s{p.batch, c.ci, c.h, c.w, c.co, 3, 3, c.stride, c.padding};
@@ -59,7 +61,8 @@ void expect_winograd_matches(const Case& c, const Placement& p, bool expect_wino
       testing::make_sliced(queue, {p.batch, c.co, oh, ow}, p.out_before, p.out_before + p.out_after, 205);
   const Tensor w = Tensor::from_host(queue, {c.co, c.ci, 3, 3}, weight);
   const Tensor b = c.bias ? Tensor::from_host(queue, {c.co}, bias) : Tensor();
-  const GemmWeights prepared = prepare_conv2d_weights(queue, w, GemmBackend::Winograd, c.stride);
+  const GemmWeights prepared =
+      prepare_conv2d_weights(queue, w, GemmBackend::Winograd, c.stride, with_input_shape ? in.view.shape() : Shape{});
   // The 36 transformed matrices packed as one (ops/winograd.hpp), else the plain packed panels.
   ASSERT_EQ(prepared.winograd.size(), expect_winograd ? 1u : 0u);
   if (expect_winograd) {
@@ -140,6 +143,20 @@ TEST(Winograd, IneligibleLayersRunPacked) {
   expect_winograd_matches({"co8", 36, 8, 37, 23, 1, 1, true, ActivationSpec::relu()}, {2}, false);
   expect_winograd_matches({"ci6", 6, 64, 37, 23, 1, 1, true, ActivationSpec::relu()}, {2}, false);
   expect_winograd_matches({"co2_direct", 5, 2, 37, 23, 1, 1, true, ActivationSpec::none()}, {2}, false);
+}
+
+TEST(Winograd, SmallOutputsStayOnThePackedGemm) {
+  // Fewer than kWinogradMinTiles 4×4 tiles (one 32-tile B panel): FlowNetC/S/SD conv6_1 (6×8)
+  // and conv5_1 (12×16) at 512×384 run the packed GEMM; conv4_1 (24×32, 48 tiles) Winograd.
+  EXPECT_FALSE(detail::winograd_preferred({1, 1024, 6, 8}, {1024, 1024, 3, 3}, 1));
+  EXPECT_FALSE(detail::winograd_preferred({1, 512, 12, 16}, {512, 512, 3, 3}, 1));
+  EXPECT_TRUE(detail::winograd_preferred({1, 512, 24, 32}, {512, 512, 3, 3}, 1));
+  EXPECT_TRUE(detail::winograd_preferred({}, {512, 512, 3, 3}, 1));  // size unknown
+  EXPECT_FALSE(detail::winograd_preferred({1, 512, 24, 32}, {512, 512, 3, 3}, 2));
+  const auto leaky = ActivationSpec::leaky_relu(0.1f);
+  expect_winograd_matches({"tiles_32", 32, 16, 16, 32, 1, 1, true, leaky}, {1}, true, true);
+  expect_winograd_matches({"tiles_28", 32, 16, 16, 28, 1, 1, true, leaky}, {2}, false, true);
+  expect_winograd_matches({"conv6_1_like", 64, 32, 6, 8, 1, 1, true, leaky}, {1}, false, true);
 }
 
 TEST(Winograd, PlanName) {

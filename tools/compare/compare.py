@@ -11,7 +11,10 @@ environment (see README.md here for how to create it).
 
     tools/compare/compare.py [--venv DIR] [--inertialnet build/inertialnet] \
         [--models FlowNet2,FlowNet2-C] [--size 512x384] [--threads 2] [--pairs 3] [--rounds 2] [--json] \
-        [--device gpu --torch-device cuda]
+        [--device gpu --torch-device cuda] [--plan packed,winograd]
+
+With several `--plan`s, each round runs ours once per plan before PyTorch, and each plan gets its
+own row and ratio. Every round line carries the 1-minute load average read before it.
 """
 
 from __future__ import annotations
@@ -49,8 +52,11 @@ def main() -> int:
     parser.add_argument("--torch-device", default="cpu",
                         help="PyTorch's device (cpu, cuda): compare an OpenCL GPU run with PyTorch on the same GPU")
     parser.add_argument("--correlation", choices=("bmm", "shift"), default="bmm", help="PyTorch's correlation")
+    parser.add_argument("--plan", default="",
+                        help="inertialnet's GEMM plan(s), comma-separated, each timed in every round (default: its default)")
     parser.add_argument("--json", action="store_true", help="print the results as JSON")
     args = parser.parse_args()
+    plans = [p for p in args.plan.split(",") if p] or [""]
 
     python = os.path.join(args.venv, "bin", "python")
     if not os.access(python, os.X_OK):
@@ -69,27 +75,36 @@ def main() -> int:
                      "--torch-device", args.torch_device]
 
     models = [m for m in args.models.split(",") if m]
-    runs = {m: {"ours": [], "ours_total": [], "torch": []} for m in models}
+    runs = {(m, p): {"ours": [], "ours_total": [], "torch": [], "load": []} for m in models for p in plans}
     device = torch_version = torch_device = ""
     for round_index in range(args.rounds):
         for model in models:
-            ours = run_json(ours_command + ["--model", model], env)["results"][0]
+            ours_runs = []
+            for plan in plans:
+                load = os.getloadavg()[0]
+                ours = run_json(ours_command + ["--model", model] + (["--plan", plan] if plan else []), env)["results"][0]
+                ours_runs.append((plan, load, ours))
+            load = os.getloadavg()[0]
             torch_run = run_json(torch_command + ["--model", model], env)
-            device, torch_version, torch_device = ours["device"], torch_run["torch"], torch_run["torch_device"]
-            runs[model]["ours"].append(ours["stages"]["flow"])
-            runs[model]["ours_total"].append(ours["seconds_per_pair"])
-            runs[model]["torch"].append(torch_run["seconds_per_pair"])
-            print(f"round {round_index + 1} {model}: ours {ours['stages']['flow']:.3f} s/pair "
-                  f"(with upload, head, download {ours['seconds_per_pair']:.3f}), PyTorch {torch_run['seconds_per_pair']:.3f} s/pair",
-                  file=sys.stderr)
+            torch_version, torch_device = torch_run["torch"], torch_run["torch_device"]
+            for plan, ours_load, ours in ours_runs:
+                device = ours["device"]
+                run = runs[(model, plan)]
+                run["ours"].append(ours["stages"]["flow"])
+                run["ours_total"].append(ours["seconds_per_pair"])
+                run["torch"].append(torch_run["seconds_per_pair"])
+                run["load"].append([ours_load, load])
+                print(f"round {round_index + 1} {model}{' --plan ' + plan if plan else ''}: ours {ours['stages']['flow']:.3f} s/pair "
+                      f"(with upload, head, download {ours['seconds_per_pair']:.3f}, load {ours_load:.1f}), "
+                      f"PyTorch {torch_run['seconds_per_pair']:.3f} s/pair (load {load:.1f})", file=sys.stderr)
 
     summary = []
-    for model in models:
-        ours = statistics.median(runs[model]["ours"])
-        theirs = statistics.median(runs[model]["torch"])
-        summary.append({"model": model, "size": args.size, "threads": args.threads, "ours_seconds_per_pair": ours,
-                        "ours_total_seconds_per_pair": statistics.median(runs[model]["ours_total"]),
-                        "torch_seconds_per_pair": theirs, "ratio": ours / theirs, "runs": runs[model]})
+    for (model, plan), run in runs.items():
+        ours = statistics.median(run["ours"])
+        theirs = statistics.median(run["torch"])
+        summary.append({"model": model, "plan": plan or "default", "size": args.size, "threads": args.threads,
+                        "ours_seconds_per_pair": ours, "ours_total_seconds_per_pair": statistics.median(run["ours_total"]),
+                        "torch_seconds_per_pair": theirs, "ratio": ours / theirs, "runs": run})
     if args.json:
         print(json.dumps({"device": device, "torch": torch_version, "torch_device": torch_device,
                           "correlation": args.correlation,
@@ -97,9 +112,9 @@ def main() -> int:
         return 0
     print(f"{args.size}, {args.threads} threads, float32; ours on {device}, PyTorch {torch_version} "
           f"on {torch_device} (correlation: {args.correlation}); medians of {args.rounds} interleaved rounds of {args.pairs} pairs")
-    print(f"{'model':<14} {'ours s/pair':>12} {'PyTorch s/pair':>15} {'ours/PyTorch':>13}")
+    print(f"{'model':<14} {'plan':<9} {'ours s/pair':>12} {'PyTorch s/pair':>15} {'ours/PyTorch':>13}")
     for s in summary:
-        print(f"{s['model']:<14} {s['ours_seconds_per_pair']:>12.3f} {s['torch_seconds_per_pair']:>15.3f} {s['ratio']:>13.2f}")
+        print(f"{s['model']:<14} {s['plan']:<9} {s['ours_seconds_per_pair']:>12.3f} {s['torch_seconds_per_pair']:>15.3f} {s['ratio']:>13.2f}")
     return 0
 
 

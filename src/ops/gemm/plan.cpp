@@ -41,14 +41,15 @@ GemmWeights time_candidates(Queue& queue, const PlannedLayer& layer, Prepare& pr
 PreparedWeights::PreparedWeights(std::filesystem::path plan_directory) : plan_directory_(std::move(plan_directory)) {}
 PreparedWeights::~PreparedWeights() = default;
 
-GemmWeights prepare_conv2d_weights(Queue& queue, const Tensor& weight, GemmBackend backend, int stride) {
+GemmWeights prepare_conv2d_weights(Queue& queue, const Tensor& weight, GemmBackend backend, int stride,
+                                   const Shape& input) {
   if (weight.rank() != 4 || !weight.contiguous()) {
     throw invalid_input("conv2d weights must be a contiguous [co, ci, kh, kw] tensor, got " + to_string(weight.shape()));
   }
   GemmWeights prepared;
   prepared.backend = backend;
   const auto rows = static_cast<std::size_t>(weight.dim(0));
-  if (backend == GemmBackend::Winograd && detail::winograd_eligible(weight.shape(), stride)) {
+  if (backend == GemmBackend::Winograd && detail::winograd_preferred(input, weight.shape(), stride)) {
     prepared.winograd = detail::winograd_weights(queue, weight, &queue.device());
   } else if (uses_packed_kernels(backend) && weight.dim(0) > kDirectConvMaxChannels) {
     const std::size_t depth = static_cast<std::size_t>(weight.numel()) / rows;
@@ -105,9 +106,10 @@ const GemmWeights& PreparedWeights::get(Queue& queue, const std::string& name, P
 }
 
 const GemmWeights& PreparedWeights::conv2d(Queue& queue, const std::string& name, const Tensor& weight, int stride,
-                                            const PlannedLayer* layer) {
+                                            const PlannedLayer* layer, const Shape& input) {
   return get(
-      queue, name, [&](GemmBackend backend) { return prepare_conv2d_weights(queue, weight, backend, stride); }, layer);
+      queue, name, [&](GemmBackend backend) { return prepare_conv2d_weights(queue, weight, backend, stride, input); },
+      layer);
 }
 
 const GemmWeights& PreparedWeights::conv_transpose2d(Queue& queue, const std::string& name, const Tensor& weight,

@@ -47,11 +47,12 @@ struct GemmWeights {
 // backend (FlowNet's predict_flow*: 2).
 inline constexpr std::int64_t kDirectConvMaxChannels = 4;
 
-// Prepares conv2d weights [co, ci, kh, kw] (of a layer of `stride`) / conv_transpose2d weights
-// [ci, co, kh, kw] (of a layer on `input` with `stride` and `padding`) for `backend`, packing on
-// `queue` into long-lived storage of `device`. Wait for `queue` before another queue uses the
-// result.
-GemmWeights prepare_conv2d_weights(Queue& queue, const Tensor& weight, GemmBackend backend, int stride);
+// Prepares conv2d weights [co, ci, kh, kw] (of a layer of `stride` on `input`; empty: size not
+// known) / conv_transpose2d weights [ci, co, kh, kw] (of a layer on `input` with `stride` and
+// `padding`) for `backend`, packing on `queue` into long-lived storage of `device`. Wait for
+// `queue` before another queue uses the result.
+GemmWeights prepare_conv2d_weights(Queue& queue, const Tensor& weight, GemmBackend backend, int stride,
+                                   const Shape& input = {});
 GemmWeights prepare_conv_transpose2d_weights(Queue& queue, const Tensor& weight, GemmBackend backend,
                                              const Shape& input, int stride, int padding);
 
@@ -77,7 +78,7 @@ class PreparedWeights {
   explicit PreparedWeights(std::filesystem::path plan_directory = {});
   ~PreparedWeights();
   const GemmWeights& conv2d(Queue& queue, const std::string& name, const Tensor& weight, int stride,
-                            const PlannedLayer* layer = nullptr);
+                            const PlannedLayer* layer = nullptr, const Shape& input = {});
   const GemmWeights& conv_transpose2d(Queue& queue, const std::string& name, const Tensor& weight,
                                       const Shape& input, int stride, int padding,
                                       const PlannedLayer* layer = nullptr);
