@@ -33,6 +33,15 @@ void add_rotation_flow(float* flow, const CameraIntrinsics& camera, HeadInput co
   }
 }
 
+Vec3 rotation_augmented_target(const Vec3& target_body, const Mat3& camera_to_body, const Vec3& omega_camera,
+                               double dt_s) {
+  const Vec3 rate = mul_transposed(camera_to_body, target_body);  // the pair's rate, camera frame
+  const Eigen::Vector3d theta = Eigen::Vector3d(rate[0], rate[1], rate[2]) * dt_s;
+  const Eigen::Vector3d turn = Eigen::Vector3d(omega_camera[0], omega_camera[1], omega_camera[2]) * dt_s;
+  const Eigen::Vector3d added = (detail::so3_log(detail::so3_exp(theta) * detail::so3_exp(turn)) - theta) / dt_s;
+  return target_body + mul(camera_to_body, Vec3{added.x(), added.y(), added.z()});
+}
+
 CameraIntrinsics camera_at_size(const CameraIntrinsics& camera, int width, int height) {
   CameraIntrinsics out;
   const double sx = static_cast<double>(width) / camera.width, sy = static_cast<double>(height) / camera.height;

@@ -292,7 +292,7 @@ bool Trainer::train(const TrainingSet& train_set, const TrainingSet& val_set, co
                            turns.uniform(-max_turn, max_turn)};
           add_rotation_flow(flows.data() + i * floats, train_set.camera(s), train_set.input(), omega,
                             train_set.interval_s(s));
-          t = t + mul(train_set.camera_to_body(s), omega);
+          t = rotation_augmented_target(t, train_set.camera_to_body(s), omega, train_set.interval_s(s));
         }
         for (int a = 0; a < 3; ++a) targets[3 * i + static_cast<std::size_t>(a)] = static_cast<float>(t[a]);
       }

@@ -220,3 +220,52 @@ run(2 ${CLI} train --train a --val b --flow flownet2 --head-size 64x48 -o x.safe
 expect_match("needs FlowNet2 weights")
 run(2 ${CLI} train --train nowhere --val b --head-size 64x48 -o x.safetensors)
 expect_match("nowhere is not a EuRoC sequence")
+
+# --- issue 23, "a head users can get": train --recipe general renders its own synthetic
+# sequences and trains with fixed settings; the same command gives the same head bit for bit
+# (here at --recipe-scale tiny: the recipe's code path in seconds). Two runs in other work and
+# cache folders (every sequence rendered and every flow computed afresh), and a third that reuses
+# the first's rendered sequences and cached flows: one file, metadata included.
+run(0 ${CLI} train --recipe general --recipe-scale tiny -o recipe1/head.safetensors --work recipe_work1
+    --cache recipe_cache1)
+expect_match("recipe general v1 \\(tiny\\): 3 training and 1 validation sequences in recipe_work1 \\(4 rendered now\\)")
+run(0 ${CLI} train --recipe general --recipe-scale tiny -o recipe2/head.safetensors --work recipe_work2
+    --cache recipe_cache2)
+run(0 ${CLI} train --recipe general --recipe-scale tiny -o recipe3/head.safetensors --work recipe_work1
+    --cache recipe_cache1)
+expect_match("\\(0 rendered now\\)")
+expect_match("read from the cache")
+file(SHA256 "${WORK}/recipe1/head.safetensors" recipe_head1)
+foreach(n 2 3)
+  file(SHA256 "${WORK}/recipe${n}/head.safetensors" recipe_head)
+  if(NOT recipe_head STREQUAL recipe_head1)
+    message(FATAL_ERROR "train --recipe general gave another head in run ${n} than in run 1")
+  endif()
+endforeach()
+run(0 ${CLI} weights --info recipe1/head.safetensors)
+expect_match("inertialnet.recipe = \\{\"name\":\"general\",\"scale\":\"tiny\",\"version\":1\\}")
+expect_match("\"train_sequences\":\\[\"general-160x100\",\"close-200x150\",\"rotation-224x126\"\\]")
+# The user's sequences are added to the recipe's.
+run(0 ${CLI} train --recipe general --recipe-scale tiny --train a --val b -o recipe4/head.safetensors
+    --work recipe_work1 --cache recipe_cache1)
+run(0 ${CLI} weights --info recipe4/head.safetensors)
+expect_match("\"train_sequences\":\\[\"general-160x100\",\"close-200x150\",\"rotation-224x126\",\"a\"\\]")
+expect_match("\"val_sequences\":\\[\"val-general-200x150\",\"b\"\\]")
+# Bad values: exit 2 naming the value, before anything is rendered.
+run(2 ${CLI} train --recipe generic -o recipe_bad/head.safetensors --work recipe_work_bad)
+expect_match("--recipe 'generic': no such recipe; the recipes are: general")
+run(2 ${CLI} train --recipe general --train a nowhere -o recipe_bad/head.safetensors --work recipe_work_bad)
+expect_match("--train nowhere: no such sequence")
+run(2 ${CLI} train --recipe general --val nowhere2 -o recipe_bad/head.safetensors --work recipe_work_bad)
+expect_match("--val nowhere2: no such sequence")
+run(2 ${CLI} train --recipe general --recipe-scale huge -o recipe_bad/head.safetensors --work recipe_work_bad)
+expect_match("--recipe-scale 'huge': expected full or tiny")
+run(2 ${CLI} train --recipe general --epochs 3 -o recipe_bad/head.safetensors --work recipe_work_bad)
+expect_match("--epochs with --recipe general: the recipe fixes it")
+if(EXISTS "${WORK}/recipe_work_bad")
+  message(FATAL_ERROR "a refused --recipe run rendered sequences")
+endif()
+run(2 ${CLI} train --val b -o recipe_bad/head.safetensors)
+expect_match("--train is required \\(or --recipe general")
+run(2 ${CLI} train --train a --val b --work w -o recipe_bad/head.safetensors)
+expect_match("--work is for --recipe")

@@ -31,6 +31,7 @@
 #include "inertialnet/models/weights.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/runtime/program_cache.hpp"
+#include "inertialnet/train/recipe.hpp"
 #include "inertialnet/train/trainer.hpp"
 #include "inertialnet/train/training_log.hpp"
 #include "inertialnet/train/training_set.hpp"
@@ -56,6 +57,8 @@ struct TrainCliOptions {
   std::string seed = "1";
   double cache_budget_mb = -1;
   bool resume = false, no_flow_cache = false, augment_flips = false;
+  // --recipe NAME (train/recipe.hpp): renders its own sequences and fixes every training setting.
+  std::string recipe, recipe_scale = "full", work;
 };
 
 std::filesystem::path sibling(const std::filesystem::path& out, const std::string& suffix) {
@@ -119,8 +122,15 @@ void check_outputs(const std::vector<Output>& outputs, const std::vector<std::st
 
 Command register_train(CLI::App& app, const GlobalOptions& global) {
   auto o = std::make_shared<TrainCliOptions>();
-  app.add_option("--train", o->train, "training sequences (EuRoC folders or ROS bags)")->required();
-  app.add_option("--val", o->val, "validation sequences (EuRoC folders or ROS bags)")->required();
+  app.add_option("--train", o->train, "training sequences (EuRoC folders or ROS bags); with --recipe, added to its own");
+  app.add_option("--val", o->val, "validation sequences (EuRoC folders or ROS bags); with --recipe, added to its own");
+  app.add_option("--recipe", o->recipe,
+                 "general: render the recipe's synthetic sequences and train with its fixed settings (the same head "
+                 "bit for bit on one device; docs/training.md)");
+  // For the reproducibility test: the recipe's code path in seconds (docs/training.md).
+  app.add_option("--recipe-scale", o->recipe_scale, "full, or tiny (a few seconds; for tests, not a usable head)")
+      ->capture_default_str();
+  app.add_option("--work", o->work, "where --recipe renders its sequences (default: <program cache>/recipes)");
   add_bag_topic_options(app, o->bag, true);
   app.add_option("--T-cam-imu", o->T_cam_imu,
                  "for ROS bags: IMU-to-camera transform, 16 numbers (4x4 row-major, Kalibr's T_cam_imu) or a YAML file "
@@ -172,7 +182,45 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
   app.add_option("--cache", o->cache, "flow cache folder (default: <program cache>/flows)");
   app.add_option("--cache-budget", o->cache_budget_mb, "largest flow cache per sequence, MB (else not cached)");
   app.add_flag("--no-flow-cache", o->no_flow_cache, "compute flows afresh and cache nothing");
-  return [o, &global]() {
+  // What a recipe fixes: giving one of these beside --recipe is refused (its head would not be the
+  // recipe's).
+  std::vector<CLI::Option*> fixed;
+  for (const char* name : {"--flow", "--weights", "--epochs", "--batch", "--lr", "--optimizer", "--momentum",
+                           "--weight-decay", "--lr-schedule", "--seed", "--head-size", "--target", "--head-input",
+                           "--dropout", "--augment-rotation", "--augment-flips", "--time-offset"}) {
+    fixed.push_back(app.get_option(name));
+  }
+  return [o, &global, fixed]() {
+    std::unique_ptr<TrainingRecipe> recipe;
+    if (o->recipe.empty()) {
+      if (o->train.empty() || o->val.empty()) {
+        throw invalid_input(std::string(o->train.empty() ? "--train" : "--val") +
+                            " is required (or --recipe general: a head from the project's synthetic sequences)");
+      }
+      if (!o->work.empty() || o->recipe_scale != "full") {
+        throw invalid_input(std::string(o->work.empty() ? "--recipe-scale" : "--work") + " is for --recipe");
+      }
+    } else {
+      recipe = std::make_unique<TrainingRecipe>(training_recipe(o->recipe, o->recipe_scale));
+      for (const CLI::Option* option : fixed) {
+        if (option->count() > 0) {
+          throw invalid_input(option->get_name() + " with --recipe " + o->recipe +
+                              ": the recipe fixes it (its head is reproducible from the recipe's name and version); "
+                              "leave it out, or train without --recipe");
+        }
+      }
+      // The user's sequences, checked before minutes of rendering.
+      for (const auto* list : {&o->train, &o->val}) {
+        for (const auto& path : *list) {
+          std::error_code ec;
+          if (!fs::exists(path, ec)) {
+            throw invalid_input(std::string(list == &o->train ? "--train " : "--val ") + path +
+                                ": no such sequence (a EuRoC folder or a ROS bag)");
+          }
+        }
+      }
+      o->head_size = std::to_string(recipe->trainer.head.input_width) + "x" + std::to_string(recipe->trainer.head.input_height);
+    }
     const auto [width, height] = parse_size(o->head_size);
     TrainerOptions options;
     options.head.input_width = width;
@@ -188,6 +236,7 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
     options.seed = parse_seed(o->seed);
     options.flip_augmentation = o->augment_flips;
     options.rotation_augmentation_deg_s = o->augment_rotation;
+    if (recipe) options = recipe->trainer;
     options.head.validate();
 
     TrainingSetOptions set_options;
@@ -196,6 +245,11 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
     set_options.flow = parse_flow_method(o->flow);
     set_options.input = parse_head_input(o->head_input);
     set_options.target = parse_sync_target(o->target);
+    if (recipe) {
+      set_options.flow = recipe->flow;
+      set_options.input = recipe->input;
+      set_options.target = recipe->target;
+    }
     if (!o->time_offset.empty()) set_options.time_offset_s = parse_seconds(o->time_offset, "--time-offset");
     set_options.bag_input.bag = o->bag;
     if (!o->T_cam_imu.empty()) set_options.bag_input.camera_imu = parse_camera_imu(o->T_cam_imu, "--T-cam-imu");
@@ -220,6 +274,24 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
     std::vector<std::string> sequences = o->train;
     sequences.insert(sequences.end(), o->val.begin(), o->val.end());
     check_outputs(outputs, o->weights, sequences);
+
+    if (recipe) {
+      const fs::path work = o->work.empty() ? default_cache_directory() / "recipes" : fs::path(o->work);
+      const RenderedRecipe rendered =
+          render_recipe(*recipe, work, [](const std::string& name, std::size_t i, std::size_t n) {
+            info("rendering " + name + " (" + std::to_string(i + 1) + " of " + std::to_string(n) + ")");
+          });
+      info("recipe " + o->recipe + " v" + std::to_string(recipe->version) + " (" + recipe->scale + "): " +
+           std::to_string(rendered.train.size()) + " training and " + std::to_string(rendered.val.size()) +
+           " validation sequences in " + work.string() + " (" + std::to_string(rendered.rendered) + " rendered now)");
+      std::vector<std::string> train, val;
+      for (const auto& p : rendered.train) train.push_back(p.string());
+      for (const auto& p : rendered.val) val.push_back(p.string());
+      train.insert(train.end(), o->train.begin(), o->train.end());
+      val.insert(val.end(), o->val.begin(), o->val.end());
+      o->train = train;
+      o->val = val;
+    }
 
     std::unique_ptr<Device> device = open_device(global);
     Trainer trainer(*device, options);  // refuses options no run can use
@@ -295,6 +367,7 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
       j["target"] = to_string(set_options.target);
       j["time_offset_s"] = set_options.time_offset_s;
       j["frame"] = "body";
+      if (recipe) j["recipe"] = nlohmann::json::parse(recipe_to_json(*recipe));
       j["train_sequences"] = train_set.sequences();
       j["val_sequences"] = val_set.sequences();
       j["epoch"] = r.epoch;
@@ -304,7 +377,9 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
       j["gain"] = nlohmann::json::parse(vec3_json(r.gain));
       // What predict reads to feed the head as it was trained (models/head_input.hpp).
       const std::string input = head_input_to_json({set_options.input, to_string(set_options.flow)});
-      return std::map<std::string, std::string>{{"inertialnet.training", j.dump()}, {kMetadataHeadInput, input}};
+      std::map<std::string, std::string> meta{{"inertialnet.training", j.dump()}, {kMetadataHeadInput, input}};
+      if (recipe) meta["inertialnet.recipe"] = recipe_to_json(*recipe);
+      return meta;
     };
 
     Progress* bar = nullptr;

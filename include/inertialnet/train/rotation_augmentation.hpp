@@ -24,6 +24,16 @@ namespace inertialnet {
 void add_rotation_flow(float* flow, const CameraIntrinsics& camera, HeadInput convention, const Vec3& omega_camera,
                        double dt_s);
 
+// The target of a pair augmented by add_rotation_flow(…, omega_camera, dt_s): the pair's relative
+// rotation exp(θ), θ = R_BCᵀ·target·dt (camera frame), followed by exp(ω·dt) is exp(φ) with
+// φ = log(exp(θ)·exp(ω·dt)), so the target becomes target + R_BC·(φ − θ)/dt. Adding R_BC·ω alone
+// misses BCH's ½·θ×(ω·dt) and higher terms: ½·|ω̄×ω|·dt, up to 1–2 deg/s for rates of 60 deg/s over
+// a 50–150 ms interval (the drawn ω is independent of the pair's own rate, so this is label noise
+// of the same size as the learned head's error; docs/training.md, "A head you can get").
+// `camera_to_body` is R_BC; rates in rad/s.
+Vec3 rotation_augmented_target(const Vec3& target_body, const Mat3& camera_to_body, const Vec3& omega_camera,
+                               double dt_s);
+
 // The pinhole camera of `camera`'s frames resized to width × height (pixel centres at integer
 // coordinates: c' = (c + 0.5)·scale − 0.5; the lens distortion is dropped, as the head ignores it).
 CameraIntrinsics camera_at_size(const CameraIntrinsics& camera, int width, int height);
