@@ -193,14 +193,17 @@ CameraChoice choose_camera(const PredictSettings& s, FrameSource& source, std::v
 
 }  // namespace
 
+// With a rolling-shutter readout given, LK lost to DIS at 752×480 close range (x up to 1.8×
+// DIS's RMSE), so DIS stays the weight-free default there.
+std::string default_flow(const PredictSettings& s) {
+  if (!s.flow.empty() || !s.weights.empty()) return s.flow;
+  return s.readout_time_s > 0 ? "dis" : "lk";
+}
+
 Prediction::Prediction(const PredictSettings& s) : settings_(s) {
   const bool have_weights = !s.weights.empty();
-  // Without weights: sparse Lucas–Kanade at the geometric head's points, 2.7–4.5× DIS's pairs/s
-  // and as accurate or better on every synthetic condition of docs/real_cameras.md except one:
-  // with a rolling-shutter readout given, the row-linear model wants DIS's denser field (752×480
-  // close range, 30 ms readout: LK's x up to 1.8× DIS's), so DIS stays the default there.
-  const char* weight_free = s.readout_time_s > 0 ? "dis" : "lk";
-  processor_.flow = parse_flow_method(s.flow.empty() ? (have_weights ? "flownet2" : weight_free) : s.flow);
+  const std::string flow = default_flow(s);
+  processor_.flow = parse_flow_method(flow.empty() ? "flownet2" : flow);
   const std::string head = s.head.empty() ? (have_weights ? "inertialnet" : "geometric") : s.head;
   if (head != "inertialnet" && head != "geometric" && head != "both") {
     throw invalid_input("unknown head '" + head + "'; expected inertialnet, geometric or both");
