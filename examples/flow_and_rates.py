@@ -37,8 +37,9 @@ for k in range(1, len(seq)):
 
 # The same in one call (what `inertialnet predict` does): Rates (.w is (N, 3) rad/s, .sigma each
 # rate's standard deviation). The loop above gives two-frame rates; predict() by default smooths
-# them over the next two pairs (smooth="lag:2"), so the comparison asks for the two-frame ones.
-rates = inertialnet.predict(sequence, smooth="off")
+# them over the next two pairs (smooth="lag:2"), so the comparison asks for the two-frame ones;
+# and its weight-free default is sparse Lucas-Kanade flow, so it is asked for DIS, the loop's.
+rates = inertialnet.predict(sequence, smooth="off", flow="dis")
 print("predict() agrees with the loop:", np.allclose([rates[c][-1] for c in ("wx", "wy", "wz")], w))
 
 report = inertialnet.evaluate(rates, sequence, target="mean")

@@ -38,14 +38,15 @@ def test_predict_flow_lk_matches_the_cli(cli, sequence, tmp_path):
     assert rates.columns == header and len(rates) == len(expected) == 4
     for i, name in enumerate(header[1:4], start=1):
         assert [csv_text(v) for v in rates[name]] == [csv_text(v) for v in expected[:, i]]
-    dis = inertialnet.predict(sequence)
+    dis = inertialnet.predict(sequence, flow="dis")
     assert not np.array_equal(dis.w, rates.w)
     with pytest.raises(ValueError, match="expected flownet2, dis or lk"):
         inertialnet.predict(sequence, flow="sparse")
 
 
 def test_dis_flow_and_geometric_head_step_by_step_match_the_cli(cli, sequence, tmp_path):
-    _, expected = cli_rates(cli, sequence, tmp_path, "--smooth", "off")  # pair by pair: the two-frame rates
+    # pair by pair: the two-frame rates; DIS named (the weight-free default is Lucas-Kanade)
+    _, expected = cli_rates(cli, sequence, tmp_path, "--smooth", "off", "--flow", "dis")
     seq = inertialnet.Sequence(sequence)
     camera, to_body, t = seq.camera, seq.camera_to_body, seq.timestamps_ns
     assert camera.width == 128 and to_body.shape == (3, 3)

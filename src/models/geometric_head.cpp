@@ -157,10 +157,13 @@ RotationEstimate GeometricHead::solve(Queue& queue, const Tensor& flow, double d
       return detail::solve_opengv(motion_field_correspondences(queue, f, map_, options_.stride), dt,
                                   camera_.mean_focal(), options_);
     }
+    // The ends of every sample once, then 20–50 passes over them alone: looking them up in the
+    // flow and the map on every pass was half of the moments' time (docs/performance.md).
+    const Tensor ends = motion_field_ends(queue, f, map_, options_.stride);
     return detail::solve_motion_field(
         [&](const MotionFieldParams& p) {
           check_stop(p.mode == MotionFieldMode::General ? "translation refinement" : "rotation passes");
-          return motion_field_moments(queue, f, map_, p);
+          return motion_field_moments_of_ends(queue, ends, p);
         },
         dt, camera_.mean_focal(), options_);
   };

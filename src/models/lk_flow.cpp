@@ -16,6 +16,10 @@
 //   row-linear model), on x: 0.75 / 0.69 / 0.53 deg/s on seeds 3 / 4 / 5 against DIS's 0.41 /
 //   0.55 / 0.43, one or two pairs off by 3–4 deg/s. 22k points (stride 4) gave 0.30 0.20 0.40 on
 //   seed 3, at DIS's cost: the row-linear model wants the denser grid, or DIS's denser field.
+//   Hence predict's weight-free default: LK, but DIS where a readout time is given.
+// - The check's backward track runs on every level: on the full frame alone (it starts at the
+//   forward track's answer; a quarter to an eighth of its time) it let wrong vectors through,
+//   worse on every condition (e.g. 376×240 general 0.27 0.17 0.14 against 0.21 0.14 0.10).
 
 #include "inertialnet/models/lk_flow.hpp"
 

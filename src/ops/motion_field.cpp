@@ -157,13 +157,14 @@ SampleGrid SampleGrid::of(int width, int height, int stride) {
   return g;
 }
 
-MotionFieldMoments motion_field_moments(Queue& queue, const Tensor& flow, const Tensor& map,
-                                        const MotionFieldParams& params) {
-  check_inputs(flow, map);
-  check_stride(params.stride);
+namespace {
+
+// One moments pass: over the flow's grid (`ends` false: `flow` and `map` as given) or over the
+// ends of motion_field_ends (`ends` true: `flow` is them, `map` unused, width … columns unused
+// but for `samples`). The launch is the same either way, so that the sums come in the same order.
+MotionFieldMoments launch_moments(Queue& queue, const Tensor& flow, const Tensor& map, int width, int height,
+                                  const SampleGrid& grid, const MotionFieldParams& params, bool ends) {
   if (!(params.dt > 0) || !std::isfinite(params.dt)) throw invalid_input(kOp + ": the frame interval dt must be positive");
-  const int width = static_cast<int>(map.w()), height = static_cast<int>(map.h());
-  const SampleGrid grid = SampleGrid::of(width, height, params.stride);
   const bool general = params.mode == MotionFieldMode::General;
   const MomentsLayout layout = moments_layout(params.mode);
   const std::size_t local = moments_work_group(queue.device(), layout.quantities);
@@ -172,11 +173,12 @@ MotionFieldMoments motion_field_moments(Queue& queue, const Tensor& flow, const 
   const std::size_t groups = std::clamp<std::size_t>((samples + 8 * local - 1) / (8 * local), 1, 64);
   const std::size_t floats = groups * static_cast<std::size_t>(layout.quantities);
   const Tensor partials = Tensor::empty(queue, {static_cast<std::int64_t>(floats)});
-  const KernelDefines defines = KernelDefines()
-                                    .add("WG_SIZE", local)
-                                    .add("MODE", general ? 1 : 0)
-                                    .add("LOSS", static_cast<int>(params.loss))
-                                    .add(layout_defines(layout));
+  KernelDefines defines = KernelDefines()
+                              .add("WG_SIZE", local)
+                              .add("MODE", general ? 1 : 0)
+                              .add("LOSS", static_cast<int>(params.loss))
+                              .add(layout_defines(layout));
+  if (ends) defines.add("ENDS", 1);
   Kernel& kernel = queue.kernel("motion_field", "moments", defines);
   const float inv_scale = params.loss == RobustLoss::LeastSquares ? 0.0f : static_cast<float>(1.0 / params.scale);
   const Vec3 t = general ? params.translation : Vec3{0, 0, 0};
@@ -193,20 +195,47 @@ MotionFieldMoments motion_field_moments(Queue& queue, const Tensor& flow, const 
   return unpack(q, layout);
 }
 
-std::vector<NormalizedCorrespondence> motion_field_correspondences(Queue& queue, const Tensor& flow, const Tensor& map,
-                                                                   int stride) {
+}  // namespace
+
+MotionFieldMoments motion_field_moments(Queue& queue, const Tensor& flow, const Tensor& map,
+                                        const MotionFieldParams& params) {
+  check_inputs(flow, map);
+  check_stride(params.stride);
+  const int width = static_cast<int>(map.w()), height = static_cast<int>(map.h());
+  return launch_moments(queue, flow, map, width, height, SampleGrid::of(width, height, params.stride), params, false);
+}
+
+MotionFieldMoments motion_field_moments_of_ends(Queue& queue, const Tensor& ends, const MotionFieldParams& params) {
+  detail::require_defined(ends, kOp, "ends");
+  if (ends.rank() != 2 || ends.dim(1) != 4 || ends.dim(0) < 1) {
+    throw invalid_input(kOp + ": the ends must be [samples, 4] (motion_field_ends), got " + to_string(ends.shape()));
+  }
+  SampleGrid grid;  // only the count matters: one row of samples
+  grid.columns = static_cast<int>(ends.dim(0));
+  grid.rows = 1;
+  return launch_moments(queue, ends, ends, 0, 0, grid, params, true);
+}
+
+Tensor motion_field_ends(Queue& queue, const Tensor& flow, const Tensor& map, int stride) {
   check_inputs(flow, map);
   check_stride(stride);
   const int width = static_cast<int>(map.w()), height = static_cast<int>(map.h());
   const SampleGrid grid = SampleGrid::of(width, height, stride);
-  const Tensor out = Tensor::empty(queue, {grid.count(), 4});
+  Tensor out = Tensor::empty(queue, {grid.count(), 4});
   Kernel& kernel = queue.kernel("motion_field", "correspondences");
   kernel.set_args(flow, map, width, height, stride, grid.first, grid.columns, grid.count(), out);
   queue.launch(kernel, Range(static_cast<std::size_t>(grid.count())), Range(detail::work_group_size(queue.device(), 64)));
+  return out;
+}
+
+std::vector<NormalizedCorrespondence> motion_field_correspondences(Queue& queue, const Tensor& flow, const Tensor& map,
+                                                                   int stride) {
+  const Tensor out = motion_field_ends(queue, flow, map, stride);
   const std::vector<float> host = out.to_host(queue);
+  const int count = static_cast<int>(out.dim(0));
   std::vector<NormalizedCorrespondence> result;
-  result.reserve(static_cast<std::size_t>(grid.count()));
-  for (int s = 0; s < grid.count(); ++s) {
+  result.reserve(static_cast<std::size_t>(count));
+  for (int s = 0; s < count; ++s) {
     const float* c = host.data() + 4 * static_cast<std::size_t>(s);
     if (std::isnan(c[0])) continue;
     result.push_back({c[0], c[1], c[2], c[3]});

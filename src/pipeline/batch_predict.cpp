@@ -141,6 +141,12 @@ Provenance prediction_provenance(const PredictSettings& s, std::size_t max_pairs
   // Every setting of PredictSettings that changes a rate or the file's metadata (rate_settings.hpp);
   // not the device, the lanes or the decoding threads (the header says why).
   for (const RateSetting& setting : rate_settings()) p.emplace_back(setting.name, setting.text(s));
+  // The flow as the run resolves it (default_flow), not the empty setting: a file written when ""
+  // meant DIS is not current once "" means LK. (rate_settings() keeps the setting itself: the
+  // resolved one also follows the weights, which the provenance records by content.)
+  for (auto& entry : p) {
+    if (entry.first == "flow") entry.second = default_flow(s);
+  }
   p.emplace_back("max_pairs", std::to_string(max_pairs));
   return p;
 }

@@ -35,6 +35,18 @@ run(0 ${CLI} predict rotation --flow lk --max-pairs 1 -o one.csv)
 expect_match("no weights given: weight-free Lucas-Kanade optical flow \\+ geometric head")
 expect_match("Lucas-Kanade flow \\+ geometric head")
 
+# The default without weights: LK; DIS where a rolling-shutter readout is given (the row-linear
+# model wants DIS's denser field; docs/real_cameras.md, "DIS or Lucas-Kanade"). An explicit
+# --flow wins either way.
+run(0 ${CLI} predict rotation --max-pairs 1 -o default.csv)
+expect_match("no weights given: weight-free Lucas-Kanade optical flow \\+ geometric head")
+run(0 ${CLI} predict rotation --readout-time 0.02 --max-pairs 1 -o default_rs.csv)
+expect_match("no weights given: weight-free DIS optical flow \\+ geometric head")
+run(0 ${CLI} predict rotation --readout-time 0.02 --flow lk --max-pairs 1 -o lk_rs.csv)
+expect_match("no weights given: weight-free Lucas-Kanade optical flow \\+ geometric head")
+run(0 ${CLI} predict rotation --flow dis --max-pairs 1 -o dis.csv)
+expect_match("no weights given: weight-free DIS optical flow \\+ geometric head")
+
 # The saved flow: one file per pair, unknown (Middlebury's 1e10) away from the tracked points.
 run(0 ${CLI} predict rotation --flow lk --max-pairs 2 --save-flow flows -o saved.csv)
 file(GLOB flows "${WORK}/flows/*.flo")

@@ -8,6 +8,7 @@
 
 #include "inertialnet/io/camera.hpp"
 #include "inertialnet/ops/motion_field.hpp"
+#include "inertialnet/runtime/error.hpp"
 #include "reference/motion_field.hpp"
 #include "support/motion_fields.hpp"
 #include "support/testing.hpp"
@@ -63,8 +64,17 @@ TEST(MotionFieldMoments, MatchTheReferenceInEveryModeAndLoss) {
           p.scale = 0.08;            // ≈0.5 px in normalised image velocity
           p.inlier_threshold = 0.3;  // ≈2 px
           p.stride = stride;
-          const MotionFieldMoments got = motion_field_moments(queue, slice, map_tensor, p);
+          const MotionFieldMoments from_flow = motion_field_moments(queue, slice, map_tensor, p);
           const MotionFieldMoments want = reference::motion_field_moments(flow, map, p);
+          // The same sums from the ends looked up once (motion_field_ends): the same samples in
+          // the same order, so the same floats; and both against the reference below.
+          const MotionFieldMoments of_ends =
+              motion_field_moments_of_ends(queue, motion_field_ends(queue, slice, map_tensor, stride), p);
+          EXPECT_EQ(of_ends.usable, from_flow.usable);
+          EXPECT_NEAR(of_ends.weight_sum, from_flow.weight_sum, 1e-9 * std::fabs(from_flow.weight_sum));
+          for (int i = 0; i < 78; ++i) EXPECT_NEAR(of_ends.gram[i], from_flow.gram[i], 1e-9 * std::fabs(from_flow.gram[i])) << i;
+          for (int i = 0; i < 6; ++i) EXPECT_NEAR(of_ends.normal[i], from_flow.normal[i], 1e-9 * std::fabs(from_flow.normal[i])) << i;
+          for (const MotionFieldMoments& got : {from_flow, of_ends}) {
           // Counts are exact; the sample set must be the same one.
           EXPECT_EQ(got.usable, want.usable);
           EXPECT_GT(want.usable, 0.9 * SampleGrid::of(k.width, k.height, stride).count());
@@ -91,10 +101,22 @@ TEST(MotionFieldMoments, MatchTheReferenceInEveryModeAndLoss) {
               EXPECT_NEAR(got.parallel_sum, want.parallel_sum, 1e-3 * std::sqrt(want.parallel_sq * want.inliers) + 1e-6);
             }
           }
+          }
         }
       }
     }
   }
+}
+
+TEST(MotionFieldMoments, OfEndsRefusesATensorThatIsNotEnds) {
+  Queue& queue = testing::test_queue();
+  MotionFieldParams p;
+  p.dt = 0.05;
+  const Tensor flat = Tensor::from_host(queue, {1, 2, 4, 4}, std::vector<float>(32, 0.0f));
+  EXPECT_THROW(motion_field_moments_of_ends(queue, flat, p), Error);
+  const Tensor ends = Tensor::from_host(queue, {2, 4}, std::vector<float>(8, 0.1f));
+  p.dt = 0;
+  EXPECT_THROW(motion_field_moments_of_ends(queue, ends, p), Error);
 }
 
 TEST(MotionFieldMoments, CorrespondencesMatchTheReference) {

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <string>
 
 #include "inertialnet/pipeline/batch_predict.hpp"
 #include "inertialnet/runtime/error.hpp"
@@ -35,4 +36,26 @@ TEST(BatchPredict, RefusesTwoSequencesOfOneNameAndLiveSources) {
   const auto paths = batch_rates_paths({"a/s1", "b/s2"}, "out");
   ASSERT_EQ(paths.size(), 2u);
   EXPECT_EQ(paths[1], fs::path("out") / "s2.csv");
+}
+
+// The provenance records the flow a weight-free run resolves to (default_flow), not the empty
+// setting: a rates file written when "" meant DIS must not count as current once "" means LK.
+TEST(BatchPredict, ProvenanceNamesTheWeightFreeFlowPredictRuns) {
+  const fs::path root = fs::temp_directory_path() / "inertialnet_test_batch_provenance";
+  fs::remove_all(root);
+  fs::create_directories(root / "seq" / "mav0");
+  const auto flow_of = [](const Provenance& provenance) {
+    for (const auto& entry : provenance) {
+      if (entry.first == "flow") return entry.second;
+    }
+    return std::string("(absent)");
+  };
+  PredictSettings settings;
+  settings.sequence = root / "seq";
+  EXPECT_EQ(flow_of(prediction_provenance(settings, 0)), "lk");
+  settings.readout_time_s = 0.03;  // the row-linear model: DIS
+  EXPECT_EQ(flow_of(prediction_provenance(settings, 0)), "dis");
+  settings.flow = "lk";  // given: as it is
+  EXPECT_EQ(flow_of(prediction_provenance(settings, 0)), "lk");
+  fs::remove_all(root);
 }

@@ -60,6 +60,9 @@ RatesTable predict_weight_free(const CalibrateTimeOptions& o, const EurocSequenc
   }
   PredictSettings settings;
   settings.sequence = o.sequence;
+  // DIS named: predict's weight-free default is Lucas-Kanade now, but the fits below (and the
+  // readout leak's model) were measured and bounded on DIS rates.
+  settings.flow = "dis";
   settings.fx = o.camera.fx;
   settings.fy = o.camera.fy;
   settings.cx = o.camera.cx;

@@ -200,8 +200,8 @@ int predict_one(const PredictOptions& given, const GlobalOptions& global, const 
   const bool live = prediction.source().open_ended();
   const auto& infos = prediction.device_infos();
   if (!have_weights) {
-    info(std::string("no weights given: weight-free ") + (o->flow == "lk" ? "Lucas-Kanade" : "DIS") +
-         " optical flow + geometric head");
+    info(std::string("no weights given: weight-free ") +
+         (processor.flow == FlowMethod::LK ? "Lucas-Kanade" : "DIS") + " optical flow + geometric head");
   }
   const std::string count = !live      ? std::to_string(pairs) + " pairs"
                             : pairs > 0 ? "up to " + std::to_string(pairs) + " pairs"
@@ -449,8 +449,9 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
                  "weights (safetensors) holding FlowNet2 and/or the InertialNet head; repeat for several files");
   app.add_option("--model", o->model, "flow network (default FlowNet2)")->transform(choice("model", flow_model_names()));
   app.add_option("--flow", o->flow,
-                 "flownet2 (default with weights), dis (OpenCV DIS; default without weights) or lk (sparse "
-                 "Lucas-Kanade at the geometric head's sample points; geometric head only)")
+                 "flownet2 (default with weights), dis (OpenCV DIS; default without weights when --readout-time is "
+                 "given) or lk (sparse Lucas-Kanade at the geometric head's sample points; geometric head only; "
+                 "default without weights otherwise)")
       ->transform(choice("flow method", {"flownet2", "dis", "lk"}));
   app.add_option("--head", o->head, "inertialnet (default with weights), geometric (default without), or both")
       ->transform(choice("head", {"inertialnet", "geometric", "both"}));

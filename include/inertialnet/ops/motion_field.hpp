@@ -103,6 +103,18 @@ struct NormalizedCorrespondence {
 MotionFieldMoments motion_field_moments(Queue& queue, const Tensor& flow, const Tensor& map,
                                         const MotionFieldParams& params);
 
+// The ends of every grid sample of `flow`, looked up once: a device tensor [samples, 4] of
+// (x1, y1, x2, y2) in grid order, NaN in all four for an unusable sample. For the many passes of
+// one flow (the geometric head's solvers run 20–50): motion_field_moments_of_ends then reads
+// these instead of the flow and the map.
+Tensor motion_field_ends(Queue& queue, const Tensor& flow, const Tensor& map, int stride);
+
+// motion_field_moments over the ends motion_field_ends wrote (params.stride is not used: the
+// ends are of the stride they were made with). The same sums, in the same order, as
+// motion_field_moments on that flow. Throws invalid_input for an undefined tensor or one not
+// [N, 4], and a non-positive dt.
+MotionFieldMoments motion_field_moments_of_ends(Queue& queue, const Tensor& ends, const MotionFieldParams& params);
+
 // The usable grid samples of `flow` as normalised correspondences, in grid order (row-major);
 // only the sampled correspondences come back to the host.
 std::vector<NormalizedCorrespondence> motion_field_correspondences(Queue& queue, const Tensor& flow, const Tensor& map,

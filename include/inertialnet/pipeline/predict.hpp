@@ -31,7 +31,7 @@ struct PredictSettings {
   std::filesystem::path sequence;    // EuRoC folder, image folder, video or live source (io/live_source.hpp)
   std::vector<std::string> weights;  // safetensors files; empty: the weight-free path
   std::string model;                 // flow network; "" takes it from the weights (else FlowNet2)
-  std::string flow;                  // "flownet2", "dis" or "lk"; "": flownet2 with weights, dis without
+  std::string flow;                  // "flownet2", "dis" or "lk"; "": see default_flow()
   std::string head;                  // "inertialnet", "geometric" or "both"; "": by the weights
   std::string solver = "motion-field";  // geometric head: "motion-field" or "opengv"
   // A calibration file (calibration_file.hpp: EuRoC sensor.yaml, Kalibr camchain, OpenCV YAML/XML)
@@ -133,6 +133,13 @@ class Prediction {
   std::vector<std::unique_ptr<WeightSet>> weight_sets_;
   std::map<const Device*, const WeightSet*> weights_of_;
 };
+
+// The flow method `settings` run with when `flow` is "": with weights, "" (FlowNet2, or the flow
+// the trained head's metadata names: known only from the weights); without, "lk" (sparse
+// Lucas–Kanade, 2.7–4.5× DIS's pairs/s and as accurate or better on the synthetic conditions of
+// docs/real_cameras.md), or "dis" where a readout time is given (the row-linear rolling-shutter
+// model wants DIS's denser field: LK lost there). A given `flow` is returned as it is.
+std::string default_flow(const PredictSettings& settings);
 
 // One pair as a rates CSV row of Prediction::layout(): the first estimator's rates and status,
 // then the others'.
