@@ -463,3 +463,11 @@ run(2 ${CLI} train --train seq --val seq -o head.safetensors --dropout nan)
 expect_match("--dropout: must be a finite number from 0 up, got nan")
 run(2 ${CLI} train --train seq --val seq -o head.safetensors --augment-rotation 1e6)
 expect_match("--augment-rotation: must be at most 1000 deg/s, got 1e6")
+# train --cache-budget: NaN, inf and negatives were taken silently (no budget, or an undefined
+# cast of inf to a byte count); refused at parse, naming the option and the value.
+run(2 ${CLI} train --train seq --val seq -o head.safetensors --cache-budget nan)
+expect_match("--cache-budget: must be a finite number from 0 up, got nan")
+run(2 ${CLI} train --train seq --val seq -o head.safetensors --cache-budget inf)
+expect_match("--cache-budget: must be a finite number from 0 up, got inf")
+run(2 ${CLI} train --train seq --val seq -o head.safetensors --cache-budget -1)
+expect_match("--cache-budget: must be a finite number from 0 up, got -1")
