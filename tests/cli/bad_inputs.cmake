@@ -471,3 +471,6 @@ run(2 ${CLI} train --train seq --val seq -o head.safetensors --cache-budget inf)
 expect_match("--cache-budget: must be a finite number from 0 up, got inf")
 run(2 ${CLI} train --train seq --val seq -o head.safetensors --cache-budget -1)
 expect_match("--cache-budget: must be a finite number from 0 up, got -1")
+# train --lr: refused by the Trainer, which did not quote the value ("must be positive").
+run(2 ${CLI} train --train seq --val seq -o head.safetensors --lr nan)
+expect_match("the learning rate must be a finite number > 0, got nan")
