@@ -474,3 +474,16 @@ expect_match("--cache-budget: must be a finite number from 0 up, got -1")
 # train --lr: refused by the Trainer, which did not quote the value ("must be positive").
 run(2 ${CLI} train --train seq --val seq -o head.safetensors --lr nan)
 expect_match("the learning rate must be a finite number > 0, got nan")
+# synth --extrinsic-error "": taken as not given before (a sequence without the error asked for).
+# run() passes its arguments through ${ARGN}, which drops an empty one: called directly here.
+execute_process(COMMAND ${CLI} synth empty_extrinsic --frames 3 --size 96x64 --extrinsic-error ""
+                WORKING_DIRECTORY "${WORK}" RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 600)
+message("$ synth --extrinsic-error \"\"\n${out}${err}(exit ${code})")
+if(NOT "${code}" STREQUAL "2")
+  message(FATAL_ERROR "expected exit code 2, got ${code}")
+endif()
+set(output "${out}${err}")
+expect_match("--extrinsic-error should be three comma-separated numbers x,y,z, found \"\"")
+if(EXISTS "${WORK}/empty_extrinsic")
+  message(FATAL_ERROR "synth wrote a sequence for an empty --extrinsic-error")
+endif()
