@@ -487,3 +487,6 @@ expect_match("--extrinsic-error should be three comma-separated numbers x,y,z, f
 if(EXISTS "${WORK}/empty_extrinsic")
   message(FATAL_ERROR "synth wrote a sequence for an empty --extrinsic-error")
 endif()
+# --flow-check above 1000 px (at 752 columns) switched the check off silently; the library's bound.
+run(2 ${CLI} predict seq --flow-check 5000)
+expect_match("--flow-check: must be at most 1000 pixels, got 5000")

@@ -20,6 +20,7 @@
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/runtime/layer_profiler.hpp"
 #include "inertialnet/io/flow_io.hpp"
+#include "inertialnet/models/flow_consistency.hpp"
 #include "inertialnet/pipeline/batch_predict.hpp"
 #include "inertialnet/pipeline/pipeline.hpp"
 #include "inertialnet/pipeline/predict.hpp"
@@ -485,7 +486,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
                  "DIS and LK: also compute the backward flow and leave out vectors whose round trip misses by more than "
                  "this many pixels (at 752 columns, scaled with the width); 0: off")
       ->capture_default_str()
-      ->check(finite_non_negative_up_to(1e6, "pixels"));
+      ->check(finite_non_negative_up_to(kMaxFlowCheckPx, "pixels"));  // the library's bound (flow_consistency.hpp)
   // Issue 22: confidence per pair and more than two frames.
   app.add_option("--max-sigma", o->max_sigma_deg_s,
                  "geometric head: a pair whose rates' standard deviation exceeds this many deg/s (along the least "
