@@ -448,7 +448,8 @@ expect_match("calib_offset.json: key \"time_offset.offset_s\" should be a number
 # computed (it stopped the batch at its turn, naming neither the manifest nor the line's path).
 file(WRITE "${WORK}/missing_manifest.txt" "seq\n\nno_such_sequence\n")
 run(2 ${CLI} predict --manifest missing_manifest.txt -o missing_batch/)
-expect_match("--manifest missing_manifest.txt: it lists the sequence .*no_such_sequence, which does not exist; nothing was computed")
+# The line is named (third, after a blank one): a manifest may list hundreds.
+expect_match("--manifest missing_manifest.txt:3: it lists the sequence .*no_such_sequence, which does not exist; nothing was computed")
 if(EXISTS "${WORK}/missing_batch/seq.csv")
   message(FATAL_ERROR "the batch computed seq before refusing the manifest")
 endif()
