@@ -498,6 +498,7 @@ py::array_t<float> dis_flow(const py::array& first, const py::array& second, con
   const auto a = images_of(first, order, "img1");
   const auto b = images_of(second, order, "img2");
   if (a.size() != b.size()) throw invalid_input("img1 and img2 hold different numbers of images.");
+  require_flow_check_setting(flow_check, "flow_check");
   std::vector<FlowField> flows;
   run_interruptibly([&](const std::atomic<bool>& stop) {
     DisFlow dis;
@@ -1113,6 +1114,7 @@ PythonPredictOptions python_predict_options(const std::string& sequence, const s
   s.device = text("device");
   s.keep_flow = take("keep_flow").cast<bool>();
   s.flow_check_px = real("flow_check");
+  require_flow_check_setting(s.flow_check_px, "flow_check");  // named as the keyword, not the library's words
   s.max_sigma_deg_s = real("max_sigma");  // predict --max-sigma, --smooth (issue 22)
   s.smooth = text("smooth");
   s.fuse = take("fuse").cast<bool>();  // predict --fuse (issue 23)

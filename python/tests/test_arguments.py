@@ -138,3 +138,14 @@ def test_out_of_memory_is_a_readable_memory_error():
             print("MemoryError:", e)
         """)], capture_output=True, text=True, timeout=300)
     assert child.stdout.startswith("MemoryError: out of host memory"), child.stdout + child.stderr
+
+
+@pytest.mark.parametrize("value", [1e300, -1.0, float("nan")])
+def test_flow_check_is_bounded_and_named(sequence, value):
+    # 1e300 switched the forward-backward check off silently (no upper bound); the message names
+    # the keyword, not the library's "flow check threshold".
+    with pytest.raises(ValueError, match=r"flow_check should be from 0 \(off\) to 1000 pixels"):
+        inertialnet.predict(sequence, flow_check=value)
+    a = np.zeros((48, 64, 3), np.uint8)
+    with pytest.raises(ValueError, match=r"flow_check should be from 0 \(off\) to 1000 pixels"):
+        inertialnet.dis_flow(a, a, flow_check=value)

@@ -239,8 +239,14 @@ void SafetensorsFile::Impl::load() {
   nlohmann::json header;
   try {
     header = nlohmann::json::parse(header_begin, header_end, reject_duplicates);
-  } catch (const nlohmann::json::exception& e) {
-    fail("the " + std::to_string(header_size) + "-byte header is not valid JSON (" + e.what() + ")");
+  } catch (const nlohmann::json::parse_error& e) {
+    // The position, not nlohmann's own text ("[json.exception.parse_error.101] …"): the rule is
+    // one message of ours. e.byte counts from 1 within the header, which starts at byte 8 of the file.
+    fail("the " + std::to_string(header_size) + "-byte header is not valid JSON (it breaks off or is malformed at byte " +
+         std::to_string(e.byte) + " of the header)");
+  } catch (const nlohmann::json::exception&) {
+    // The parser's other refusal: a number beyond a double (out_of_range.406).
+    fail("the " + std::to_string(header_size) + "-byte header is not valid JSON (it holds a number out of range)");
   }
   if (!header.is_object()) fail(std::string("the header is a JSON ") + header.type_name() + ", not an object");
   if (!duplicate.empty()) fail("the header lists '" + duplicate + "' more than once");

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <string>
 
 #include "inertialnet/runtime/error.hpp"
@@ -53,10 +54,15 @@ int mark_inconsistent_flow(FlowField& forward, const FlowField& backward, double
   return marked;
 }
 
-void require_flow_check_setting(double px_at_752_columns) {
-  if (!std::isfinite(px_at_752_columns) || px_at_752_columns < 0) {
-    throw invalid_input("the flow check threshold should be a non-negative number of pixels, got " +
-                        std::to_string(px_at_752_columns));
+void require_flow_check_setting(double px_at_752_columns, const char* name) {
+  // The upper bound: a round trip missing by more than kMaxFlowCheckPx pixels at 752 columns is
+  // no flow at all, so a larger value only switches the check off silently (1e300 did) while
+  // the backward pass is still paid for; 0 is the way to switch it off.
+  if (!std::isfinite(px_at_752_columns) || px_at_752_columns < 0 || px_at_752_columns > kMaxFlowCheckPx) {
+    std::ostringstream value;  // 1e+300 as such (std::to_string wrote 301 digits)
+    value << px_at_752_columns;
+    throw invalid_input(std::string(name) + " should be from 0 (off) to " + std::to_string(kMaxFlowCheckPx) +
+                        " pixels at 752 columns, got " + value.str());
   }
 }
 

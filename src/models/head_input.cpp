@@ -9,6 +9,7 @@
 
 #include "inertialnet/io/safetensors.hpp"
 #include "inertialnet/runtime/error.hpp"
+#include "core/json_object.hpp"
 
 namespace inertialnet {
 
@@ -28,13 +29,7 @@ std::string head_input_to_json(const HeadInputInfo& info) {
 }
 
 HeadInputInfo head_input_from_json(const std::string& text) {
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::exception&) {
-    throw invalid_input("it is not JSON");
-  }
-  if (!j.is_object()) throw invalid_input("it is not a JSON object");
+  nlohmann::json j = parse_json_object(text);
   HeadInputInfo info;
   for (const auto& [key, value] : j.items()) {
     if (!value.is_string()) throw invalid_input("\"" + key + "\" is not a string");

@@ -9,6 +9,7 @@
 
 #include "inertialnet/io/safetensors.hpp"
 #include "inertialnet/runtime/error.hpp"
+#include "core/json_object.hpp"
 
 namespace inertialnet {
 
@@ -83,13 +84,7 @@ std::string sigma_calibration_to_json(const SigmaCalibration& c) {
 }
 
 SigmaCalibration sigma_calibration_from_json(const std::string& text) {
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::exception&) {
-    throw invalid_input("it is not JSON");
-  }
-  if (!j.is_object()) throw invalid_input("it is not a JSON object");
+  nlohmann::json j = parse_json_object(text);
   for (const auto& item : j.items()) {
     const std::string& key = item.key();
     if (key != "version" && key != "scale" && key != "floor_rad_s" && key != "pairs" && key != "geometric_scale" &&

@@ -104,9 +104,15 @@ std::vector<fs::path> batch_rates_paths(const std::vector<fs::path>& sequences, 
 }
 
 std::vector<fs::path> read_batch_manifest(const fs::path& manifest) {
+  std::vector<fs::path> sequences;
+  for (auto& entry : read_batch_manifest_entries(manifest)) sequences.push_back(std::move(entry.sequence));
+  return sequences;
+}
+
+std::vector<BatchManifestEntry> read_batch_manifest_entries(const fs::path& manifest) {
   std::ifstream in(manifest);
   if (!in) throw invalid_input("Cannot read the manifest " + manifest.string() + ".");
-  std::vector<fs::path> sequences;
+  std::vector<BatchManifestEntry> sequences;
   std::string line;
   std::size_t number = 0;
   while (std::getline(in, line)) {
@@ -115,7 +121,8 @@ std::vector<fs::path> read_batch_manifest(const fs::path& manifest) {
     if (begin == std::string::npos || line[begin] == '#') continue;
     const auto end = line.find_last_not_of(" \t\r");
     const fs::path path = line.substr(begin, end - begin + 1);
-    sequences.push_back(path.is_absolute() || is_live_source(path.string()) ? path : manifest.parent_path() / path);
+    sequences.push_back(
+        {path.is_absolute() || is_live_source(path.string()) ? path : manifest.parent_path() / path, number});
   }
   if (sequences.empty()) {
     throw invalid_input("The manifest " + manifest.string() + " lists no sequence (" + std::to_string(number) +

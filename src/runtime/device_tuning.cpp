@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "inertialnet/runtime/error.hpp"
+#include "core/json_object.hpp"
 #include "runtime/atomic_file.hpp"
 #include "runtime/hash.hpp"
 
@@ -138,14 +139,8 @@ void check_xgemm_parameters(const std::map<std::string, std::size_t>& p, const D
 
 std::optional<DeviceTuning> parse_device_tuning(const std::string& document, const DeviceInfo& device) {
   DeviceTuning tuning;
-  json root;
+  const json root = parse_json_object(document, JsonFailure::AtByte);
   try {
-    root = json::parse(document);
-  } catch (const json::parse_error& e) {
-    throw invalid_input("it is not valid JSON (it breaks off or is malformed at byte " + std::to_string(e.byte) + ")");
-  }
-  try {
-    if (!root.is_object()) throw invalid_input("it is not a JSON object");
     const std::string schema = string_member(root, "schema", "");
     if (schema != kTuneSchema) throw invalid_input("schema '" + schema + "', expected " + kTuneSchema);
     if (string_member(root, "platform", "") != device.platform_name ||

@@ -144,7 +144,10 @@ Trainer::Trainer(Device& device, const TrainerOptions& options)
     : device_(device), options_(options), queue_(device.create_queue()) {
   options_.head.validate();
   if (options.epochs < 1 || options.batch < 1) throw invalid_input("training: epochs and batch must be at least 1");
-  if (!(options.lr > 0.0f) || !std::isfinite(options.lr)) throw invalid_input("training: the learning rate must be positive");
+  // The value quoted like the decay's and the momentum's below (`--lr nan` said only "must be positive").
+  if (!(options.lr > 0.0f) || !std::isfinite(options.lr)) {
+    throw invalid_input("training: the learning rate must be a finite number > 0, got " + number(options.lr));
+  }
   // A negative or non-finite decay or momentum pushes the weights away from zero or to NaN from
   // the first step: refused here, not discovered as a diverged run.
   if (!(options.weight_decay >= 0.0f) || !std::isfinite(options.weight_decay)) {

@@ -448,7 +448,8 @@ expect_match("calib_offset.json: key \"time_offset.offset_s\" should be a number
 # computed (it stopped the batch at its turn, naming neither the manifest nor the line's path).
 file(WRITE "${WORK}/missing_manifest.txt" "seq\n\nno_such_sequence\n")
 run(2 ${CLI} predict --manifest missing_manifest.txt -o missing_batch/)
-expect_match("--manifest missing_manifest.txt: it lists the sequence .*no_such_sequence, which does not exist; nothing was computed")
+# The line is named (third, after a blank one): a manifest may list hundreds.
+expect_match("--manifest missing_manifest.txt:3: it lists the sequence .*no_such_sequence, which does not exist; nothing was computed")
 if(EXISTS "${WORK}/missing_batch/seq.csv")
   message(FATAL_ERROR "the batch computed seq before refusing the manifest")
 endif()
@@ -463,3 +464,30 @@ run(2 ${CLI} train --train seq --val seq -o head.safetensors --dropout nan)
 expect_match("--dropout: must be a finite number from 0 up, got nan")
 run(2 ${CLI} train --train seq --val seq -o head.safetensors --augment-rotation 1e6)
 expect_match("--augment-rotation: must be at most 1000 deg/s, got 1e6")
+# train --cache-budget: NaN, inf and negatives were taken silently (no budget, or an undefined
+# cast of inf to a byte count); refused at parse, naming the option and the value.
+run(2 ${CLI} train --train seq --val seq -o head.safetensors --cache-budget nan)
+expect_match("--cache-budget: must be a finite number from 0 up, got nan")
+run(2 ${CLI} train --train seq --val seq -o head.safetensors --cache-budget inf)
+expect_match("--cache-budget: must be a finite number from 0 up, got inf")
+run(2 ${CLI} train --train seq --val seq -o head.safetensors --cache-budget -1)
+expect_match("--cache-budget: must be a finite number from 0 up, got -1")
+# train --lr: refused by the Trainer, which did not quote the value ("must be positive").
+run(2 ${CLI} train --train seq --val seq -o head.safetensors --lr nan)
+expect_match("the learning rate must be a finite number > 0, got nan")
+# synth --extrinsic-error "": taken as not given before (a sequence without the error asked for).
+# run() passes its arguments through ${ARGN}, which drops an empty one: called directly here.
+execute_process(COMMAND ${CLI} synth empty_extrinsic --frames 3 --size 96x64 --extrinsic-error ""
+                WORKING_DIRECTORY "${WORK}" RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 600)
+message("$ synth --extrinsic-error \"\"\n${out}${err}(exit ${code})")
+if(NOT "${code}" STREQUAL "2")
+  message(FATAL_ERROR "expected exit code 2, got ${code}")
+endif()
+set(output "${out}${err}")
+expect_match("--extrinsic-error should be three comma-separated numbers x,y,z, found \"\"")
+if(EXISTS "${WORK}/empty_extrinsic")
+  message(FATAL_ERROR "synth wrote a sequence for an empty --extrinsic-error")
+endif()
+# --flow-check above 1000 px (at 752 columns) switched the check off silently; the library's bound.
+run(2 ${CLI} predict seq --flow-check 5000)
+expect_match("--flow-check: must be at most 1000 pixels, got 5000")

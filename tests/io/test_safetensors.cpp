@@ -283,6 +283,26 @@ TEST_F(SafetensorsTest, HeaderNotJson) {
                        {"zero.safetensors", "not valid JSON"});
 }
 
+// The message names the file and the position in our words; nlohmann's own text
+// ("[json.exception.parse_error.101] parse error at line 1, …") was embedded before. The x is
+// the 9th byte of the header.
+TEST_F(SafetensorsTest, HeaderNotJsonSaysWhereWithoutTheParsersText) {
+  const std::string p = write_file("broken.safetensors", "{\"a\": 1 x}");
+  expect_invalid_input([&] { SafetensorsFile f(p); },
+                       {"broken.safetensors", "header is not valid JSON", "malformed at byte 9 of the header"});
+  const std::string q = write_file("overflow.safetensors", "{\"a\": 1e999}");
+  expect_invalid_input([&] { SafetensorsFile f(q); }, {"overflow.safetensors", "a number out of range"});
+  for (const auto& file : {p, q}) {
+    try {
+      SafetensorsFile f(file);
+      ADD_FAILURE() << file << " was read";
+    } catch (const Error& e) {
+      EXPECT_EQ(std::string(e.what()).find("json.exception"), std::string::npos) << e.what();
+      EXPECT_EQ(std::string(e.what()).find("syntax error"), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST_F(SafetensorsTest, HeaderNotAnObject) {
   expect_invalid_input([&] { SafetensorsFile f(write_file("array.safetensors", "[1, 2]")); },
                        {"array.safetensors", "array", "not an object"});

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <string>
 
 #include "inertialnet/runtime/error.hpp"
 
@@ -59,6 +60,30 @@ TEST(FlowConsistency, LeavesVectorsThatLeaveTheImageAndRejectsBadArguments) {
   FlowField other = uniform(21, 20, 0.0f, 0.0f);
   EXPECT_THROW(mark_inconsistent_flow(forward, other, 1.0), Error);
   EXPECT_THROW(mark_inconsistent_flow(forward, backward, 0.0), Error);
+}
+
+// The setting had no upper bound: 1e300 switched the check off silently. Bounded at 1000 px
+// (at 752 columns), the value quoted as given and the setting named as the caller names it.
+TEST(FlowConsistency, RefusesACheckSettingAboveTheBoundQuotingIt) {
+  EXPECT_NO_THROW(require_flow_check_setting(0.0));
+  EXPECT_NO_THROW(require_flow_check_setting(1000.0));
+  for (const double bad : {1e300, 1000.5, -1.0}) {
+    try {
+      require_flow_check_setting(bad, "flow_check");
+      ADD_FAILURE() << bad << " was taken";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.kind(), ErrorKind::InvalidInput);
+      EXPECT_NE(std::string(e.what()).find("flow_check should be from 0 (off) to 1000 pixels"), std::string::npos)
+          << e.what();
+    }
+  }
+  try {
+    require_flow_check_setting(1e300);
+    ADD_FAILURE() << "1e300 was taken";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("the flow check threshold should be"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("got 1e+300"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include "inertialnet/models/head_input.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/train/rotation_augmentation.hpp"
+#include "support/testing.hpp"
 
 namespace inertialnet {
 namespace {
@@ -164,6 +165,14 @@ TEST(RotationAugmentation, CameraAtSizeScalesFocalLengthsAndPrincipalPoint) {
   EXPECT_DOUBLE_EQ(s.fy, 457.296 / 2);
   EXPECT_DOUBLE_EQ(s.cx, (367.215 + 0.5) / 2 - 0.5);
   EXPECT_DOUBLE_EQ(s.cy, (248.375 + 0.5) / 2 - 0.5);
+}
+
+// The metadata readers share parse_json_object (src/core/json_object.hpp); their words stay
+// "it is not JSON" (the caller quotes the value) and "it is not a JSON object".
+TEST(HeadInput, MetadataThatIsNotAJsonObjectIsNamedAsBefore) {
+  testing::expect_invalid_input([] { head_input_from_json("{\"convention\": "); }, "it is not JSON");
+  testing::expect_invalid_input([] { head_input_from_json("{\"flow\": 1e999}"); }, "it is not JSON");
+  testing::expect_invalid_input([] { head_input_from_json("[1]"); }, "it is not a JSON object");
 }
 
 }  // namespace

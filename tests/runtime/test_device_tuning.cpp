@@ -71,6 +71,15 @@ TEST(DeviceTuning, AnotherDevicesFileDoesNotApply) {
   EXPECT_FALSE(parse_device_tuning(document_for(fake_device()), other));
 }
 
+// A number beyond a double is nlohmann's out_of_range, not a parse_error: it escaped the reader
+// as nlohmann's own exception ("[json.exception.out_of_range.406] …"). Read through the shared
+// parse_json_object (src/core/json_object.hpp) it is bad input in our words.
+TEST(DeviceTuning, ANumberBeyondADoubleIsInvalidInput) {
+  testing::expect_invalid_input([] { parse_device_tuning(R"({"schema": 1e999})", fake_device()); },
+                                "not valid JSON (it holds a number beyond the range of a double)");
+  testing::expect_invalid_input([] { parse_device_tuning("[1]", fake_device()); }, "it is not a JSON object");
+}
+
 TEST(DeviceTuning, MalformedDocumentsAreInvalidInput) {
   testing::expect_invalid_input([] { parse_device_tuning("{", fake_device()); }, "not valid JSON");
   testing::expect_invalid_input([] { parse_device_tuning(R"({"schema": "inertialnet.tune/9"})", fake_device()); },

@@ -347,6 +347,19 @@ TEST(Trainer, RefusesANegativeOrNonFiniteWeightDecayOrMomentum) {
   testing::expect_invalid_input([&] { Trainer(testing::test_device(), options); }, "momentum");
 }
 
+// The learning rate's message quotes the value, like the decay's (it said only "must be positive").
+TEST(Trainer, RefusesANonPositiveOrNonFiniteLearningRateQuotingIt) {
+  TrainerOptions options = small_adam(1);
+  options.lr = std::numeric_limits<float>::quiet_NaN();
+  testing::expect_invalid_input([&] { Trainer(testing::test_device(), options); },
+                                "learning rate must be a finite number > 0, got nan");
+  options.lr = -0.5f;
+  testing::expect_invalid_input([&] { Trainer(testing::test_device(), options); },
+                                "learning rate must be a finite number > 0, got -0.5");
+  options.lr = std::numeric_limits<float>::infinity();
+  testing::expect_invalid_input([&] { Trainer(testing::test_device(), options); }, "got inf");
+}
+
 TEST(Trainer, ResumeChecksTheStateBeforeUsingIt) {
   Sets& s = sets();
   const fs::path dir = testing::temporary_directory("trainer_resume_checks");

@@ -20,6 +20,7 @@
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/runtime/layer_profiler.hpp"
 #include "inertialnet/io/flow_io.hpp"
+#include "inertialnet/models/flow_consistency.hpp"
 #include "inertialnet/pipeline/batch_predict.hpp"
 #include "inertialnet/pipeline/pipeline.hpp"
 #include "inertialnet/pipeline/predict.hpp"
@@ -370,8 +371,12 @@ int predict_one(const PredictOptions& given, const GlobalOptions& global, const 
 int predict_batch(const PredictOptions& options, const GlobalOptions& global) {
   namespace fs = std::filesystem;
   std::vector<fs::path> sequences(options.sequences.begin(), options.sequences.end());
+  std::vector<std::size_t> manifest_lines;  // the manifest line of sequences[options.sequences.size() + k]
   if (!options.manifest.empty()) {
-    for (const auto& s : read_batch_manifest(options.manifest)) sequences.push_back(s);
+    for (const auto& entry : read_batch_manifest_entries(options.manifest)) {
+      sequences.push_back(entry.sequence);
+      manifest_lines.push_back(entry.line);
+    }
   }
   if (sequences.empty()) throw invalid_input("no sequence given: name them, or give --manifest FILE.");
   if (options.output.empty()) {
@@ -392,7 +397,11 @@ int predict_batch(const PredictOptions& options, const GlobalOptions& global) {
   for (std::size_t i = 0; i < sequences.size(); ++i) {
     if (fs::exists(sequences[i], ec)) continue;
     const bool listed = i >= options.sequences.size();
-    throw invalid_input((listed ? "--manifest " + options.manifest + ": it lists the sequence " : "the sequence ") +
+    // manifest:line, as the other line-based readers name a line (the manifest may list hundreds).
+    throw invalid_input((listed ? "--manifest " + options.manifest + ":" +
+                                      std::to_string(manifest_lines[i - options.sequences.size()]) +
+                                      ": it lists the sequence "
+                                : "the sequence ") +
                         sequences[i].string() + (listed ? ", which does not exist" : " does not exist") +
                         (ec ? " (" + ec.message() + ")" : std::string()) + "; nothing was computed.");
   }
@@ -485,7 +494,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
                  "DIS and LK: also compute the backward flow and leave out vectors whose round trip misses by more than "
                  "this many pixels (at 752 columns, scaled with the width); 0: off")
       ->capture_default_str()
-      ->check(finite_non_negative_up_to(1e6, "pixels"));
+      ->check(finite_non_negative_up_to(kMaxFlowCheckPx, "pixels"));  // the library's bound (flow_consistency.hpp)
   // Issue 22: confidence per pair and more than two frames.
   app.add_option("--max-sigma", o->max_sigma_deg_s,
                  "geometric head: a pair whose rates' standard deviation exceeds this many deg/s (along the least "

@@ -38,7 +38,7 @@ Command register_synth(CLI::App& app, const GlobalOptions&) {
       ->capture_default_str();
   app.add_option("--readout-time", o->readout_time, "rolling shutter: seconds from the first row to the last")
       ->capture_default_str();
-  app.add_option("--extrinsic-error", o->extrinsic_error,
+  CLI::Option* extrinsic_error = app.add_option("--extrinsic-error", o->extrinsic_error,
                  "write cam0's camera-IMU rotation this far off, rx,ry,rz in degrees (a rotation vector in the IMU "
                  "frame: the correction calibrate should find)");
   app.add_option("--exposure-time", o->exposure_time, "motion blur: seconds each row is exposed")->capture_default_str();
@@ -51,7 +51,7 @@ Command register_synth(CLI::App& app, const GlobalOptions&) {
   app.add_flag("--bias-walk", o->bias_walk, "the gyro bias drifts as a random walk (EuRoC's random walk density)");
   app.add_flag("--no-noise", o->no_noise, "exact IMU: no white noise, no bias");
   app.add_flag("--overwrite", o->overwrite, "replace an existing sequence in OUT_DIR");
-  return [o]() {
+  return [o, extrinsic_error]() {
     SynthOptions options;
     options.frames = o->frames;
     options.motion = parse_synth_motion(o->motion);
@@ -64,7 +64,9 @@ Command register_synth(CLI::App& app, const GlobalOptions&) {
     options.time_offset_s = o->time_offset;
     options.readout_time_s = o->readout_time;
     options.exposure_time_s = o->exposure_time;
-    if (!o->extrinsic_error.empty()) {
+    // Whether it was given, not whether it is empty: `--extrinsic-error ""` was taken as not given
+    // (a sequence without the error asked for); parse_vec3 refuses it, naming the option.
+    if (extrinsic_error->count() > 0) {
       const Vec3 e = parse_vec3(o->extrinsic_error, "--extrinsic-error");
       options.extrinsic_error_deg = {e[0], e[1], e[2]};
     }

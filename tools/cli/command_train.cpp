@@ -180,7 +180,11 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
   app.add_option("--log", o->log, "per-epoch CSV");
   app.add_option("--plot", o->plot, "loss curves (PNG)");
   app.add_option("--cache", o->cache, "flow cache folder (default: <program cache>/flows)");
-  app.add_option("--cache-budget", o->cache_budget_mb, "largest flow cache per sequence, MB (else not cached)");
+  // Checked at parse: NaN, inf or a negative budget was taken silently (NaN and negatives read as
+  // "not given", inf cast to an unsigned byte count is undefined). 1e6 MB (a terabyte) keeps the
+  // byte count far inside uint64.
+  app.add_option("--cache-budget", o->cache_budget_mb, "largest flow cache per sequence, MB (else not cached)")
+      ->check(finite_non_negative_up_to(1e6, "MB"));
   app.add_flag("--no-flow-cache", o->no_flow_cache, "compute flows afresh and cache nothing");
   // What a recipe fixes: giving one of these beside --recipe is refused (its head would not be the
   // recipe's).

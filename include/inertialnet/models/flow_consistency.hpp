@@ -20,7 +20,9 @@ int mark_inconsistent_flow(FlowField& forward, const FlowField& backward, double
 // width; predict --flow-check, Python's flow_check), so that one setting means the same at every size.
 inline double flow_check_threshold_px(double px_at_752_columns, int width) { return px_at_752_columns * width / 752.0; }
 
-// Refuses (invalid_input) a check setting that is negative or not finite; 0 means no check.
-void require_flow_check_setting(double px_at_752_columns);
+// Refuses (invalid_input) a check setting that is negative, not finite or above kMaxFlowCheckPx,
+// naming it as `name` (Python's keyword, say) and quoting the value; 0 means no check.
+inline constexpr int kMaxFlowCheckPx = 1000;
+void require_flow_check_setting(double px_at_752_columns, const char* name = "the flow check threshold");
 
 }  // namespace inertialnet

@@ -48,6 +48,14 @@ std::vector<std::filesystem::path> batch_rates_paths(const std::vector<std::file
 // lines and lines starting with '#' skipped. invalid_input (naming the line) for an empty one.
 std::vector<std::filesystem::path> read_batch_manifest(const std::filesystem::path& manifest);
 
+// The same with the line each sequence is on (counted from 1, blank and comment lines included),
+// so that a later refusal (a sequence that does not exist) names manifest:line.
+struct BatchManifestEntry {
+  std::filesystem::path sequence;
+  std::size_t line = 0;
+};
+std::vector<BatchManifestEntry> read_batch_manifest_entries(const std::filesystem::path& manifest);
+
 // What a run with these settings would record (reads the sequence's file list and hashes the
 // weights and calibration files).
 Provenance prediction_provenance(const PredictSettings& settings, std::size_t max_pairs);
