@@ -17,16 +17,7 @@
 namespace inertialnet {
 namespace {
 
-CameraIntrinsics pinhole(int w, int h, double fx, double fy) {
-  CameraIntrinsics c;
-  c.width = w;
-  c.height = h;
-  c.fx = fx;
-  c.fy = fy;
-  c.cx = (w - 1) / 2.0;
-  c.cy = (h - 1) / 2.0;
-  return c;
-}
+using testing::pinhole_camera;
 
 // The pixel flow a camera sees when it turns at ω for dt (nothing else moving): the augmentation
 // added to a zero flow, in pixels.
@@ -50,9 +41,9 @@ TEST(HeadInput, NormalizedInputIsTheSameForAnyCameraResolutionAndFrameInterval) 
   const Vec3 omega{0.3, -0.5, 0.2};  // rad/s
   // EuRoC's cam0 at 752×480 and 30 ms, a 1280×720 camera of another focal length over a 430 ms
   // gap, and a 320×180 one at 1 ms.
-  const CameraIntrinsics euroc = pinhole(752, 480, 458.654, 457.296);
-  const CameraIntrinsics hd = pinhole(1280, 720, 910.0, 905.0);
-  const CameraIntrinsics small = pinhole(320, 180, 230.0, 230.0);
+  const CameraIntrinsics euroc = pinhole_camera(752, 480, 458.654, 457.296);
+  const CameraIntrinsics hd = pinhole_camera(1280, 720, 910.0, 905.0);
+  const CameraIntrinsics small = pinhole_camera(320, 180, 230.0, 230.0);
   const double dts[] = {0.03, 0.43, 0.001};
   const CameraIntrinsics* cameras[] = {&euroc, &hd, &small};
   std::array<double, 2> normalized[3], paper[3];
@@ -77,7 +68,7 @@ TEST(HeadInput, NormalizedInputIsTheSameForAnyCameraResolutionAndFrameInterval) 
 }
 
 TEST(HeadInput, NormalizedIsThePaperResizeDividedByFocalLengthAndInterval) {
-  const CameraIntrinsics c = pinhole(96, 64, 80.0, 70.0);
+  const CameraIntrinsics c = pinhole_camera(96, 64, 80.0, 70.0);
   std::vector<float> flow(2 * 96 * 64);
   for (std::size_t i = 0; i < flow.size(); ++i) flow[i] = static_cast<float>(std::sin(0.37 * static_cast<double>(i)) * 3.0);
   const auto paper = head_input(flow.data(), 96, 64, 48, 32, HeadInput::Paper, 0.05, c.fx, c.fy);
@@ -125,7 +116,7 @@ TEST(HeadInput, MetadataRoundTripAndRefusals) {
 TEST(RotationAugmentation, AddsTheRotationalMotionFieldInEitherConvention) {
   // A small rotation: the finite-rotation flow over dt, per second in normalised units, is the
   // instantaneous motion field A(x, y)·ω of docs/data_conventions.md at every pixel.
-  const CameraIntrinsics c = pinhole(40, 30, 36.0, 33.0);
+  const CameraIntrinsics c = pinhole_camera(40, 30, 36.0, 33.0);
   const Vec3 omega{0.2, -0.1, 0.3};
   const double dt = 1e-3;
   const std::size_t plane = 40 * 30;
@@ -155,7 +146,7 @@ TEST(RotationAugmentation, AddsTheRotationalMotionFieldInEitherConvention) {
 }
 
 TEST(RotationAugmentation, CameraAtSizeScalesFocalLengthsAndPrincipalPoint) {
-  CameraIntrinsics c = pinhole(752, 480, 458.654, 457.296);
+  CameraIntrinsics c = pinhole_camera(752, 480, 458.654, 457.296);
   c.cx = 367.215;
   c.cy = 248.375;
   const CameraIntrinsics s = camera_at_size(c, 376, 240);

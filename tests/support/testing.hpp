@@ -37,6 +37,18 @@ Difference compare(const std::vector<float>& actual, const std::vector<float>& e
 // Runs `call`, expects an Error of kind InvalidInput and returns its message ("" and a test
 // failure when nothing or something else is thrown).
 std::string invalid_input_message(const std::function<void()>& call);
+// A pinhole camera of w×h pixels with its principal point at the image centre, no distortion.
+inline CameraIntrinsics pinhole_camera(int w, int h, double fx, double fy) {
+  CameraIntrinsics c;
+  c.width = w;
+  c.height = h;
+  c.fx = fx;
+  c.fy = fy;
+  c.cx = (w - 1) / 2.0;
+  c.cy = (h - 1) / 2.0;
+  return c;
+}
+
 // True when `part` occurs in `text` (for checking messages).
 inline bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 

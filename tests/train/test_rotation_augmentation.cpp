@@ -11,20 +11,12 @@
 
 #include "inertialnet/core/vec3.hpp"
 #include "inertialnet/train/rotation_augmentation.hpp"
+#include "support/testing.hpp"
 
 namespace inertialnet {
 namespace {
 
-CameraIntrinsics pinhole(int w, int h, double fx, double fy) {
-  CameraIntrinsics c;
-  c.width = w;
-  c.height = h;
-  c.fx = fx;
-  c.fy = fy;
-  c.cx = (w - 1) / 2.0;
-  c.cy = (h - 1) / 2.0;
-  return c;
-}
+using testing::pinhole_camera;
 
 std::vector<float> turned(const CameraIntrinsics& c, const std::vector<float>& flow, const Vec3& omega, double dt) {
   std::vector<float> out = flow;
@@ -39,7 +31,7 @@ double largest_difference(const std::vector<float>& a, const std::vector<float>&
 }
 
 TEST(RotationAugmentation, TheTargetIsTheRateOfTheComposedRotation) {
-  const CameraIntrinsics c = pinhole(64, 40, 39.0, 38.1);
+  const CameraIntrinsics c = pinhole_camera(64, 40, 39.0, 38.1);
   // Camera to body: EuRoC-like, the camera's z along the body's x (a permutation with signs).
   const Mat3 r_bc{0, 0, 1, -1, 0, 0, 0, -1, 0};
   const Vec3 rate_camera{0.9, -0.7, 0.5};  // the pair's own rate, rad/s (≈ 50 deg/s per axis)
