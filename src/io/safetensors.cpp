@@ -342,4 +342,13 @@ std::vector<float> SafetensorsFile::to_float32(const std::string& name) const {
   return out;
 }
 
+std::optional<MetadataEntry> find_metadata(const std::vector<std::string>& paths, const std::string& key) {
+  for (const auto& path : paths) {
+    const SafetensorsFile file(path);
+    const auto& meta = file.metadata();
+    if (const auto found = meta.find(key); found != meta.end()) return MetadataEntry{path, found->second};
+  }
+  return std::nullopt;
+}
+
 }  // namespace inertialnet

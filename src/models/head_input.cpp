@@ -50,20 +50,15 @@ HeadInputInfo head_input_from_json(const std::string& text) {
 }
 
 HeadInputInfo read_head_input(const std::vector<std::string>& paths) {
-  for (const auto& path : paths) {
-    const SafetensorsFile file(path);
-    const auto& meta = file.metadata();
-    const auto found = meta.find(kMetadataHeadInput);
-    if (found == meta.end()) continue;
-    try {
-      return head_input_from_json(found->second);
-    } catch (const Error& e) {
-      if (e.kind() != ErrorKind::InvalidInput) throw;
-      throw invalid_input(path + ": metadata " + kMetadataHeadInput + " '" + found->second.substr(0, 80) +
-                          "' is not a head input description: " + e.what());
-    }
+  const auto entry = find_metadata(paths, kMetadataHeadInput);
+  if (!entry) return {};
+  try {
+    return head_input_from_json(entry->value);
+  } catch (const Error& e) {
+    if (e.kind() != ErrorKind::InvalidInput) throw;
+    throw invalid_input(entry->path + ": metadata " + kMetadataHeadInput + " '" + entry->value.substr(0, 80) +
+                        "' is not a head input description: " + e.what());
   }
-  return {};
 }
 
 std::vector<float> resize_flow(const float* flow, int w, int h, int out_w, int out_h) {

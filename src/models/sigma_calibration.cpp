@@ -112,20 +112,15 @@ SigmaCalibration sigma_calibration_from_json(const std::string& text) {
 }
 
 std::optional<SigmaCalibration> read_sigma_calibration(const std::vector<std::string>& paths) {
-  for (const auto& path : paths) {
-    const SafetensorsFile file(path);
-    const auto& meta = file.metadata();
-    const auto found = meta.find(kMetadataSigmaCalibration);
-    if (found == meta.end()) continue;
-    try {
-      return sigma_calibration_from_json(found->second);
-    } catch (const Error& e) {
-      if (e.kind() != ErrorKind::InvalidInput) throw;
-      throw invalid_input(path + ": metadata " + kMetadataSigmaCalibration + " '" + found->second.substr(0, 160) +
-                          "' is not a valid σ calibration: " + e.what());
-    }
+  const auto entry = find_metadata(paths, kMetadataSigmaCalibration);
+  if (!entry) return std::nullopt;
+  try {
+    return sigma_calibration_from_json(entry->value);
+  } catch (const Error& e) {
+    if (e.kind() != ErrorKind::InvalidInput) throw;
+    throw invalid_input(entry->path + ": metadata " + kMetadataSigmaCalibration + " '" + entry->value.substr(0, 160) +
+                        "' is not a valid σ calibration: " + e.what());
   }
-  return std::nullopt;
 }
 
 SigmaCalibration fit_sigma_calibration(const std::vector<SigmaFitSample>& samples) {

@@ -136,6 +136,21 @@ TEST_F(SafetensorsTest, RoundTripKeepsNamesShapesValuesAndMetadata) {
   EXPECT_FALSE(temporary_left_beside(p));
 }
 
+// Weight files given together: the first that carries the key answers, with its path.
+TEST_F(SafetensorsTest, FindMetadataSearchesTheFilesInOrder) {
+  const std::string a = path("a.safetensors"), b = path("b.safetensors"), c = path("c.safetensors");
+  write_safetensors(a, std::vector<HostTensor>{{"x", {1}, {1.0f}}});
+  write_safetensors(b, std::vector<HostTensor>{{"y", {1}, {2.0f}}}, {{"key", "from b"}});
+  write_safetensors(c, std::vector<HostTensor>{{"z", {1}, {3.0f}}}, {{"key", "from c"}});
+  const auto found = find_metadata({a, b, c}, "key");
+  ASSERT_TRUE(found.has_value());
+  EXPECT_EQ(found->path, b);
+  EXPECT_EQ(found->value, "from b");
+  EXPECT_EQ(find_metadata({c, b}, "key")->value, "from c");
+  EXPECT_FALSE(find_metadata({a}, "key").has_value());
+  EXPECT_FALSE(find_metadata({}, "key").has_value());
+}
+
 TEST_F(SafetensorsTest, WriterPadsHeaderWithSpacesToAMultipleOfEight) {
   // Try several name lengths so that at least one header needs padding.
   for (int extra = 0; extra < 8; ++extra) {

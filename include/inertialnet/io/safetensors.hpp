@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -76,5 +77,15 @@ class SafetensorsFile {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+// A "__metadata__" value and the file it was found in.
+struct MetadataEntry {
+  std::string path;
+  std::string value;
+};
+
+// The first of `paths` (weight files given together, searched in order) whose metadata holds
+// `key`; nullopt when none does. Each file is opened and validated like SafetensorsFile.
+std::optional<MetadataEntry> find_metadata(const std::vector<std::string>& paths, const std::string& key);
 
 }  // namespace inertialnet
