@@ -30,20 +30,25 @@ def sequences_of(sequences: Union[PathLike, Iterable[PathLike]]) -> List[str]:
     """The sequences a batch takes: a list of paths; or one string that is a glob pattern
     (``"data/*/"``, sorted), a manifest file (``.txt``: one path a line, as ``predict --manifest``
     reads it) or a single sequence."""
+    return _sequences_and_manifest(sequences)[0]
+
+
+def _sequences_and_manifest(sequences: Union[PathLike, Iterable[PathLike]]):
+    """sequences_of's list, and the manifest it came from ("" when none)."""
     if isinstance(sequences, (str, os.PathLike)):
         text = os.fspath(sequences)
         if any(c in text for c in "*?["):
             found = sorted(_glob.glob(text))
             if not found:
                 raise ValueError(f"the pattern {text} matches no sequence")
-            return found
+            return found, ""
         if text.endswith(".txt") and os.path.isfile(text):
-            return list(_native._read_batch_manifest(text))
-        return [text]
+            return list(_native._read_batch_manifest(text)), text
+        return [text], ""
     found = [os.fspath(s) for s in sequences]
     if not found:
         raise ValueError("no sequence given")
-    return found
+    return found, ""
 
 
 def _import_ray():
@@ -121,11 +126,13 @@ def predict(
     The other arguments are :func:`inertialnet.predict`'s (the CLI's options); ``device`` is a spec
     string. Errors as :func:`inertialnet.predict`: ``ValueError`` for bad input (two sequences of
     one name, an unreadable sequence), ``RuntimeError`` for a device failure."""
-    seqs = sequences_of(sequences)
+    seqs, manifest = _sequences_and_manifest(sequences)
     out_dir = os.fspath(out_dir)
     if os.path.exists(out_dir) and not os.path.isdir(out_dir):
         raise ValueError(f"out_dir {out_dir}: it exists and is not a folder")
     outputs = list(_native._batch_rates_paths(seqs, out_dir))
+    # As the CLI: every sequence is there before the first is computed (a manifest's by its line).
+    _native._require_batch_sequences([] if manifest else seqs, manifest)
     os.makedirs(out_dir, exist_ok=True)
     if isinstance(weights, (str, os.PathLike)):
         weights = [weights]

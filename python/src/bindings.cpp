@@ -1347,6 +1347,11 @@ PYBIND11_MODULE(_inertialnet, m) {
     for (const auto& p : read_batch_manifest(manifest)) paths.push_back(p.string());
     return paths;
   });
+  // Every sequence of a batch exists before the first is computed; a listed one named manifest:line.
+  m.def("_require_batch_sequences", [](const std::vector<std::filesystem::path>& named,
+                                       const std::filesystem::path& manifest) {
+    require_batch_sequences_exist(batch_sequences(named, manifest), manifest.string());
+  });
   m.def("_eval_table", &eval_table_of);
   m.def("_write_rates_csv",
         [](const std::filesystem::path& path, const std::vector<std::string>& columns, const py::array& t,

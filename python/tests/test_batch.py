@@ -89,6 +89,19 @@ def test_bad_batches(three):
         batch.predict(str(three / "nothing*"), three / "none")
 
 
+def test_missing_sequence_refused_before_any_is_computed(three):
+    """A missing sequence stops the batch before the first is computed (it stopped it at its turn,
+    after the others' work), a manifest's one named manifest:line, as the CLI does."""
+    with pytest.raises(ValueError, match=r"the sequence .*gone does not exist; nothing was computed"):
+        batch.predict([three / "s1", three / "gone"], three / "early")
+    assert not (three / "early" / "s1.csv").exists()
+    manifest = three / "early.txt"
+    manifest.write_text("# two sequences\ns1\n\ngone2\n")
+    with pytest.raises(ValueError, match=r"early\.txt:4: it lists the sequence .*gone2, which does not exist"):
+        batch.predict(str(manifest), three / "early_manifest")
+    assert not (three / "early_manifest" / "s1.csv").exists()
+
+
 def test_ray_cluster_survives_a_killed_worker_and_resumes(three, cli_batch, tmp_path):
     """A local cluster of two worker CPUs; the worker computing s2 kills itself (SIGKILL) in the
     middle of the sequence on the first try, leaving s2.csv.partial: Ray retries the task, and the

@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/json_object.hpp"
 #include "inertialnet/runtime/error.hpp"
 
 namespace inertialnet {
@@ -230,11 +231,11 @@ std::string head_config_to_json(const HeadConfig& c) {
 HeadConfig head_config_from_json(const std::string& text) {
   nlohmann::json j;
   try {
-    j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::exception& e) {
-    throw invalid_input(std::string("head configuration is not valid JSON (") + e.what() + "): " + text);
+    j = parse_json_object(text);
+  } catch (const Error& e) {
+    // parse_json_object's own words ("it is not JSON", "… not a JSON object"), never nlohmann's.
+    throw invalid_input("head configuration: " + std::string(e.what()) + ": " + text);
   }
-  if (!j.is_object()) throw invalid_input("head configuration is not a JSON object: " + text);
 
   HeadConfig c;
   for (auto it = j.begin(); it != j.end(); ++it) {
@@ -244,6 +245,11 @@ HeadConfig head_config_from_json(const std::string& text) {
       known = true;
       if (!it.value().is_number_integer()) {
         throw invalid_input("head configuration: " + it.key() + " is " + it.value().dump() + "; expected an integer");
+      }
+      // Beyond int64 it would wrap to a negative number and be reported as a value the file never held.
+      if (it.value().is_number_unsigned() && it.value().get<uint64_t>() > uint64_t(kMaxHeadDimension)) {
+        throw invalid_input("head configuration: " + it.key() + " is " + it.value().dump() + "; expected 1 to " +
+                            std::to_string(kMaxHeadDimension));
       }
       c.*field.member = it.value().get<int64_t>();
     }

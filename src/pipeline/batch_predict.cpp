@@ -131,6 +131,29 @@ std::vector<BatchManifestEntry> read_batch_manifest_entries(const fs::path& mani
   return sequences;
 }
 
+std::vector<BatchManifestEntry> batch_sequences(const std::vector<fs::path>& named, const fs::path& manifest) {
+  std::vector<BatchManifestEntry> sequences;
+  for (const auto& path : named) sequences.push_back({path, 0});
+  if (!manifest.empty()) {
+    for (auto& entry : read_batch_manifest_entries(manifest)) sequences.push_back(std::move(entry));
+  }
+  return sequences;
+}
+
+void require_batch_sequences_exist(const std::vector<BatchManifestEntry>& sequences, const std::string& manifest_label) {
+  for (const auto& entry : sequences) {
+    std::error_code ec;
+    if (fs::exists(entry.sequence, ec)) continue;
+    const std::string why = (ec ? " (" + ec.message() + ")" : std::string()) + "; nothing was computed.";
+    // manifest:line, as the other line-based readers name a line (a manifest may list hundreds).
+    if (entry.line > 0) {
+      throw invalid_input(manifest_label + ":" + std::to_string(entry.line) + ": it lists the sequence " +
+                          entry.sequence.string() + ", which does not exist" + why);
+    }
+    throw invalid_input("the sequence " + entry.sequence.string() + " does not exist" + why);
+  }
+}
+
 Provenance prediction_provenance(const PredictSettings& s, std::size_t max_pairs) {
   Provenance p;
   p.emplace_back("tool", "inertialnet " + build_versions().inertialnet);

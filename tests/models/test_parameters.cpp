@@ -321,9 +321,14 @@ TEST(HeadConfigJson, RejectsMalformedConfigurations) {
     } catch (const Error& e) {
       EXPECT_EQ(e.kind(), ErrorKind::InvalidInput);
       EXPECT_NE(std::string(e.what()).find(part), std::string::npos) << e.what();
+      EXPECT_EQ(std::string(e.what()).find("json.exception"), std::string::npos) << e.what();
     }
   };
-  expect_rejected("not json", "not valid JSON");
+  expect_rejected("not json", "head configuration: it is not JSON: not json");
+  // A number beyond a double is nlohmann's out_of_range, not a parse error: our words all the same.
+  expect_rejected(R"({"input_height": 1e400, "input_width": 64})", "it is not JSON");
+  expect_rejected(R"({"input_height": 18446744073709551615, "input_width": 64})",
+                  "input_height is 18446744073709551615; expected 1 to");
   expect_rejected("[1]", "not a JSON object");
   expect_rejected(R"({"input_width": 64})", "input_height");
   expect_rejected(R"({"input_height": 64, "input_width": 64, "fc1_unit": 3})", "unknown field 'fc1_unit'");

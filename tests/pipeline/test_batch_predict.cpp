@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "inertialnet/pipeline/batch_predict.hpp"
@@ -36,6 +37,47 @@ TEST(BatchPredict, RefusesTwoSequencesOfOneNameAndLiveSources) {
   const auto paths = batch_rates_paths({"a/s1", "b/s2"}, "out");
   ASSERT_EQ(paths.size(), 2u);
   EXPECT_EQ(paths[1], fs::path("out") / "s2.csv");
+}
+
+// A batch's sequences in order (named first, then the manifest's with their lines), and the
+// refusal of a missing one before any is computed, a listed one as manifest:line.
+TEST(BatchPredict, SequencesWithTheirManifestLinesAndTheMissingOneNamed) {
+  const fs::path root = fs::temp_directory_path() / "inertialnet_test_batch_sequences";
+  fs::remove_all(root);
+  fs::create_directories(root / "here");
+  fs::create_directories(root / "there");
+  {
+    std::ofstream manifest(root / "list.txt");
+    manifest << "# sequences\nhere\n\nthere\ngone\n";
+  }
+  const auto entries = batch_sequences({root / "there"}, root / "list.txt");
+  ASSERT_EQ(entries.size(), 4u);
+  EXPECT_EQ(entries[0].sequence, root / "there");
+  EXPECT_EQ(entries[0].line, 0u);
+  EXPECT_EQ(entries[1].sequence, root / "here");
+  EXPECT_EQ(entries[1].line, 2u);
+  EXPECT_EQ(entries[2].line, 4u);
+  EXPECT_EQ(entries[3].line, 5u);
+  EXPECT_NO_THROW(require_batch_sequences_exist({entries.begin(), entries.begin() + 3}, "list.txt"));
+  try {
+    require_batch_sequences_exist(entries, "--manifest list.txt");
+    FAIL() << "a missing listed sequence was accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::InvalidInput);
+    EXPECT_NE(std::string(e.what()).find("--manifest list.txt:5: it lists the sequence " + (root / "gone").string() +
+                                         ", which does not exist; nothing was computed."),
+              std::string::npos)
+        << e.what();
+  }
+  try {
+    require_batch_sequences_exist(batch_sequences({root / "missing"}, ""), "");
+    FAIL() << "a missing named sequence was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("the sequence " + (root / "missing").string() + " does not exist"),
+              std::string::npos)
+        << e.what();
+  }
+  fs::remove_all(root);
 }
 
 // The provenance records the flow a weight-free run resolves to (default_flow), not the empty

@@ -370,14 +370,10 @@ int predict_one(const PredictOptions& given, const GlobalOptions& global, const 
 // stopped. The first sequence that fails stops the batch with its error (and exit code).
 int predict_batch(const PredictOptions& options, const GlobalOptions& global) {
   namespace fs = std::filesystem;
-  std::vector<fs::path> sequences(options.sequences.begin(), options.sequences.end());
-  std::vector<std::size_t> manifest_lines;  // the manifest line of sequences[options.sequences.size() + k]
-  if (!options.manifest.empty()) {
-    for (const auto& entry : read_batch_manifest_entries(options.manifest)) {
-      sequences.push_back(entry.sequence);
-      manifest_lines.push_back(entry.line);
-    }
-  }
+  const std::vector<BatchManifestEntry> entries =
+      batch_sequences({options.sequences.begin(), options.sequences.end()}, options.manifest);
+  std::vector<fs::path> sequences;
+  for (const auto& entry : entries) sequences.push_back(entry.sequence);
   if (sequences.empty()) throw invalid_input("no sequence given: name them, or give --manifest FILE.");
   if (options.output.empty()) {
     throw invalid_input("a batch of " + std::to_string(sequences.size()) +
@@ -391,20 +387,8 @@ int predict_batch(const PredictOptions& options, const GlobalOptions& global) {
     throw invalid_input("--save-flow: give it to a single-sequence predict; a batch writes rates files only.");
   }
   const std::vector<fs::path> outputs = batch_rates_paths(sequences, options.output);
+  require_batch_sequences_exist(entries, "--manifest " + options.manifest);
   std::error_code ec;
-  // Every sequence is there before the first is computed: a missing one would otherwise stop the
-  // batch only when its turn comes, after the others' hours, named without its manifest.
-  for (std::size_t i = 0; i < sequences.size(); ++i) {
-    if (fs::exists(sequences[i], ec)) continue;
-    const bool listed = i >= options.sequences.size();
-    // manifest:line, as the other line-based readers name a line (the manifest may list hundreds).
-    throw invalid_input((listed ? "--manifest " + options.manifest + ":" +
-                                      std::to_string(manifest_lines[i - options.sequences.size()]) +
-                                      ": it lists the sequence "
-                                : "the sequence ") +
-                        sequences[i].string() + (listed ? ", which does not exist" : " does not exist") +
-                        (ec ? " (" + ec.message() + ")" : std::string()) + "; nothing was computed.");
-  }
   if (fs::exists(options.output, ec) && !fs::is_directory(options.output, ec)) {
     throw invalid_input("-o " + options.output + ": it exists and is not a folder; a batch writes one rates file per "
                         "sequence into a folder.");

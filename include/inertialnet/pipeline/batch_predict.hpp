@@ -56,6 +56,15 @@ struct BatchManifestEntry {
 };
 std::vector<BatchManifestEntry> read_batch_manifest_entries(const std::filesystem::path& manifest);
 
+// A batch's sequences: those named (line 0), then those `manifest` lists (when it is not empty).
+std::vector<BatchManifestEntry> batch_sequences(const std::vector<std::filesystem::path>& named,
+                                                const std::filesystem::path& manifest);
+
+// Refuses the batch (invalid_input) unless every sequence exists, before the first is computed: a
+// missing one would otherwise stop the batch only at its turn, after the others' hours. A listed one
+// is named as `manifest_label:line` (the CLI passes "--manifest FILE", Python the file).
+void require_batch_sequences_exist(const std::vector<BatchManifestEntry>& sequences, const std::string& manifest_label);
+
 // What a run with these settings would record (reads the sequence's file list and hashes the
 // weights and calibration files).
 Provenance prediction_provenance(const PredictSettings& settings, std::size_t max_pairs);
