@@ -25,6 +25,7 @@ std::string head_input_to_json(const HeadInputInfo& info) {
   nlohmann::json j = nlohmann::json::object();
   j["convention"] = to_string(info.convention);
   j["flow"] = info.flow;
+  j["frame"] = info.camera_frame ? "camera" : "body";
   return j.dump();
 }
 
@@ -41,6 +42,9 @@ HeadInputInfo head_input_from_json(const std::string& text) {
         throw invalid_input("\"flow\" is '" + v.substr(0, 40) + "'; expected dis or flownet2");
       }
       info.flow = v;
+    } else if (key == "frame") {
+      if (v != "camera" && v != "body") throw invalid_input("\"frame\" is '" + v.substr(0, 40) + "'; expected camera or body");
+      info.camera_frame = v == "camera";
     } else {
       throw invalid_input("unknown key \"" + key.substr(0, 40) + "\"");
     }

@@ -61,7 +61,7 @@ HeadUncertainty::HeadUncertainty(Queue& queue, const WeightSet& weights, const H
     for (std::size_t i = 0; i < n_in; ++i) fc1_t_[i * n_h + h] = w1[h * n_in + i];
 }
 
-std::array<double, 3> HeadUncertainty::spread(const std::vector<float>& features) const {
+std::array<double, 3> HeadUncertainty::spread(const std::vector<float>& features, const std::optional<Mat3>& rotation) const {
   if (static_cast<std::int64_t>(features.size()) != inputs_) {
     throw invalid_input("the InertialNet head's σ expects " + std::to_string(inputs_) + " features, got " +
                         std::to_string(features.size()));
@@ -92,6 +92,10 @@ std::array<double, 3> HeadUncertainty::spread(const std::vector<float>& features
       for (std::size_t k = 0; k < n_h; ++k) y += static_cast<double>(row[k]) * std::max(0.0f, h[k]);
       outputs[static_cast<std::size_t>(pass)][static_cast<std::size_t>(a)] = y;
     }
+    if (rotation) {
+      auto& y = outputs[static_cast<std::size_t>(pass)];
+      y = mul(*rotation, y);
+    }
   }
   std::array<double, 3> out{};
   const double n = options_.passes;
@@ -108,8 +112,8 @@ std::array<double, 3> HeadUncertainty::spread(const std::vector<float>& features
   return out;
 }
 
-std::array<double, 3> HeadUncertainty::sigma(const std::vector<float>& features) const {
-  const std::array<double, 3> s = spread(features);
+std::array<double, 3> HeadUncertainty::sigma(const std::vector<float>& features, const std::optional<Mat3>& rotation) const {
+  const std::array<double, 3> s = spread(features, rotation);
   if (options_.calibration) return options_.calibration->sigma(s);
   std::array<double, 3> out{};
   for (std::size_t a = 0; a < 3; ++a) out[a] = std::hypot(options_.scale * s[a], options_.floor_rad_s);

@@ -222,6 +222,7 @@ Prediction::Prediction(const PredictSettings& s) : settings_(s) {
   if (processor_.inertialnet_head) {
     const HeadInputInfo trained = read_head_input(s.weights);
     processor_.head_input = trained.convention;
+    processor_.head_camera_frame = trained.camera_frame;
     if (!trained.flow.empty()) {
       const FlowMethod learned = parse_flow_method(trained.flow);
       if (s.flow.empty()) {
@@ -335,8 +336,10 @@ std::vector<std::pair<std::string, std::string>> Prediction::csv_metadata() cons
   std::vector<std::pair<std::string, std::string>> metadata;
   const char* geometric_frame = processor_.camera_to_body ? "body" : "camera";
   if (processor_.inertialnet_head) {
-    // InertialNet is trained against the gyro, so it answers in the body (IMU) frame.
-    metadata = {{"frame", "body"}, {"estimator", "network"}};
+    // A head trained on the gyro answers in the body (IMU) frame; one trained on camera-frame
+    // targets in the body frame where the camera-to-body rotation is known, else the camera's.
+    const bool camera = processor_.head_camera_frame && !processor_.camera_to_body;
+    metadata = {{"frame", camera ? "camera" : "body"}, {"estimator", "network"}};
     if (processor_.geometric_head) {
       metadata.push_back({"frame_geometric", geometric_frame});
       metadata.push_back({"estimator_geometric", "inter_frame"});

@@ -160,6 +160,7 @@ class RatesProcessor : public PairProcessor {
       const auto omega = head_->compute(q, input, &stop).to_host(q);
       if (std::isfinite(omega[0]) && std::isfinite(omega[1]) && std::isfinite(omega[2])) {
         answer.w = {omega[0], omega[1], omega[2]};
+        if (options_.head_camera_frame) answer.w = to_body(options_.camera_to_body, answer.w);
         if (options_.fuse) answer.sigma = head_sigma(q);
       } else {
         answer.status = PairStatus::NonFinite;
@@ -230,7 +231,11 @@ class RatesProcessor : public PairProcessor {
   // The InertialNet head's σ for the flow it has just seen (its features), rad/s.
   std::array<double, 3> head_sigma(Queue& q) {
     if (!uncertainty_) uncertainty_ = std::make_unique<HeadUncertainty>(q, *weights_, head_->config(), options_.head_sigma);
-    return uncertainty_->sigma(head_->features().to_host(q));
+    // A camera-frame head's passes are turned into the body frame before their spread is taken, so
+    // that its σ calibration (fitted on body-frame errors) applies per body axis.
+    const std::optional<Mat3> to_rates_frame =
+        options_.head_camera_frame ? options_.camera_to_body : std::optional<Mat3>{};
+    return uncertainty_->sigma(head_->features().to_host(q), to_rates_frame);
   }
 
   static std::string frame_name(const Frame& f) {

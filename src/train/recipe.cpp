@@ -29,7 +29,7 @@ constexpr auto G = SynthOptions::General;
 constexpr auto C = SynthOptions::CloseRange;
 constexpr auto R = SynthOptions::Rotation;
 
-// "general", version 1. Every condition of the renderer (docs/real_cameras.md, "Synthetic
+// "general" (version: kGeneralVersion below). Every condition of the renderer (docs/real_cameras.md, "Synthetic
 // real-camera conditions") on six cameras: sizes 128×128 to 240×160, so focal lengths in pixels
 // from 78 to 147 and aspect ratios 1:1 to 16:9 (synth scales EuRoC cam0's intrinsics to the
 // size, so every camera has EuRoC's field of view), at 20 Hz with frame drops in every sequence
@@ -75,7 +75,9 @@ constexpr Row kGeneral[] = {
     {"val-general-200x150", G, 200, 150, 20, 2001, 0.3, 0, 0, 0, 1, true},
     {"val-handheld-160x100", C, 160, 100, 20, 2002, 0.3, 0.02, 0.015, 0, 0.4, true},
 };
-constexpr int kGeneralVersion = 1;
+// Version 2: the normalized head learns camera-frame rates (docs/training.md, "The frame of a
+// head's rates"); version 1's head answered in EuRoC's body frame.
+constexpr int kGeneralVersion = 2;
 constexpr int kGeneralFrames = 100;  // 5 s at 20 Hz, ≈70 pairs after the drops
 // Each training row is rendered this many times, copy k with seed + 100·k (named <row>-<k> for k ≥ 1):
 // more scenes and motions of every condition and camera. Measured (docs/training.md): the head's

@@ -249,14 +249,17 @@ std::size_t TrainingSet::add_sequence(const std::filesystem::path& root, const F
   if (sequence.frames.size() < 2) throw invalid_input(root.string() + " has fewer than two frames");
   SyncOptions sync;
   sync.target = options_.target;
-  sync.camera_frame = false;  // the body (IMU) frame, as the gyro measures and predict reports
+  // A normalized head learns camera-frame rates, which do not depend on the rig (head_input.hpp);
+  // a paper head the body (IMU) frame, as the gyro measures it. Without a camera rotation the
+  // normalized convention is refused below (it needs the calibration).
+  sync.camera_frame = camera_frame_targets(options_.input) && (sequence.camera || sequence.imu_to_camera);
   sync.bias = BiasSource::Automatic;
   sync.time_offset_s = options_.time_offset_s;  // checked there: finite, within an hour
   const GyroTruth truth = sync_gyro(sequence, sync);
   for (const auto& note : truth.notes) notes_.push_back(sequence.name + ": " + note);
   notes_.push_back(sequence.name + ": targets bias-corrected from " + to_string(truth.bias_source));
-  Mat3 camera_to_body{1, 0, 0, 0, 1, 0, 0, 0, 1};
-  if (sequence.camera || sequence.imu_to_camera) {
+  Mat3 camera_to_body{1, 0, 0, 0, 1, 0, 0, 0, 1};  // camera-frame targets: the identity
+  if (!sync.camera_frame && (sequence.camera || sequence.imu_to_camera)) {
     const Mat3 r = imu_to_camera_rotation(sequence);  // R_CS: IMU → camera; its transpose back
     camera_to_body = {r[0], r[3], r[6], r[1], r[4], r[7], r[2], r[5], r[8]};
   }

@@ -98,12 +98,22 @@ TEST(HeadInput, NormalizedInputRefusesAMissingIntervalOrFocalLength) {
 }
 
 TEST(HeadInput, MetadataRoundTripAndRefusals) {
-  const HeadInputInfo info{HeadInput::Normalized, "dis"};
-  EXPECT_EQ(head_input_to_json(info), "{\"convention\":\"normalized\",\"flow\":\"dis\"}");
+  const HeadInputInfo info{HeadInput::Normalized, "dis", true};
+  EXPECT_EQ(head_input_to_json(info), "{\"convention\":\"normalized\",\"flow\":\"dis\",\"frame\":\"camera\"}");
   const HeadInputInfo back = head_input_from_json(head_input_to_json(info));
   EXPECT_EQ(back.convention, HeadInput::Normalized);
   EXPECT_EQ(back.flow, "dis");
+  EXPECT_TRUE(back.camera_frame);
+  EXPECT_FALSE(head_input_from_json(head_input_to_json({HeadInput::Paper, "", false})).camera_frame);
   EXPECT_EQ(head_input_from_json("{\"convention\":\"paper\"}").convention, HeadInput::Paper);
+  // Written before the frame was recorded: such a head answers in its training rig's body frame.
+  EXPECT_FALSE(head_input_from_json("{\"convention\":\"normalized\",\"flow\":\"dis\"}").camera_frame);
+  try {
+    head_input_from_json("{\"convention\":\"normalized\",\"frame\":\"world\"}");
+    ADD_FAILURE() << "frame world accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("\"frame\" is 'world'; expected camera or body"), std::string::npos) << e.what();
+  }
   for (const char* bad : {"", "[]", "{\"flow\":\"dis\"}", "{\"convention\":\"pixels\"}", "{\"convention\":1}",
                           "{\"convention\":\"paper\",\"flow\":\"raft\"}", "{\"convention\":\"paper\",\"size\":\"1\"}"}) {
     SCOPED_TRACE(bad);

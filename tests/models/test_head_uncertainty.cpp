@@ -69,6 +69,22 @@ TEST(HeadUncertainty, OneFeaturesSpreadIsTheBernoulliSpread) {
     EXPECT_DOUBLE_EQ(sigma[a], std::hypot(1.5 * spread[a], 0.002)) << a;
     EXPECT_EQ(u.spread(features)[a], spread[a]) << "the masks are the same on every call";
   }
+  // A camera-frame head's passes turned into the body frame before the spread: every pass is
+  // y_drop + m·d (m = 0 or 1, d = y_keep − y_drop), so the turned passes spread along R·d by the
+  // same std(m) — exactly, as the masks are the same on every call.
+  const double c = std::cos(0.7), s = std::sin(0.7);
+  const Mat3 rotation{c, -s, 0, s * 0.6, c * 0.6, -0.8, s * 0.8, c * 0.8, 0.6};  // about z, then about x
+  Vec3 d{};
+  for (std::size_t a = 0; a < 3; ++a) d[a] = output(x / (1 - p), a) - output(0, a);
+  const double std_m = spread[0] / std::abs(d[0]);
+  const Vec3 turned = mul(rotation, d);
+  const auto spread_turned = u.spread(features, rotation);
+  const auto sigma_turned = u.sigma(features, rotation);
+  for (std::size_t a = 0; a < 3; ++a) {
+    // 1e-6: the kernel's fc1 sums in float, this test's d in double.
+    EXPECT_NEAR(spread_turned[a], std::abs(turned[a]) * std_m, 1e-6 * std::abs(d[0]) * std_m) << a;
+    EXPECT_DOUBLE_EQ(sigma_turned[a], std::hypot(1.5 * spread_turned[a], 0.002)) << a;
+  }
 }
 
 TEST(HeadUncertainty, ClearErrors) {

@@ -30,7 +30,7 @@ namespace fs = std::filesystem;
 constexpr int kHeadWidth = 320, kHeadHeight = 180;
 
 struct Fixture {
-  fs::path root, sequence, head;
+  fs::path root, sequence, head, body_head;
 };
 
 // A 1280×720 sequence of 5 frames and a head trained on it for one epoch at 320×180 (normalized
@@ -64,7 +64,10 @@ const Fixture& fixture() {
     Trainer trainer(testing::test_device(), t);
     EXPECT_TRUE(trainer.train(set, set, {}));
     out.head = out.root / "head.safetensors";
-    trainer.save_head(out.head, {{kMetadataHeadInput, head_input_to_json({HeadInput::Normalized, "dis"})}});
+    trainer.save_head(out.head, {{kMetadataHeadInput, head_input_to_json({HeadInput::Normalized, "dis", true})}});
+    // The same weights as a head written before the frame was recorded (body frame of its rig).
+    out.body_head = out.root / "body_head.safetensors";
+    trainer.save_head(out.body_head, {{kMetadataHeadInput, head_input_to_json({HeadInput::Normalized, "dis", false})}});
     return out;
   }();
   return f;
@@ -78,9 +81,27 @@ TEST(HeadInputPredict, AHeadOf320x180GivesOn1280x720FramesTheRatesOfTheTrainingS
   Prediction prediction(settings);
   EXPECT_EQ(prediction.processor().flow, FlowMethod::DIS);
   EXPECT_EQ(prediction.processor().head_input, HeadInput::Normalized);
+  // Trained on camera-frame targets (as train writes it): reported in the body frame through the
+  // sequence's own camera-to-IMU rotation, and the rates file says body.
+  EXPECT_TRUE(prediction.processor().head_camera_frame);
+  ASSERT_TRUE(prediction.processor().camera_to_body.has_value());
+  const Mat3 camera_to_body = *prediction.processor().camera_to_body;
+  EXPECT_EQ(prediction.csv_metadata().front(), (std::pair<std::string, std::string>{"frame", "body"}));
   std::vector<PairResult> results;
   prediction.run([&](const PairResult& r) { results.push_back(r); });
   ASSERT_EQ(results.size(), 4u);
+  // The same weights marked as a body-frame head: the head's own output, not turned.
+  PredictSettings as_body = settings;
+  as_body.weights = {f.body_head.string()};
+  Prediction body_prediction(as_body);
+  EXPECT_FALSE(body_prediction.processor().head_camera_frame);
+  std::vector<PairResult> body_results;
+  body_prediction.run([&](const PairResult& r) { body_results.push_back(r); });
+  ASSERT_EQ(body_results.size(), 4u);
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    const Vec3 turned = mul(camera_to_body, body_results[i].rates.front().w);
+    for (std::size_t a = 0; a < 3; ++a) EXPECT_NEAR(results[i].rates.front().w[a], turned[a], 1e-12) << i << " " << a;
+  }
 
   // The training set's flows of the same frames, through the same head.
   TrainingSetOptions o;
@@ -103,8 +124,9 @@ TEST(HeadInputPredict, AHeadOf320x180GivesOn1280x720FramesTheRatesOfTheTrainingS
     set.flow(i, flow.data());
     const auto omega =
         head.compute(queue, Tensor::from_host(queue, {1, 2, kHeadHeight, kHeadWidth}, flow)).to_host(queue);
+    const Vec3 omega_body = mul(camera_to_body, Vec3{omega[0], omega[1], omega[2]});
     for (int a = 0; a < 3; ++a) {
-      const double want = omega[static_cast<std::size_t>(a)], got = r->rates.front().w[static_cast<std::size_t>(a)];
+      const double want = omega_body[static_cast<std::size_t>(a)], got = r->rates.front().w[static_cast<std::size_t>(a)];
       largest = std::max(largest, std::abs(want));
       // The set stores its flows as float16 (11 significant bits a value); through the head's
       // sums that left differences of at most 4e-6 rad/s on rates up to 1.2 rad/s: 5e-5 relative

@@ -21,6 +21,7 @@
 
 #include "inertialnet/models/head_backprop.hpp"
 #include "inertialnet/models/inertialnet_head.hpp"
+#include "inertialnet/io/euroc.hpp"
 #include "inertialnet/io/safetensors.hpp"
 #include "inertialnet/io/safetensors_writer.hpp"
 #include "inertialnet/models/weights.hpp"
@@ -267,6 +268,53 @@ TEST(TrainingSet, ATimeOffsetPutsTheTargetsOnTheImuClock) {
             << "\n";
   EXPECT_LT(with, 0.005);
   EXPECT_GT(without, 4 * with);
+}
+
+// The targets' frame: a normalized head learns camera-frame rates (the rig's camera-to-IMU
+// rotation is not part of what it learns, so it carries to another rig), a paper head the body
+// (IMU) frame's gyro. Each target against the exact camera-frame interval mean the sequence was
+// rendered with, per component, turned by EuRoC's rotation for the paper head.
+TEST(TrainingSet, TargetsAreCameraFrameForANormalizedHeadAndBodyFrameForAPaperHead) {
+  const fs::path dir = fs::path(testing::temporary_directory("trainer_frames")) / "frames";
+  SynthOptions so;
+  so.frames = 21;
+  so.width = kWidth;
+  so.height = kHeight;
+  so.motion = SynthOptions::General;
+  so.seed = 33;
+  so.max_rate_deg_s = 60;
+  so.noise = false;
+  const SynthReport truth = write_synthetic_sequence(dir, so);
+  const Mat3 camera_to_body = read_euroc(dir).camera->rotation_BS();
+  ASSERT_GT(std::abs(camera_to_body[0] - 1), 0.5);  // EuRoC's cam0 is turned ≈ 90° against its IMU
+  auto rms_error = [&](HeadInput input, bool body) {
+    TrainingSetOptions o = set_options({});
+    o.target = SyncTarget::Mean;
+    o.input = input;
+    TrainingSet set(o);
+    set.add_sequence(dir);
+    EXPECT_GT(set.size(), 15u);
+    double sum = 0;
+    for (std::size_t i = 0; i < set.size(); ++i) {
+      const auto k = static_cast<std::size_t>(
+          std::find(truth.camera_t_ns.begin(), truth.camera_t_ns.end(), set.timestamp_ns(i)) - truth.camera_t_ns.begin());
+      EXPECT_TRUE(k > 0 && k < truth.camera_t_ns.size()) << "pair " << i;
+      if (k == 0 || k >= truth.camera_t_ns.size()) continue;
+      const Vec3 w = body ? mul(camera_to_body, truth.interval_rates[k - 1]) : truth.interval_rates[k - 1];
+      for (int a = 0; a < 3; ++a) {
+        const double d = set.targets()[i][static_cast<std::size_t>(a)] - w[static_cast<std::size_t>(a)];
+        sum += d * d;
+      }
+      // The augmentations turn targets by this rotation: the identity for camera-frame targets.
+      const Mat3 identity{1, 0, 0, 0, 1, 0, 0, 0, 1};
+      EXPECT_EQ(set.camera_to_body(i), input == HeadInput::Paper ? camera_to_body : identity);
+    }
+    return std::sqrt(sum / static_cast<double>(3 * set.size()));
+  };
+  EXPECT_LT(rms_error(HeadInput::Normalized, false), 0.005);
+  EXPECT_LT(rms_error(HeadInput::Paper, true), 0.005);
+  // And not the other way round (the rates are tens of deg/s: a wrong frame is far off).
+  EXPECT_GT(rms_error(HeadInput::Normalized, true), 0.05);
 }
 
 TEST(TrainingSet, RefusesAFolderWithoutAnImu) {

@@ -370,7 +370,7 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
       j["input_size"] = std::to_string(options.head.input_width) + "x" + std::to_string(options.head.input_height);
       j["target"] = to_string(set_options.target);
       j["time_offset_s"] = set_options.time_offset_s;
-      j["frame"] = "body";
+      j["frame"] = camera_frame_targets(set_options.input) ? "camera" : "body";
       if (recipe) j["recipe"] = nlohmann::json::parse(recipe_to_json(*recipe));
       j["train_sequences"] = train_set.sequences();
       j["val_sequences"] = val_set.sequences();
@@ -380,7 +380,8 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
       j["spread_ratio"] = nlohmann::json::parse(vec3_json(r.spread_ratio));
       j["gain"] = nlohmann::json::parse(vec3_json(r.gain));
       // What predict reads to feed the head as it was trained (models/head_input.hpp).
-      const std::string input = head_input_to_json({set_options.input, to_string(set_options.flow)});
+      const std::string input = head_input_to_json(
+          {set_options.input, to_string(set_options.flow), camera_frame_targets(set_options.input)});
       std::map<std::string, std::string> meta{{"inertialnet.training", j.dump()}, {kMetadataHeadInput, input}};
       if (recipe) meta["inertialnet.recipe"] = recipe_to_json(*recipe);
       return meta;

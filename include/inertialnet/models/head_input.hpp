@@ -27,14 +27,21 @@ HeadInput parse_head_input(const std::string& text);  // invalid_input listing t
 // Metadata key of a trained head: head_input_to_json().
 inline constexpr const char* kMetadataHeadInput = "inertialnet.head_input";
 
-// How a head was trained: its input convention and the flow method it learned from ("dis",
-// "flownet2"; empty when unknown).
+// How a head was trained: its input convention, the flow method it learned from ("dis",
+// "flownet2"; empty when unknown), and the frame of the rates it answers in. A head trained on
+// body-frame (gyro) targets has learned its training rig's camera-to-IMU rotation with the motion:
+// on another rig its rates come out in the wrong frame. A normalized head is therefore trained on
+// camera-frame targets and `predict` turns its answer into the body frame with the sequence's own
+// rotation; paper heads (and normalized heads written before, without "frame") answer in the body
+// frame of the rig they were trained on.
 struct HeadInputInfo {
   HeadInput convention = HeadInput::Paper;
   std::string flow;
+  bool camera_frame = false;
 };
 
-// {"convention":"normalized","flow":"dis"} (keys sorted, compact).
+// {"convention":"normalized","flow":"dis","frame":"camera"} (keys sorted, compact; "frame" is
+// "camera" or "body", and read as "body" when absent).
 std::string head_input_to_json(const HeadInputInfo& info);
 // invalid_input for anything else than the object above (an unknown convention, a wrong type).
 HeadInputInfo head_input_from_json(const std::string& json);

@@ -19,6 +19,7 @@
 #include <optional>
 #include <vector>
 
+#include "inertialnet/core/vec3.hpp"
 #include "inertialnet/models/parameters.hpp"
 #include "inertialnet/models/sigma_calibration.hpp"
 #include "inertialnet/models/weights.hpp"
@@ -46,10 +47,11 @@ class HeadUncertainty {
   // Downloads fc1 and fc2 (head.fc1.weight, …) from `weights` through `queue`, once.
   HeadUncertainty(Queue& queue, const WeightSet& weights, const HeadConfig& config, const HeadSigmaOptions& options);
   // The raw spread s (rad/s, per output) of the passes for one sample's flattened conv3
-  // features (fc1_inputs values).
-  std::array<double, 3> spread(const std::vector<float>& features) const;
+  // features (fc1_inputs values); with `rotation`, of the passes' outputs turned by it (a
+  // camera-frame head's rates in the body frame).
+  std::array<double, 3> spread(const std::vector<float>& features, const std::optional<Mat3>& rotation = {}) const;
   // The calibrated σ (rad/s) for the same features: the options' calibration when they have one.
-  std::array<double, 3> sigma(const std::vector<float>& features) const;
+  std::array<double, 3> sigma(const std::vector<float>& features, const std::optional<Mat3>& rotation = {}) const;
 
  private:
   HeadSigmaOptions options_;

@@ -58,6 +58,10 @@ struct RatesProcessorOptions {
   // size whatever the frames' size, and with the normalized convention divided by the pair's
   // interval and the focal lengths of `camera` (then required).
   HeadInput head_input = HeadInput::Paper;
+  // Whether the head answers in the camera frame (its metadata, head_input.hpp): its rates (and its
+  // σ) are then turned into the body frame by camera_to_body when that is known, as the geometric
+  // head's; else they stay in the camera frame.
+  bool head_camera_frame = false;
   // A geometric rate whose σ along its least certain direction (the calibrated covariance's
   // largest eigenvalue; at least every per-axis EstimatorRates::sigma, and the same in any frame)
   // exceeds this many rad/s is not reported: the pair gets PairStatus::Uncertain (predict

@@ -43,6 +43,10 @@
 
 namespace inertialnet {
 
+// Whether a head of this input convention is trained on camera-frame targets (normalized: its
+// rates do not depend on the rig, models/head_input.hpp) or body-frame ones (paper).
+inline bool camera_frame_targets(HeadInput input) { return input == HeadInput::Normalized; }
+
 struct TrainingSetOptions {
   int width = 0, height = 0;  // the head's input (flow) size
   FlowMethod flow = FlowMethod::DIS;
@@ -92,8 +96,9 @@ class TrainingSet {
   void set_targets(std::vector<Vec3> targets);
   const std::vector<Vec3>& targets() const noexcept { return targets_; }
   std::int64_t timestamp_ns(std::size_t i) const { return t_ns_.at(i); }
-  // The rotation from the camera frame to the frame of the targets (the body/IMU frame): the
-  // sequence's cam0 calibration, else the identity. Flip augmentation needs it.
+  // The rotation from the camera frame to the frame of the targets: the identity for camera-frame
+  // targets (camera_frame_targets), else the body (IMU) frame's: the sequence's cam0 calibration,
+  // else the identity. Flip and rotation augmentation need it.
   const Mat3& camera_to_body(std::size_t i) const { return camera_to_body_.at(i); }
   HeadInput input() const noexcept { return options_.input; }
   // Sample i's frame interval (seconds) and its sequence's pinhole camera at the head's size
