@@ -14,6 +14,7 @@
 #include "inertialnet/io/calibration_file.hpp"
 #include "inertialnet/io/camera.hpp"
 #include "inertialnet/models/flow_consistency.hpp"
+#include "inertialnet/models/head_ensemble.hpp"
 #include "inertialnet/models/head_input.hpp"
 #include "inertialnet/models/sigma_calibration.hpp"
 #include "inertialnet/runtime/device_selection.hpp"
@@ -222,6 +223,7 @@ Prediction::Prediction(const PredictSettings& s) : settings_(s) {
   if (processor_.inertialnet_head) {
     const HeadInputInfo trained = read_head_input(s.weights);
     processor_.head_input = trained.convention;
+    processor_.ensemble_members = read_head_ensemble(s.weights);  // 1: a single head
     if (!trained.flow.empty()) {
       const FlowMethod learned = parse_flow_method(trained.flow);
       if (s.flow.empty()) {
