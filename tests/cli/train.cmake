@@ -301,6 +301,21 @@ foreach(f head.member0.safetensors head.member1.last.safetensors head.member1.st
     message(FATAL_ERROR "train --ensemble 2 did not write ens/${f}")
   endif()
 endforeach()
+# --resume: every member from its own state. Finished members are kept and the ensemble is
+# written again (also when it is missing); resumed to 2 epochs, both members train their second.
+file(REMOVE "${WORK}/ens/head.safetensors")
+run(0 ${CLI} train --train a --val b --head-size 64x48 --optimizer adam --lr 1e-3 --epochs 1 --ensemble 2
+    -o ens/head.safetensors --cache cache --resume)
+expect_match("nothing to do: ens/head.member1.state.safetensors has finished epoch 1 .*Its best head is kept as it is")
+expect_match("wrote ens/head.safetensors \\(an ensemble")
+run(0 ${CLI} train --train a --val b --head-size 64x48 --optimizer adam --lr 1e-3 --epochs 2 --ensemble 2
+    -o ens/head.safetensors --cache cache --resume)
+expect_match("resuming after epoch 1 from ens/head.member0.state.safetensors")
+expect_match("resuming after epoch 1 from ens/head.member1.state.safetensors")
+foreach(k 0 1)
+  run(0 ${CLI} weights --info ens/head.member${k}.last.safetensors)
+  expect_match("\"epoch\":2")
+endforeach()
 run(2 ${CLI} train --train a --val b --ensemble 0 -o ens_bad/head.safetensors)
 expect_match("--ensemble")
 run(2 ${CLI} train --recipe general --ensemble 3 -o recipe_bad/head.safetensors --work recipe_work_bad)

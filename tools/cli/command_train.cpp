@@ -348,13 +348,26 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
       trainer.resume(state_path);
       if (trainer.finished()) {
         info("nothing to do: " + state_path.string() + " has finished epoch " + std::to_string(trainer.epochs_done()) +
-             " of --epochs " + std::to_string(options.epochs) + "; raise --epochs to train on. No file was written.");
+             " of --epochs " + std::to_string(options.epochs) + "; raise --epochs to train on." +
+             (members > 1 ? std::string(" Its best head is kept as it is.") : std::string(" No file was written.")));
         done[static_cast<std::size_t>(k)] = true;
         continue;
       }
       info("resuming after epoch " + std::to_string(trainer.epochs_done()) + " from " + state_path.string());
     }
-    if (std::all_of(done.begin(), done.end(), [](bool d) { return d; })) return 0;
+    // Every member finished already: nothing to train; an ensemble is written again from the members'
+    // best heads (a run stopped between its last member and the ensemble file has none yet).
+    const auto write_ensemble = [&] {
+      std::vector<std::string> bests;
+      for (const auto& f : files) bests.push_back(f.best.string());
+      write_head_ensemble(out.string(), bests);
+      std::printf("wrote %s (an ensemble of the %d members' best heads)\n", out.string().c_str(), members);
+    };
+    if (std::all_of(done.begin(), done.end(), [](bool d) { return d; })) {
+      if (members > 1) write_ensemble();
+      flush_standard_output();
+      return 0;
+    }
     // Opened (and their targets checked by the atomic writer) before the flows.
     std::vector<std::unique_ptr<TrainingLog>> logs(static_cast<std::size_t>(members));
     if (!o->log.empty()) {
@@ -520,12 +533,7 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
       }
       flush_standard_output();
     }
-    if (members > 1) {
-      std::vector<std::string> bests;
-      for (const auto& f : files) bests.push_back(f.best.string());
-      write_head_ensemble(out.string(), bests);
-      std::printf("wrote %s (an ensemble of the %d members' best heads)\n", out.string().c_str(), members);
-    }
+    if (members > 1) write_ensemble();
     flush_standard_output();
     return 0;
   };
