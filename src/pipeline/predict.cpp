@@ -311,6 +311,9 @@ std::string Prediction::method() const {
   method += processor_.inertialnet_head && processor_.geometric_head ? " + InertialNet and geometric heads"
             : processor_.inertialnet_head                            ? " + InertialNet head"
                                                                      : " + geometric head";
+  if (processor_.inertialnet_head && processor_.ensemble_members > 1) {
+    method += " (InertialNet: an ensemble of " + std::to_string(processor_.ensemble_members) + " heads)";
+  }
   return method;
 }
 
@@ -339,6 +342,8 @@ std::vector<std::pair<std::string, std::string>> Prediction::csv_metadata() cons
   if (processor_.inertialnet_head) {
     // InertialNet is trained against the gyro, so it answers in the body (IMU) frame.
     metadata = {{"frame", "body"}, {"estimator", "network"}};
+    // The rates are the mean of this many heads (models/head_ensemble.hpp).
+    if (processor_.ensemble_members > 1) metadata.push_back({"ensemble_members", std::to_string(processor_.ensemble_members)});
     if (processor_.geometric_head) {
       metadata.push_back({"frame_geometric", geometric_frame});
       metadata.push_back({"estimator_geometric", "inter_frame"});

@@ -2,6 +2,7 @@
 // Issue 23: an ensemble of InertialNet heads in one file (models/head_ensemble.hpp). The file
 // keeps every member's tensors exactly; predict reports the members' mean and, with --fuse, takes
 // the learned σ from their spread; a malformed record is bad input naming file, key and value.
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <filesystem>
@@ -214,6 +215,18 @@ TEST(HeadEnsemble, PredictReportsTheMembersMeanAndTakesTheLearnedSigmaFromTheirS
   const Fixture& f = fixture();
   const std::string path = (f.root / "ensemble_predict.safetensors").string();
   write_head_ensemble(path, f.heads);
+  {
+    // The run says what answered: the method line and the rates file's metadata.
+    PredictSettings settings;
+    settings.sequence = f.sequence;
+    settings.weights = {path};
+    const Prediction prediction(settings);
+    EXPECT_EQ(prediction.processor().ensemble_members, 3);
+    EXPECT_NE(prediction.method().find("an ensemble of 3 heads"), std::string::npos) << prediction.method();
+    const auto meta = prediction.csv_metadata();
+    EXPECT_NE(std::find(meta.begin(), meta.end(), std::make_pair(std::string("ensemble_members"), std::string("3"))),
+              meta.end());
+  }
   for (const bool fuse : {false, true}) {
     const std::vector<PairResult> ensemble = predict({path}, fuse);
     std::vector<std::vector<PairResult>> members;
