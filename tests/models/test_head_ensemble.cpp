@@ -166,6 +166,20 @@ TEST(HeadEnsemble, TheFileKeepsEveryMembersTensorsExactly) {
   EXPECT_EQ(wa, wb);
 }
 
+TEST(HeadEnsemble, AFlowModelBesideTheEnsembleDoesNotClaimTheMembersTensors) {
+  // predict -w flownet2.safetensors -w ensemble.safetensors: the flow model owns every name but the
+  // head's, and the members' ensemble.* names are the head's too.
+  const Fixture& f = fixture();
+  const std::string path = (f.root / "ensemble_names.safetensors").string();
+  write_head_ensemble(path, f.heads);
+  const WeightSet set = WeightSet::load(testing::test_device(), {path});
+  const std::string message =
+      invalid_input_message([&] { set.check("FlowNet2-S", model_parameters(ModelKind::FlowNet2S)); });
+  EXPECT_NE(message.find("missing"), std::string::npos) << message;
+  EXPECT_EQ(message.find("ensemble."), std::string::npos) << message;
+  EXPECT_NO_THROW(set.check("InertialNet head", model_parameters(ModelKind::InertialNetHead, set.head_config())));
+}
+
 TEST(HeadEnsemble, WritingRefusesHeadsThatDoNotBelongTogetherNamingTheFile) {
   const Fixture& f = fixture();
   // The second head with another input convention in its metadata.
