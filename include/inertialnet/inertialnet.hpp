@@ -61,6 +61,7 @@
 #include "inertialnet/models/dis_flow.hpp"
 #include "inertialnet/models/geometric_head.hpp"
 #include "inertialnet/models/head_backprop.hpp"
+#include "inertialnet/models/head_ensemble.hpp"
 #include "inertialnet/models/inertialnet_head.hpp"
 #include "inertialnet/models/parameters.hpp"
 #include "inertialnet/models/synthetic_weights.hpp"

@@ -63,6 +63,8 @@ class _InertialNetHead:
     # dt (s), fx, fy (px): needed by a head of normalized input (config["input"]); 0: not given.
     def rates(self, flow: npt.NDArray[np.float32], dt: float = 0.0, fx: float = 0.0,
               fy: float = 0.0) -> npt.NDArray[np.float64]: ...
+    # input_width, input_height, input, flow, and members (a head ensemble's heads, whose mean
+    # rates() answers; 1 for a single head).
     config: dict[str, Union[int, str]]
 
 # Wrapped by inertialnet.Sequence (a collections.abc.Sequence, python/inertialnet/_sequence.py).

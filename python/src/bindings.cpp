@@ -640,6 +640,11 @@ class PyInertialNetHead {
     weights_ = std::make_unique<WeightSet>(WeightSet::load(*device_, paths));
     head_ = std::make_unique<InertialNetHead>(*device_, *weights_);
     input_ = read_head_input(paths);
+    // A head ensemble (models/head_ensemble.hpp): rates() is its members' mean, as in predict.
+    for (int k = 1; k < read_head_ensemble(paths); ++k) {
+      member_weights_.push_back(std::make_unique<WeightSet>(weights_->ensemble_member(k)));
+      members_.push_back(std::make_unique<InertialNetHead>(*device_, *member_weights_.back()));
+    }
   }
 
   // (3,) for one flow (H, W, 2), (N, 3) for a batch (N, H, W, 2), of frames of any size: turned
@@ -693,13 +698,21 @@ class PyInertialNetHead {
       in_w = c.input_width;
     }
     std::vector<float> omega;
+    std::vector<std::vector<float>> member_omega;
     run_interruptibly([&](const std::atomic<bool>& stop) {
       Queue& queue = device_->queue();
       const Tensor flow = Tensor::from_host(queue, {n, 2, in_h, in_w}, planar);
       omega = head_->compute(queue, flow, &stop).to_host(queue);
+      for (const auto& member : members_) member_omega.push_back(member->compute(queue, flow, &stop).to_host(queue));
     });
     py::array_t<double> out(batch ? std::vector<py::ssize_t>{n, 3} : std::vector<py::ssize_t>{3});
-    std::copy(omega.begin(), omega.end(), out.mutable_data());
+    double* o = out.mutable_data();
+    for (std::size_t i = 0; i < omega.size(); i += 3) {
+      std::vector<std::array<double, 3>> outputs{{omega[i], omega[i + 1], omega[i + 2]}};
+      for (const auto& m : member_omega) outputs.push_back({m[i], m[i + 1], m[i + 2]});
+      const EnsembleRates e = combine_ensemble(outputs);
+      std::copy(e.mean.begin(), e.mean.end(), o + i);
+    }
     return out;
   }
 
@@ -710,6 +723,7 @@ class PyInertialNetHead {
     d["input_height"] = c.input_height;
     d["input"] = to_string(input_.convention);  // "normalized" or "paper" (models/head_input.hpp)
     d["flow"] = input_.flow;                     // the flow it was trained on; "" when unknown
+    d["members"] = 1 + static_cast<int>(members_.size());  // an ensemble's heads (models/head_ensemble.hpp)
     return d;
   }
 
@@ -718,6 +732,9 @@ class PyInertialNetHead {
   std::unique_ptr<WeightSet> weights_;
   std::unique_ptr<InertialNetHead> head_;
   HeadInputInfo input_;
+  // An ensemble's members 1…K−1 (head_ is member 0) and their weight sets.
+  std::vector<std::unique_ptr<WeightSet>> member_weights_;
+  std::vector<std::unique_ptr<InertialNetHead>> members_;
 };
 
 // --- sequences, predict, evaluate ------------------------------------------------------------------

@@ -136,3 +136,21 @@ def test_fused_estimator_matches_the_cli(cli, sequence, tmp_path):
     stream = list(inertialnet.stream(sequence, head_weights, flow="dis", head="both", fuse=True, smooth="off"))
     assert stream[0][1].shape == (3, 3) and len(stream[0][2]) == 3
     np.testing.assert_array_equal(np.stack([s[1][2] for s in stream]), fused.w)
+
+
+def test_a_head_ensemble_answers_its_members_mean(cli, sequence, tmp_path):
+    # Issue 23: train --ensemble 2 writes two heads (seeds 1 and 2) and one ensemble file of both;
+    # InertialNetHead.rates() on the ensemble is the members' mean, as predict reports it.
+    out = tmp_path / "ens.safetensors"
+    cli("train", "--train", sequence, "--val", sequence, "--head-size", "32x24", "--optimizer", "adam", "--lr", "1e-3",
+        "--epochs", "1", "--ensemble", "2", "--cache", tmp_path / "cache", "-o", out)
+    ensemble = inertialnet.InertialNetHead.load(out)
+    members = [inertialnet.InertialNetHead.load(tmp_path / f"ens.member{k}.safetensors") for k in (0, 1)]
+    assert ensemble.config["members"] == 2 and members[0].config["members"] == 1
+    s = inertialnet.Sequence(sequence)
+    flow = inertialnet.dis_flow(s[0], s[1])
+    dt = float(s.timestamps_ns[1] - s.timestamps_ns[0]) * 1e-9
+    got = ensemble.rates(flow, camera=s.camera, dt=dt)
+    each = [m.rates(flow, camera=s.camera, dt=dt) for m in members]
+    assert not np.array_equal(each[0], each[1])  # two seeds, two heads
+    np.testing.assert_allclose(got, (each[0] + each[1]) / 2, rtol=1e-12, atol=0)

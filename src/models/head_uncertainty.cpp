@@ -113,10 +113,13 @@ std::array<double, 3> HeadUncertainty::spread(const std::vector<float>& features
 }
 
 std::array<double, 3> HeadUncertainty::sigma(const std::vector<float>& features, const std::optional<Mat3>& rotation) const {
-  const std::array<double, 3> s = spread(features, rotation);
-  if (options_.calibration) return options_.calibration->sigma(s);
+  return options_.sigma_of_spread(spread(features, rotation));
+}
+
+std::array<double, 3> HeadSigmaOptions::sigma_of_spread(const std::array<double, 3>& s) const {
+  if (calibration) return calibration->sigma(s);
   std::array<double, 3> out{};
-  for (std::size_t a = 0; a < 3; ++a) out[a] = std::hypot(options_.scale * s[a], options_.floor_rad_s);
+  for (std::size_t a = 0; a < 3; ++a) out[a] = std::hypot(scale * s[a], floor_rad_s);
   return out;
 }
 

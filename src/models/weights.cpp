@@ -15,6 +15,8 @@ namespace inertialnet {
 namespace {
 
 bool is_head_name(const std::string& name) { return name.rfind("head.", 0) == 0; }
+// The tensors of a head ensemble's members k ≥ 1 (models/head_ensemble.hpp): no flow model's.
+bool is_ensemble_name(const std::string& name) { return name.rfind("ensemble.", 0) == 0; }
 
 }  // namespace
 
@@ -103,9 +105,29 @@ const Tensor& WeightSet::get(const std::string& name) const {
 void WeightSet::check(const std::string& model, const std::vector<ParameterSpec>& parameters) const {
   const bool head_model = !parameters.empty() && is_head_name(parameters.front().name);
   WeightFitOptions options;
-  options.owns = [head_model](const std::string& name) { return is_head_name(name) == head_model; };
+  options.owns = [head_model](const std::string& name) {
+    return head_model ? is_head_name(name) : !is_head_name(name) && !is_ensemble_name(name);
+  };
   check_weights_fit("weights " + sources(), shapes_, std::vector<TensorSpec>(parameters.begin(), parameters.end()),
                     model, options);
+}
+
+WeightSet WeightSet::ensemble_member(int k) const {
+  const std::string prefix = "ensemble." + std::to_string(k) + ".";
+  WeightSet member;
+  for (const auto& [name, tensor] : tensors_) {
+    if (name.rfind(prefix, 0) != 0) continue;
+    const std::string own = name.substr(prefix.size());
+    member.tensors_.emplace(own, tensor);
+    member.shapes_.emplace(own, shapes_.at(name));
+    member.source_of_.emplace(own, source_of_.at(name));
+  }
+  for (const auto& source : source_names_) member.source_names_.push_back(source + " (ensemble member " + std::to_string(k) + ")");
+  member.synthetic_sources_ = synthetic_sources_;
+  member.models_ = models_;
+  member.has_head_config_ = has_head_config_;
+  member.head_config_ = head_config_;
+  return member;
 }
 
 std::string WeightSet::sources() const {

@@ -14,6 +14,7 @@
 #include "inertialnet/io/calibration_file.hpp"
 #include "inertialnet/io/camera.hpp"
 #include "inertialnet/models/flow_consistency.hpp"
+#include "inertialnet/models/head_ensemble.hpp"
 #include "inertialnet/models/head_input.hpp"
 #include "inertialnet/models/sigma_calibration.hpp"
 #include "inertialnet/runtime/device_selection.hpp"
@@ -223,6 +224,7 @@ Prediction::Prediction(const PredictSettings& s) : settings_(s) {
     const HeadInputInfo trained = read_head_input(s.weights);
     processor_.head_input = trained.convention;
     processor_.head_camera_frame = trained.camera_frame;
+    processor_.ensemble_members = read_head_ensemble(s.weights);  // 1: a single head
     if (!trained.flow.empty()) {
       const FlowMethod learned = parse_flow_method(trained.flow);
       if (s.flow.empty()) {
@@ -310,6 +312,9 @@ std::string Prediction::method() const {
   method += processor_.inertialnet_head && processor_.geometric_head ? " + InertialNet and geometric heads"
             : processor_.inertialnet_head                            ? " + InertialNet head"
                                                                      : " + geometric head";
+  if (processor_.inertialnet_head && processor_.ensemble_members > 1) {
+    method += " (InertialNet: an ensemble of " + std::to_string(processor_.ensemble_members) + " heads)";
+  }
   return method;
 }
 
@@ -340,6 +345,8 @@ std::vector<std::pair<std::string, std::string>> Prediction::csv_metadata() cons
     // targets in the body frame where the camera-to-body rotation is known, else the camera's.
     const bool camera = processor_.head_camera_frame && !processor_.camera_to_body;
     metadata = {{"frame", camera ? "camera" : "body"}, {"estimator", "network"}};
+    // The rates are the mean of this many heads (models/head_ensemble.hpp).
+    if (processor_.ensemble_members > 1) metadata.push_back({"ensemble_members", std::to_string(processor_.ensemble_members)});
     if (processor_.geometric_head) {
       metadata.push_back({"frame_geometric", geometric_frame});
       metadata.push_back({"estimator_geometric", "inter_frame"});

@@ -13,6 +13,7 @@
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/models/dis_flow.hpp"
 #include "inertialnet/models/flownet.hpp"
+#include "inertialnet/models/head_ensemble.hpp"
 #include "inertialnet/models/inertialnet_head.hpp"
 #include "inertialnet/models/lk_flow.hpp"
 #include "inertialnet/models/texture.hpp"
@@ -61,7 +62,14 @@ class RatesProcessor : public PairProcessor {
       : options_(options), weights_(weights), queue_(device.create_queue()) {
     if (options.flow == FlowMethod::FlowNet) flownet_ = std::make_unique<FlowNet>(device, options.flow_model, *weights);
     if (options.flow == FlowMethod::DIS) dis_ = std::make_unique<DisFlow>();
-    if (options.inertialnet_head) head_ = std::make_unique<InertialNetHead>(device, *weights);
+    if (options.inertialnet_head) {
+      head_ = std::make_unique<InertialNetHead>(device, *weights);
+      // Member 0 is the file's plain head; the others are its ensemble.<k>.* tensors.
+      for (int k = 1; k < options.ensemble_members; ++k) {
+        member_weights_.push_back(std::make_unique<WeightSet>(weights->ensemble_member(k)));
+        members_.push_back(std::make_unique<InertialNetHead>(device, *member_weights_.back()));
+      }
+    }
     if (options.geometric_head) {
       GeometricHeadOptions geometric = options.geometric;
       // LK tracks the head's grid points and nothing else: its coarser grid is the head's.
@@ -158,10 +166,28 @@ class RatesProcessor : public PairProcessor {
                                              static_cast<int>(c.input_height), options_.head_input, dt, fx, fy));
       }
       const auto omega = head_->compute(q, input, &stop).to_host(q);
-      if (std::isfinite(omega[0]) && std::isfinite(omega[1]) && std::isfinite(omega[2])) {
-        answer.w = {omega[0], omega[1], omega[2]};
-        if (options_.head_camera_frame) answer.w = to_body(options_.camera_to_body, answer.w);
-        if (options_.fuse) answer.sigma = head_sigma(q);
+      bool finite = std::isfinite(omega[0]) && std::isfinite(omega[1]) && std::isfinite(omega[2]);
+      std::vector<std::array<double, 3>> outputs{{omega[0], omega[1], omega[2]}};
+      for (const auto& member : members_) {
+        const auto w = member->compute(q, input, &stop).to_host(q);
+        finite = finite && std::isfinite(w[0]) && std::isfinite(w[1]) && std::isfinite(w[2]);
+        outputs.push_back({w[0], w[1], w[2]});
+      }
+      if (finite) {
+        // A camera-frame head's rates (every member's) turned into the body frame first, so that an
+        // ensemble's spread, like the dropout passes (head_sigma), is per body axis, where the σ
+        // calibration was fitted.
+        if (options_.head_camera_frame) {
+          for (auto& w : outputs) w = to_body(options_.camera_to_body, w);
+        }
+        if (members_.empty()) {
+          answer.w = outputs.front();
+          if (options_.fuse) answer.sigma = head_sigma(q);
+        } else {
+          const EnsembleRates e = combine_ensemble(outputs);
+          answer.w = e.mean;
+          if (options_.fuse) answer.sigma = options_.head_sigma.sigma_of_spread(e.spread);
+        }
       } else {
         answer.status = PairStatus::NonFinite;
         answer.reason = "the InertialNet head's output is not finite (NaN or infinity)";
@@ -295,6 +321,9 @@ class RatesProcessor : public PairProcessor {
   std::unique_ptr<DisFlow> dis_;
   std::unique_ptr<LkFlow> lk_;
   std::unique_ptr<InertialNetHead> head_;
+  // A head ensemble's members 1…K−1 (head_ is member 0) and the weight sets they read.
+  std::vector<std::unique_ptr<WeightSet>> member_weights_;
+  std::vector<std::unique_ptr<InertialNetHead>> members_;
   std::unique_ptr<GeometricHead> geometric_;
   std::unique_ptr<HeadUncertainty> uncertainty_;  // with options_.fuse, made on the first pair
 };

@@ -65,3 +65,29 @@ expect_match("nan.safetensors: metadata inertialnet.sigma_calibration '.*NaN.*' 
 if(EXISTS "${WORK}/bad.csv")
   message(FATAL_ERROR "a refused run left bad.csv")
 endif()
+
+# Issue 23, an ensemble of heads (train --ensemble): calibrate-sigma fits the members' spread, and
+# predict --fuse uses it; a malformed inertialnet.ensemble is exit 2 naming file, key and value.
+run(0 ${CLI} train --train a --val b --head-size 96x64 --optimizer adam --lr 1e-3 --epochs 2 --target mean
+    --no-flow-cache --ensemble 2 -o ens.safetensors)
+run(0 ${CLI} calibrate-sigma ens.safetensors --val val --max-sigma 0)
+expect_match("on 25 pairs: scale")
+expect_match("wrote inertialnet.sigma_calibration into ens.safetensors")
+run(0 ${CLI} predict low -w ens.safetensors --head both --fuse --smooth off --max-sigma 0 -o ens.csv)
+file(WRITE "${WORK}/edit_ensemble.py" [=[
+import json, struct, sys
+path, out, value = sys.argv[1], sys.argv[2], sys.argv[3]
+data = open(path, "rb").read()
+n = struct.unpack("<Q", data[:8])[0]
+header = json.loads(data[8:8 + n])
+header["__metadata__"]["inertialnet.ensemble"] = value
+text = json.dumps(header).encode()
+text += b" " * (-len(text) % 8)
+open(out, "wb").write(struct.pack("<Q", len(text)) + text + data[8 + n:])
+]=])
+run(0 ${PYTHON} edit_ensemble.py ens.safetensors ens_bad.safetensors "{\"members\":1,\"version\":1}")
+run(2 ${CLI} predict low -w ens_bad.safetensors -o bad.csv)
+expect_match("ens_bad.safetensors: metadata inertialnet.ensemble '\\{\"members\":1,\"version\":1\\}' is not a head ensemble description: \"members\" is 1: must be a whole number from 2 to 64")
+if(EXISTS "${WORK}/bad.csv")
+  message(FATAL_ERROR "a refused ensemble left bad.csv")
+endif()

@@ -230,7 +230,7 @@ expect_match("nowhere is not a EuRoC sequence")
 # the first's rendered sequences and cached flows: one file, metadata included.
 run(0 ${CLI} train --recipe general --recipe-scale tiny -o recipe1/head.safetensors --work recipe_work1
     --cache recipe_cache1)
-expect_match("recipe general v1 \\(tiny\\): 3 training and 1 validation sequences in recipe_work1 \\(4 rendered now\\)")
+expect_match("recipe general v2 \\(tiny\\): 3 training and 1 validation sequences in recipe_work1 \\(4 rendered now\\)")
 run(0 ${CLI} train --recipe general --recipe-scale tiny -o recipe2/head.safetensors --work recipe_work2
     --cache recipe_cache2)
 run(0 ${CLI} train --recipe general --recipe-scale tiny -o recipe3/head.safetensors --work recipe_work1
@@ -245,7 +245,7 @@ foreach(n 2 3)
   endif()
 endforeach()
 run(0 ${CLI} weights --info recipe1/head.safetensors)
-expect_match("inertialnet.recipe = \\{\"name\":\"general\",\"scale\":\"tiny\",\"version\":1\\}")
+expect_match("inertialnet.recipe = \\{\"name\":\"general\",\"scale\":\"tiny\",\"version\":2\\}")
 expect_match("\"train_sequences\":\\[\"general-160x100\",\"close-200x150\",\"rotation-224x126\"\\]")
 # The user's sequences are added to the recipe's.
 run(0 ${CLI} train --recipe general --recipe-scale tiny --train a --val b -o recipe4/head.safetensors
@@ -271,3 +271,54 @@ run(2 ${CLI} train --val b -o recipe_bad/head.safetensors)
 expect_match("--train is required \\(or --recipe general")
 run(2 ${CLI} train --train a --val b --work w -o recipe_bad/head.safetensors)
 expect_match("--work is for --recipe")
+
+# --- issue 23, an ensemble of heads: the recipe (v2) trains its members (2 at tiny scale) with
+# seeds 3 and 4, each with its own files, and writes their best heads as one file, the same bit for
+# bit in every run above (the SHA-256 comparison); its sequences keep version 1's folder.
+run(0 ${CLI} weights --info recipe1/head.safetensors)
+expect_match("inertialnet.ensemble = \\{\"members\":2,\"version\":1\\}")
+if(NOT IS_DIRECTORY "${WORK}/recipe_work1/general-v1-tiny")
+  message(FATAL_ERROR "the recipe's sequences are not in general-v1-tiny")
+endif()
+foreach(k 0 1)
+  math(EXPR seed "3 + ${k}")
+  run(0 ${CLI} weights --info recipe1/head.member${k}.safetensors)
+  expect_match("\"seed\":${seed}")
+  expect_no_match("inertialnet.ensemble")
+endforeach()
+file(SHA256 "${WORK}/recipe1/head.member0.safetensors" member0)
+file(SHA256 "${WORK}/recipe1/head.member1.safetensors" member1)
+if(member0 STREQUAL member1)
+  message(FATAL_ERROR "the recipe's two ensemble members are the same head")
+endif()
+run(0 ${CLI} predict a -w recipe1/head.safetensors --smooth off -o ensemble_rates.csv)
+# --ensemble K without the recipe: K members' files beside -o (log and plot too), one ensemble file.
+run(0 ${CLI} train --train a --val b --head-size 64x48 --optimizer adam --lr 1e-3 --epochs 1 --ensemble 2
+    -o ens/head.safetensors --log ens/train.csv --plot ens/loss.png --cache cache)
+expect_match("ensemble member 1 of 2: seed 2")
+expect_match("wrote ens/head.safetensors \\(an ensemble of the 2 members' best heads\\)")
+foreach(f head.member0.safetensors head.member1.last.safetensors head.member1.state.safetensors train.member0.csv
+          train.member1.csv loss.member1.png head.safetensors)
+  if(NOT EXISTS "${WORK}/ens/${f}")
+    message(FATAL_ERROR "train --ensemble 2 did not write ens/${f}")
+  endif()
+endforeach()
+# --resume: every member from its own state. Finished members are kept and the ensemble is
+# written again (also when it is missing); resumed to 2 epochs, both members train their second.
+file(REMOVE "${WORK}/ens/head.safetensors")
+run(0 ${CLI} train --train a --val b --head-size 64x48 --optimizer adam --lr 1e-3 --epochs 1 --ensemble 2
+    -o ens/head.safetensors --cache cache --resume)
+expect_match("nothing to do: ens/head.member1.state.safetensors has finished epoch 1 .*Its best head is kept as it is")
+expect_match("wrote ens/head.safetensors \\(an ensemble")
+run(0 ${CLI} train --train a --val b --head-size 64x48 --optimizer adam --lr 1e-3 --epochs 2 --ensemble 2
+    -o ens/head.safetensors --cache cache --resume)
+expect_match("resuming after epoch 1 from ens/head.member0.state.safetensors")
+expect_match("resuming after epoch 1 from ens/head.member1.state.safetensors")
+foreach(k 0 1)
+  run(0 ${CLI} weights --info ens/head.member${k}.last.safetensors)
+  expect_match("\"epoch\":2")
+endforeach()
+run(2 ${CLI} train --train a --val b --ensemble 0 -o ens_bad/head.safetensors)
+expect_match("--ensemble")
+run(2 ${CLI} train --recipe general --ensemble 3 -o recipe_bad/head.safetensors --work recipe_work_bad)
+expect_match("--ensemble with --recipe general: the recipe fixes it")

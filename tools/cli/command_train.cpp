@@ -27,6 +27,7 @@
 #include "inertialnet/eval/plots.hpp"
 #include "inertialnet/io/camera_imu.hpp"
 #include "inertialnet/eval/time_offset.hpp"
+#include "inertialnet/models/head_ensemble.hpp"
 #include "inertialnet/models/head_input.hpp"
 #include "inertialnet/models/weights.hpp"
 #include "inertialnet/runtime/error.hpp"
@@ -59,6 +60,8 @@ struct TrainCliOptions {
   bool resume = false, no_flow_cache = false, augment_flips = false;
   // --recipe NAME (train/recipe.hpp): renders its own sequences and fixes every training setting.
   std::string recipe, recipe_scale = "full", work;
+  // --ensemble K: K heads with seeds seed…seed+K−1, written as one ensemble file (models/head_ensemble.hpp).
+  int ensemble = 1;
 };
 
 std::filesystem::path sibling(const std::filesystem::path& out, const std::string& suffix) {
@@ -176,6 +179,11 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
                  "its rate to the target (0: off)")
       ->capture_default_str()
       ->check(finite_non_negative_up_to(1000, "deg/s"));  // the Trainer's bound (trainer.cpp)
+  app.add_option("--ensemble", o->ensemble,
+                 "train K heads with seeds --seed, --seed+1, … (each with its own <stem>.member<k> files) and write "
+                 "their best heads as one ensemble at -o: predict reports their mean, --fuse uses their spread")
+      ->capture_default_str()
+      ->check(CLI::Range(1, kMaxEnsembleMembers));
   app.add_flag("--resume", o->resume, "continue from <stem>.state.safetensors beside -o");
   app.add_option("--log", o->log, "per-epoch CSV");
   app.add_option("--plot", o->plot, "loss curves (PNG)");
@@ -191,7 +199,7 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
   std::vector<CLI::Option*> fixed;
   for (const char* name : {"--flow", "--weights", "--epochs", "--batch", "--lr", "--optimizer", "--momentum",
                            "--weight-decay", "--lr-schedule", "--seed", "--head-size", "--target", "--head-input",
-                           "--dropout", "--augment-rotation", "--augment-flips", "--time-offset"}) {
+                           "--dropout", "--augment-rotation", "--augment-flips", "--time-offset", "--ensemble"}) {
     fixed.push_back(app.get_option(name));
   }
   return [o, &global, fixed]() {
@@ -261,19 +269,43 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
       throw invalid_input("--flow flownet2 needs FlowNet2 weights (--weights FILE)");
     }
 
-    // Every output, checked before anything is computed.
+    // An ensemble (--ensemble K, or the recipe's members; models/head_ensemble.hpp): K heads of
+    // the same settings with seeds seed, seed+1, …, each with its own files (<stem>.member<k> for
+    // every output), then their best heads in one file at -o. One member: the files as named.
+    const int members = recipe ? recipe->members : o->ensemble;
     const fs::path out = o->out;
-    const fs::path last_path = sibling(out, ".last.safetensors");
-    const fs::path state_path = sibling(out, ".state.safetensors");
-    std::vector<Output> outputs{{out, "-o"},
-                                {last_path, "the last head (beside -o)"},
-                                {state_path, "the training state (beside -o)"}};
-    if (!o->log.empty()) outputs.push_back({o->log, "--log"});
+    struct MemberFiles {
+      fs::path best, last, state, log, plot;
+    };
+    const auto member_file = [members](const fs::path& path, int k) {
+      if (members == 1 || path.empty()) return path;
+      return path.parent_path() / (path.stem().string() + ".member" + std::to_string(k) + path.extension().string());
+    };
+    std::vector<MemberFiles> files;
+    for (int k = 0; k < members; ++k) {
+      MemberFiles f;
+      f.best = member_file(out, k);
+      f.last = sibling(f.best, ".last.safetensors");
+      f.state = sibling(f.best, ".state.safetensors");
+      f.log = member_file(o->log, k);
+      f.plot = member_file(o->plot, k);
+      files.push_back(f);
+    }
+    // Every output, checked before anything is computed.
+    std::vector<Output> outputs;
+    if (members > 1) outputs.push_back({out, "-o"});
+    for (int k = 0; k < members; ++k) {
+      const std::string of = members > 1 ? " of ensemble member " + std::to_string(k) : std::string();
+      outputs.push_back({files[k].best, members > 1 ? "the best head" + of + " (beside -o)" : "-o"});
+      outputs.push_back({files[k].last, "the last head" + of + " (beside -o)"});
+      outputs.push_back({files[k].state, "the training state" + of + " (beside -o)"});
+      if (!o->log.empty()) outputs.push_back({files[k].log, "--log" + of});
+      if (!o->plot.empty()) outputs.push_back({files[k].plot, "--plot" + of});
+    }
     if (!o->plot.empty()) {
       std::string extension = fs::path(o->plot).extension().string();
       for (auto& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
       if (extension != ".png") throw invalid_input("--plot " + o->plot + ": the name must end in .png.");
-      outputs.push_back({o->plot, "--plot"});
     }
     std::vector<std::string> sequences = o->train;
     sequences.insert(sequences.end(), o->val.begin(), o->val.end());
@@ -298,8 +330,16 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
     }
 
     std::unique_ptr<Device> device = open_device(global);
-    Trainer trainer(*device, options);  // refuses options no run can use
-    if (o->resume) {
+    // Every member's trainer, and its state with --resume, before the flows.
+    std::vector<std::unique_ptr<Trainer>> trainers;
+    std::vector<bool> done(static_cast<std::size_t>(members), false);
+    for (int k = 0; k < members; ++k) {
+      TrainerOptions member_options = options;
+      member_options.seed = options.seed + static_cast<std::uint64_t>(k);
+      trainers.push_back(std::make_unique<Trainer>(*device, member_options));  // refuses options no run can use
+      Trainer& trainer = *trainers.back();
+      const fs::path& state_path = files[k].state;
+      if (!o->resume) continue;
       std::error_code ec;
       if (!fs::exists(state_path, ec)) {
         throw invalid_input("--resume: there is no training state " + state_path.string() +
@@ -308,14 +348,34 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
       trainer.resume(state_path);
       if (trainer.finished()) {
         info("nothing to do: " + state_path.string() + " has finished epoch " + std::to_string(trainer.epochs_done()) +
-             " of --epochs " + std::to_string(options.epochs) + "; raise --epochs to train on. No file was written.");
-        return 0;
+             " of --epochs " + std::to_string(options.epochs) + "; raise --epochs to train on." +
+             (members > 1 ? std::string(" Its best head is kept as it is.") : std::string(" No file was written.")));
+        done[static_cast<std::size_t>(k)] = true;
+        continue;
       }
       info("resuming after epoch " + std::to_string(trainer.epochs_done()) + " from " + state_path.string());
     }
-    // Opened (and its target checked by the atomic writer) before the flows.
-    std::unique_ptr<TrainingLog> log;
-    if (!o->log.empty()) log = std::make_unique<TrainingLog>(o->log, o->resume ? trainer.epochs_done() : -1);
+    // Every member finished already: nothing to train; an ensemble is written again from the members'
+    // best heads (a run stopped between its last member and the ensemble file has none yet).
+    const auto write_ensemble = [&] {
+      std::vector<std::string> bests;
+      for (const auto& f : files) bests.push_back(f.best.string());
+      write_head_ensemble(out.string(), bests);
+      std::printf("wrote %s (an ensemble of the %d members' best heads)\n", out.string().c_str(), members);
+    };
+    if (std::all_of(done.begin(), done.end(), [](bool d) { return d; })) {
+      if (members > 1) write_ensemble();
+      flush_standard_output();
+      return 0;
+    }
+    // Opened (and their targets checked by the atomic writer) before the flows.
+    std::vector<std::unique_ptr<TrainingLog>> logs(static_cast<std::size_t>(members));
+    if (!o->log.empty()) {
+      for (int k = 0; k < members; ++k) {
+        if (done[static_cast<std::size_t>(k)]) continue;
+        logs[k] = std::make_unique<TrainingLog>(files[k].log.string(), o->resume ? trainers[k]->epochs_done() : -1);
+      }
+    }
 
     WeightSet flownet;
     if (set_options.flow == FlowMethod::FlowNet) {
@@ -350,119 +410,131 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
     load(train_set, o->train, "train");
     load(val_set, o->val, "val");
 
-    std::vector<double> plot_epochs, plot_train, plot_val;
+    for (int k = 0; k < members; ++k) {
+      if (done[static_cast<std::size_t>(k)]) continue;
+      Trainer& trainer = *trainers[static_cast<std::size_t>(k)];
+      const MemberFiles& f = files[static_cast<std::size_t>(k)];
+      TrainingLog* log = logs[static_cast<std::size_t>(k)].get();
+      const std::uint64_t seed = options.seed + static_cast<std::uint64_t>(k);
+      if (members > 1) info("ensemble member " + std::to_string(k) + " of " + std::to_string(members) + ": seed " + std::to_string(seed));
+      std::vector<double> plot_epochs, plot_train, plot_val;
 
-    auto metadata = [&](const EpochReport& r) {
-      nlohmann::json j;
-      j["optimizer"] = to_string(options.optimizer);
-      j["lr"] = options.lr;
-      j["momentum"] = options.momentum;
-      j["weight_decay"] = options.weight_decay;
-      j["lr_schedule"] = to_string(options.schedule);
-      j["epochs"] = options.epochs;
-      j["batch"] = options.batch;
-      j["seed"] = options.seed;
-      j["augment_flips"] = options.flip_augmentation;
-      j["augment_rotation_deg_s"] = options.rotation_augmentation_deg_s;
-      j["dropout"] = options.head.dropout;
-      j["head_input"] = to_string(set_options.input);
-      j["flow"] = to_string(set_options.flow);
-      j["input_size"] = std::to_string(options.head.input_width) + "x" + std::to_string(options.head.input_height);
-      j["target"] = to_string(set_options.target);
-      j["time_offset_s"] = set_options.time_offset_s;
-      j["frame"] = camera_frame_targets(set_options.input) ? "camera" : "body";
-      if (recipe) j["recipe"] = nlohmann::json::parse(recipe_to_json(*recipe));
-      j["train_sequences"] = train_set.sequences();
-      j["val_sequences"] = val_set.sequences();
-      j["epoch"] = r.epoch;
-      j["val_rmse_deg_s"] = nlohmann::json::parse(vec3_json(r.val_rmse_deg_s));
-      j["zero_rmse_deg_s"] = nlohmann::json::parse(vec3_json(r.zero_rmse_deg_s));
-      j["spread_ratio"] = nlohmann::json::parse(vec3_json(r.spread_ratio));
-      j["gain"] = nlohmann::json::parse(vec3_json(r.gain));
-      // What predict reads to feed the head as it was trained (models/head_input.hpp).
-      const std::string input = head_input_to_json(
-          {set_options.input, to_string(set_options.flow), camera_frame_targets(set_options.input)});
-      std::map<std::string, std::string> meta{{"inertialnet.training", j.dump()}, {kMetadataHeadInput, input}};
-      if (recipe) meta["inertialnet.recipe"] = recipe_to_json(*recipe);
-      return meta;
-    };
+      auto metadata = [&](const EpochReport& r) {
+        nlohmann::json j;
+        j["optimizer"] = to_string(options.optimizer);
+        j["lr"] = options.lr;
+        j["momentum"] = options.momentum;
+        j["weight_decay"] = options.weight_decay;
+        j["lr_schedule"] = to_string(options.schedule);
+        j["epochs"] = options.epochs;
+        j["batch"] = options.batch;
+        j["seed"] = seed;
+        if (members > 1) j["ensemble_member"] = k;
+        j["augment_flips"] = options.flip_augmentation;
+        j["augment_rotation_deg_s"] = options.rotation_augmentation_deg_s;
+        j["dropout"] = options.head.dropout;
+        j["head_input"] = to_string(set_options.input);
+        j["flow"] = to_string(set_options.flow);
+        j["input_size"] = std::to_string(options.head.input_width) + "x" + std::to_string(options.head.input_height);
+        j["target"] = to_string(set_options.target);
+        j["time_offset_s"] = set_options.time_offset_s;
+        j["frame"] = camera_frame_targets(set_options.input) ? "camera" : "body";
+        if (recipe) j["recipe"] = nlohmann::json::parse(recipe_to_json(*recipe));
+        j["train_sequences"] = train_set.sequences();
+        j["val_sequences"] = val_set.sequences();
+        j["epoch"] = r.epoch;
+        j["val_rmse_deg_s"] = nlohmann::json::parse(vec3_json(r.val_rmse_deg_s));
+        j["zero_rmse_deg_s"] = nlohmann::json::parse(vec3_json(r.zero_rmse_deg_s));
+        j["spread_ratio"] = nlohmann::json::parse(vec3_json(r.spread_ratio));
+        j["gain"] = nlohmann::json::parse(vec3_json(r.gain));
+        // What predict reads to feed the head as it was trained (models/head_input.hpp).
+        const std::string input = head_input_to_json(
+            {set_options.input, to_string(set_options.flow), camera_frame_targets(set_options.input)});
+        std::map<std::string, std::string> meta{{"inertialnet.training", j.dump()}, {kMetadataHeadInput, input}};
+        if (recipe) meta["inertialnet.recipe"] = recipe_to_json(*recipe);
+        return meta;
+      };
 
-    Progress* bar = nullptr;
-    std::unique_ptr<Progress> epoch_bar;
-    TrainerCallbacks callbacks;
-    callbacks.stop = &interrupt_requested();
-    callbacks.on_batch = [&](int epoch, std::size_t b, std::size_t batches, double) {
-      if (b == 1) {
-        epoch_bar = std::make_unique<Progress>("epoch " + std::to_string(epoch) + "/" + std::to_string(options.epochs), batches);
-        bar = epoch_bar.get();
-      }
-      bar->update(b);
-    };
-    callbacks.on_epoch = [&](const EpochReport& r) {
+      Progress* bar = nullptr;
+      std::unique_ptr<Progress> epoch_bar;
+      TrainerCallbacks callbacks;
+      callbacks.stop = &interrupt_requested();
+      callbacks.on_batch = [&](int epoch, std::size_t b, std::size_t batches, double) {
+        if (b == 1) {
+          epoch_bar = std::make_unique<Progress>("epoch " + std::to_string(epoch) + "/" + std::to_string(options.epochs), batches);
+          bar = epoch_bar.get();
+        }
+        bar->update(b);
+      };
+      callbacks.on_epoch = [&](const EpochReport& r) {
+        epoch_bar.reset();
+        char line[512];
+        std::snprintf(line, sizeof line,
+                      "epoch %d/%d  lr %.3g  train %.5g  val %.5g  RMSE %.2f %.2f %.2f deg/s (zero %.2f %.2f %.2f)  "
+                      "spread %.2f %.2f %.2f  gain %.2f %.2f %.2f  %.1f s%s",
+                      r.epoch, r.epochs, r.lr, r.train_loss, r.val_loss, r.val_rmse_deg_s[0], r.val_rmse_deg_s[1],
+                      r.val_rmse_deg_s[2], r.zero_rmse_deg_s[0], r.zero_rmse_deg_s[1], r.zero_rmse_deg_s[2],
+                      r.spread_ratio[0], r.spread_ratio[1], r.spread_ratio[2], r.gain[0], r.gain[1], r.gain[2], r.seconds,
+                      r.best ? "  best" : "");
+        info(line);
+        if (r.collapsed) {
+          char ratio[16];
+          std::snprintf(ratio, sizeof ratio, "%g", kCollapseRatio);
+          warning(std::string("the predictions' spread fell below ") + ratio +
+                  " of the targets' on some axis: the head is collapsing towards the mean (the paper's "
+                  "\"same-value problem\"); try a larger learning rate, Adam, or more epochs");
+        }
+        if (log) log->append(r);
+        plot_epochs.push_back(r.epoch);
+        plot_train.push_back(r.train_loss);
+        plot_val.push_back(r.val_loss);
+        if (!o->plot.empty()) {
+          plot_loss_curves(f.plot.string(), plot_epochs, {{"train", plot_train}, {"validation", plot_val}},
+                           "InertialNet head training (MSE, rad^2/s^2)");
+        }
+      };
+      bool wrote_best = false;
+      auto on_best = [&](const EpochReport& r) {
+        trainer.save_head(f.best, metadata(r));
+        wrote_best = true;
+      };
+      auto on_last = [&](const EpochReport& r) {
+        trainer.save_head(f.last, metadata(r));
+        trainer.save_state(f.state);
+      };
+
+      const bool finished = [&] {
+        const InterruptGuard guard;
+        return trainer.train(train_set, val_set, callbacks, on_best, on_last);
+      }();
       epoch_bar.reset();
-      char line[512];
-      std::snprintf(line, sizeof line,
-                    "epoch %d/%d  lr %.3g  train %.5g  val %.5g  RMSE %.2f %.2f %.2f deg/s (zero %.2f %.2f %.2f)  "
-                    "spread %.2f %.2f %.2f  gain %.2f %.2f %.2f  %.1f s%s",
-                    r.epoch, r.epochs, r.lr, r.train_loss, r.val_loss, r.val_rmse_deg_s[0], r.val_rmse_deg_s[1],
-                    r.val_rmse_deg_s[2], r.zero_rmse_deg_s[0], r.zero_rmse_deg_s[1], r.zero_rmse_deg_s[2],
-                    r.spread_ratio[0], r.spread_ratio[1], r.spread_ratio[2], r.gain[0], r.gain[1], r.gain[2], r.seconds,
-                    r.best ? "  best" : "");
-      info(line);
-      if (r.collapsed) {
-        char ratio[16];
-        std::snprintf(ratio, sizeof ratio, "%g", kCollapseRatio);
-        warning(std::string("the predictions' spread fell below ") + ratio +
-                " of the targets' on some axis: the head is collapsing towards the mean (the paper's "
-                "\"same-value problem\"); try a larger learning rate, Adam, or more epochs");
+      if (!finished) {
+        // The interrupted epoch does not count; its partial updates are in the last head.
+        EpochReport r = trainer.last();
+        trainer.save_head(f.last, metadata(r));
+        if (trainer.epochs_done() == 0) trainer.save_head(f.best, metadata(r));
+        end_progress_line();
+        std::cerr << "inertialnet: interrupted: " << f.last.string() << " holds the weights so far; "
+                  << f.state.string() << " resumes after epoch " << trainer.epochs_done()
+                  << (members > 1 ? " (rerun with --resume: every member resumes from its own state)" : "") << "\n";
+        return 1;
       }
-      if (log) log->append(r);
-      plot_epochs.push_back(r.epoch);
-      plot_train.push_back(r.train_loss);
-      plot_val.push_back(r.val_loss);
-      if (!o->plot.empty()) {
-        plot_loss_curves(o->plot, plot_epochs, {{"train", plot_train}, {"validation", plot_val}},
-                         "InertialNet head training (MSE, rad^2/s^2)");
+      const EpochReport& best = trainer.best();
+      if (wrote_best) {
+        std::printf("best epoch %d: validation RMSE %.3f %.3f %.3f deg/s (zero predictor %.3f %.3f %.3f), spread %.2f %.2f %.2f\n",
+                    best.epoch, best.val_rmse_deg_s[0], best.val_rmse_deg_s[1], best.val_rmse_deg_s[2],
+                    best.zero_rmse_deg_s[0], best.zero_rmse_deg_s[1], best.zero_rmse_deg_s[2], best.spread_ratio[0],
+                    best.spread_ratio[1], best.spread_ratio[2]);
+        std::printf("wrote %s (best), %s (last)\n", f.best.string().c_str(), f.last.string().c_str());
+      } else {
+        // Resumed, and no epoch of this run beat the state's best: the best file still holds that epoch's head.
+        std::printf("best epoch %d (before this run): mean validation RMSE %.3f deg/s; no epoch of this run improved on it\n",
+                    best.epoch, trainer.best_mean_rmse_deg_s());
+        std::printf("kept %s (best), wrote %s (last)\n", f.best.string().c_str(), f.last.string().c_str());
       }
-    };
-    bool wrote_best = false;
-    auto on_best = [&](const EpochReport& r) {
-      trainer.save_head(out, metadata(r));
-      wrote_best = true;
-    };
-    auto on_last = [&](const EpochReport& r) {
-      trainer.save_head(last_path, metadata(r));
-      trainer.save_state(state_path);
-    };
-
-    const bool finished = [&] {
-      const InterruptGuard guard;
-      return trainer.train(train_set, val_set, callbacks, on_best, on_last);
-    }();
-    epoch_bar.reset();
-    if (!finished) {
-      // The interrupted epoch does not count; its partial updates are in the last head.
-      EpochReport r = trainer.last();
-      trainer.save_head(last_path, metadata(r));
-      if (trainer.epochs_done() == 0) trainer.save_head(out, metadata(r));
-      end_progress_line();
-      std::cerr << "inertialnet: interrupted: " << last_path.string() << " holds the weights so far; "
-                << state_path.string() << " resumes after epoch " << trainer.epochs_done() << "\n";
-      return 1;
+      flush_standard_output();
     }
-    const EpochReport& best = trainer.best();
-    if (wrote_best) {
-      std::printf("best epoch %d: validation RMSE %.3f %.3f %.3f deg/s (zero predictor %.3f %.3f %.3f), spread %.2f %.2f %.2f\n",
-                  best.epoch, best.val_rmse_deg_s[0], best.val_rmse_deg_s[1], best.val_rmse_deg_s[2],
-                  best.zero_rmse_deg_s[0], best.zero_rmse_deg_s[1], best.zero_rmse_deg_s[2], best.spread_ratio[0],
-                  best.spread_ratio[1], best.spread_ratio[2]);
-      std::printf("wrote %s (best), %s (last)\n", out.string().c_str(), last_path.string().c_str());
-    } else {
-      // Resumed, and no epoch of this run beat the state's best: -o still holds that epoch's head.
-      std::printf("best epoch %d (before this run): mean validation RMSE %.3f deg/s; no epoch of this run improved on it\n",
-                  best.epoch, trainer.best_mean_rmse_deg_s());
-      std::printf("kept %s (best), wrote %s (last)\n", out.string().c_str(), last_path.string().c_str());
-    }
+    if (members > 1) write_ensemble();
     flush_standard_output();
     return 0;
   };

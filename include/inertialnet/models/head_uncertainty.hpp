@@ -40,6 +40,9 @@ struct HeadSigmaOptions {
   // sigma_calibration.hpp); when set it replaces scale and floor_rad_s.
   std::optional<SigmaCalibration> calibration;
   void validate() const;   // invalid_input for passes outside 2..1000, p outside (0, 1), scale/floor < 0
+  // The calibrated σ (rad/s) for a raw spread s per axis: the calibration's when set, else
+  // sqrt((scale·s)² + floor²). Shared by the dropout passes and a head ensemble's members.
+  std::array<double, 3> sigma_of_spread(const std::array<double, 3>& spread) const;
 };
 
 class HeadUncertainty {

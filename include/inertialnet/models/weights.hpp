@@ -34,9 +34,14 @@ class WeightSet {
   const Tensor& get(const std::string& name) const;  // invalid_input naming the tensor
   const std::map<std::string, Tensor>& tensors() const { return tensors_; }
   const std::map<std::string, Shape>& shapes() const { return shapes_; }
+  // Member k ≥ 1 of a head ensemble in this set (models/head_ensemble.hpp): its tensors
+  // ensemble.<k>.head.* as head.*, the set's head configuration, and prepared weights of its own
+  // (the members' tensors share names). The tensors are shared with this set, not copied.
+  WeightSet ensemble_member(int k) const;
 
   // Checks that the set holds what `parameters` lists with those shapes, and nothing else in
-  // that model's namespace (every name but head.* for a flow model; head.* for the head).
+  // that model's namespace (every name but head.* and an ensemble's ensemble.* for a flow model;
+  // head.* for the head).
   // Throws one invalid_input naming `model`, the sources, and every problem.
   void check(const std::string& model, const std::vector<ParameterSpec>& parameters) const;
 

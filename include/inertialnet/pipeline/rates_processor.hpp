@@ -76,6 +76,11 @@ struct RatesProcessorOptions {
   // The geometric σ factor and the heads' error correlation of the head's σ calibration
   // (sigma_calibration.hpp; defaults: plain inverse-variance weights).
   FusionWeights fusion;
+  // The InertialNet head's weights hold this many heads (models/head_ensemble.hpp; from the
+  // metadata "inertialnet.ensemble"): the reported rates are their mean, and with `fuse` the
+  // learned σ comes from their spread (head_sigma's calibration or scale and floor applied to
+  // it) instead of Monte-Carlo dropout.
+  int ensemble_members = 1;
 };
 
 // Each lane gets its own queue and model instances. `weights` holds one set per device, loaded

@@ -9,7 +9,7 @@
 // The table lives in src/train/recipe.cpp; docs/training.md ("A head you can get") says what it
 // renders, how long it takes and how its head measures on a camera it never saw. Changing any row
 // or setting changes the head: bump the recipe's version with it (the version is in the head's
-// metadata and in the rendered sequences' folder name).
+// metadata; the rendered sequences' folder name has the version of the sequence table).
 #pragma once
 
 #include <cstdint>
@@ -41,6 +41,11 @@ struct TrainingRecipe {
   HeadInput input = HeadInput::Normalized;
   SyncTarget target = SyncTarget::Mean;
   std::vector<RecipeSequence> sequences;
+  // Heads trained with seeds trainer.seed, +1, …, written as one ensemble (models/head_ensemble.hpp).
+  int members = 1;
+  // The version of the sequence table, which names the folder the sequences are rendered into: a
+  // version that changed only the training keeps the sequences (and their cached flows) of the last.
+  int sequences_version = 0;
 };
 
 // The recipes there are ("general").
@@ -56,13 +61,13 @@ struct RenderedRecipe {
 // Called before each sequence is rendered: its name, its index and the count.
 using RecipeProgress = std::function<void(const std::string& sequence, std::size_t index, std::size_t count)>;
 
-// Renders the recipe's sequences under work_dir/<name>-v<version>-<scale>/. A sequence already
+// Renders the recipe's sequences under work_dir/<name>-v<sequences_version>-<scale>/. A sequence already
 // there from the same recipe row (its recipe.json says so) is reused; any other content of its
 // folder is replaced. invalid_input for a work folder that cannot be used.
 RenderedRecipe render_recipe(const TrainingRecipe& recipe, const std::filesystem::path& work_dir,
                              const RecipeProgress& progress = {});
 
-// {"name":"general","version":1,"scale":"full"}: the head's metadata inertialnet.recipe.
+// {"name":"general","scale":"full","version":2}: the head's metadata inertialnet.recipe.
 std::string recipe_to_json(const TrainingRecipe& recipe);
 
 }  // namespace inertialnet
