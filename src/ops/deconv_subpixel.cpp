@@ -16,8 +16,11 @@ bool subpixel_eligible(const Shape& weight, int stride, int padding) {
 
 bool subpixel_preferred(const Shape& input, const Shape& weight, int stride, int padding) {
   if (input.size() != 4 || !subpixel_eligible(weight, stride, padding)) return false;
-  const std::int64_t h = input[2], w = input[3];
-  return h * w >= 20 * (h + w + 1);
+  // The phase weights (16·ci·co floats) against the input (ci·H·W): where the weights are the
+  // smaller, the direct form walks its A panels against a stretch of input rows and beat GEMM +
+  // col2im on every FlowNet2 layer (docs/performance.md); where they are the larger (deconv5,
+  // deconv4, deconv3 of FlowNetC/S/SD at 512×384) neither sub-pixel form did.
+  return 16 * weight[1] <= input[2] * input[3];
 }
 
 PackedPanels subpixel_weights(Queue& queue, const Tensor& weight, Device* long_lived) {
@@ -27,23 +30,88 @@ PackedPanels subpixel_weights(Queue& queue, const Tensor& weight, Device* long_l
   }
   const auto in_channels = static_cast<std::size_t>(weight.dim(0));
   const auto out_channels = static_cast<std::size_t>(weight.dim(1));
-  const std::size_t rows = 4 * out_channels, depth = 4 * in_channels;
+  // Each phase's rows padded to whole A panels, so that a panel belongs to one phase (the
+  // direct form runs the phases as separate products).
+  const int tile_rows = packed_gemm_tile_rows(out_channels, 0, packed_gemm_setting(queue.device(), "MR"));
+  const auto width = static_cast<std::size_t>(tile_rows);
+  const std::size_t phase_rows = (out_channels + width - 1) / width * width;
+  const std::size_t rows = 4 * phase_rows, depth = 4 * in_channels;
   const Tensor phases = Tensor::empty(queue, {static_cast<std::int64_t>(rows), static_cast<std::int64_t>(depth)});
   Kernel& kernel = queue.kernel("deconv_subpixel", "subpixel_weights");
-  kernel.set_args(weight, phases, static_cast<int>(in_channels), static_cast<int>(out_channels));
+  kernel.set_args(weight, phases, static_cast<int>(in_channels), static_cast<int>(out_channels),
+                  static_cast<int>(phase_rows));
   queue.launch(kernel, Range(depth, rows), Range(1, 1));
-  return pack_a(queue, Transpose::No, rows, depth, MatrixView::of(phases, depth), 0, long_lived);
+  return pack_a(queue, Transpose::No, rows, depth, MatrixView::of(phases, depth), tile_rows, long_lived);
+}
+
+namespace {
+
+// The phase weights' rows per phase (co padded to whole A panels), checked against the layer.
+std::size_t checked_phase_rows(const Tensor& input, const PackedPanels& weights, const Tensor& output) {
+  const auto in_channels = static_cast<std::size_t>(input.c());
+  const auto out_channels = static_cast<std::size_t>(output.c());
+  const auto tile_rows = static_cast<std::size_t>(weights.width);
+  const std::size_t phase_rows = (out_channels + tile_rows - 1) / tile_rows * tile_rows;
+  if (weights.lines != 4 * phase_rows || weights.depth != 4 * in_channels) {
+    throw invalid_input("conv_transpose2d: the sub-pixel weights are [" + std::to_string(weights.lines) + " × " +
+                        std::to_string(weights.depth) + "], the layer needs [" + std::to_string(4 * phase_rows) +
+                        " × " + std::to_string(4 * in_channels) + "]");
+  }
+  return phase_rows;
+}
+
+}  // namespace
+
+void conv_transpose2d_subpixel_direct(Queue& queue, const Tensor& input, const PackedPanels& weights,
+                                      const Tensor& bias, const Tensor& output,
+                                      const ConvTranspose2dOptions& options) {
+  const std::size_t phase_rows = checked_phase_rows(input, weights, output);
+  const int in_channels = static_cast<int>(input.c());
+  const int out_channels = static_cast<int>(output.c());
+  const int height = static_cast<int>(input.h()), width = static_cast<int>(input.w());
+  // A tile is 32 windows: SEG columns × 32 / SEG rows, SEG the narrowest of 8, 16, 32 that
+  // holds the row (so a narrow input still fills the tile's lanes).
+  const int seg = width <= 8 ? 8 : width <= 16 ? 16 : 32;
+  const int tile_rows = 32 / seg;
+  const int tiles = (width + seg - 1) / seg, row_tiles = (height + tile_rows - 1) / tile_rows;
+  // A tile's loads reach from bordered row a0 to a0 + tile_rows + 1 and column b0 to b0 + seg + 1.
+  const int padded_w = tiles * seg + 2, padded_h = row_tiles * tile_rows + 2;
+  const std::size_t padded_floats = static_cast<std::size_t>(in_channels) * padded_h * padded_w;
+  // Walk the input against one A panel where the weights outweigh the bordered input: the
+  // deep layers on small inputs then read their weights from memory once, not once per tile.
+  const bool tiles_first = weights.data.numel() > static_cast<std::int64_t>(padded_floats);
+  const Tensor padded = Tensor::empty(queue, {static_cast<std::int64_t>(padded_floats)});
+  Kernel& border = queue.kernel("deconv_subpixel", "subpixel_border");
+  const bool has_bias = bias.defined();
+  Kernel& kernel = queue.kernel("deconv_subpixel", "subpixel_direct",
+                                KernelDefines()
+                                    .add("MR", weights.width)
+                                    .add("SEG", seg)
+                                    .add("TILES_FIRST", tiles_first)
+                                    .add("HAS_BIAS", has_bias)
+                                    .add(activation_defines(options.activation)));
+  const auto phase_panels = phase_rows / static_cast<std::size_t>(weights.width);
+  const Range global = tiles_first ? Range(static_cast<std::size_t>(tiles), static_cast<std::size_t>(row_tiles), 4 * phase_panels)
+                                   : Range(4 * phase_panels, static_cast<std::size_t>(tiles), static_cast<std::size_t>(row_tiles));
+  for (std::int64_t n = 0; n < input.n(); ++n) {
+    const Tensor in_n = input.sample(n);
+    const Tensor out_n = output.sample(n);
+    border.set_args(in_n, padded, height, width, padded_h, padded_w);
+    queue.launch(border, Range(static_cast<std::size_t>(padded_w), static_cast<std::size_t>(padded_h),
+                               static_cast<std::size_t>(in_channels)));
+    // Without a bias the kernel never reads its bias argument; any valid buffer will do.
+    const Tensor bias_arg = has_bias ? bias : out_n;
+    kernel.set_args(weights.data, padded, out_n, bias_arg, in_channels, out_channels, static_cast<int>(phase_panels),
+                    height, width, padded_h, padded_w);
+    queue.launch(kernel, global, Range(1, 1, 1));
+  }
 }
 
 void conv_transpose2d_subpixel(Queue& queue, const Tensor& input, const PackedPanels& weights, const Tensor& bias,
                                const Tensor& output, const ConvTranspose2dOptions& options) {
   const auto in_channels = static_cast<std::size_t>(input.c());
   const auto out_channels = static_cast<std::size_t>(output.c());
-  if (weights.lines != 4 * out_channels || weights.depth != 4 * in_channels) {
-    throw invalid_input("conv_transpose2d: the sub-pixel weights are [" + std::to_string(weights.lines) + " × " +
-                        std::to_string(weights.depth) + "], the layer needs [" + std::to_string(4 * out_channels) +
-                        " × " + std::to_string(4 * in_channels) + "]");
-  }
+  const std::size_t phase_rows = checked_phase_rows(input, weights, output);
   const int height = static_cast<int>(input.h()), width = static_cast<int>(input.w());
   // Every 2×2 window of the input padded by one: (H+1)×(W+1), the phases' windows among them.
   const Im2colGeometry geometry{2, 2, 1, 1, height + 1, width + 1};
@@ -70,7 +138,7 @@ void conv_transpose2d_subpixel(Queue& queue, const Tensor& input, const PackedPa
       const std::size_t count = std::min(block, windows - first);
       const PackedPanels b = im2col_panels(queue, in_n, geometry, first, count, panels);
       kernel.set_args(weights.data, b.data, out_n, bias_arg, static_cast<int>(weights.lines), static_cast<int>(count),
-                      static_cast<int>(depth), static_cast<int>(out_channels), height, width,
+                      static_cast<int>(depth), static_cast<int>(out_channels), static_cast<int>(phase_rows), height, width,
                       static_cast<int>(first));
       queue.launch(kernel, Range(weights.panels(), b.panels()), Range(1, 1));
     }
