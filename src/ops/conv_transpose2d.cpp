@@ -76,7 +76,7 @@ void conv_transpose2d(Queue& queue, const Tensor& input, const Tensor& weight, c
     if (options.prepared && options.prepared->subpixel.data.defined()) subpixel = true;
     else if (options.prepared && options.prepared->packed.data.defined()) subpixel = false;
     else subpixel = detail::subpixel_preferred(input.shape(), weight.shape(), options.stride, options.padding);
-    direct = subpixel;  // the window-grid form only when forced: the direct one tied or won everywhere
+    direct = subpixel && detail::subpixel_direct_preferred(input.shape(), weight.shape());
   }
   if (subpixel) {
     detail::report_backend(queue, to_string(GemmBackend::Packed));

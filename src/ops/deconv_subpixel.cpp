@@ -14,13 +14,22 @@ bool subpixel_eligible(const Shape& weight, int stride, int padding) {
   return weight.size() == 4 && weight[2] == 4 && weight[3] == 4 && stride == 2 && padding == 1;
 }
 
+bool subpixel_direct_preferred(const Shape& input, const Shape& weight) {
+  if (input.size() != 4 || weight.size() != 4) return false;
+  // The direct form reads its B values from a zero-bordered copy of the input: one more pass over
+  // it, cheap while the input stays in the last-level cache (≤ 2 Mi floats, 8 MiB), and it walks
+  // its A panels against the input, which pays where the phase weights (16·ci·co floats) are no
+  // larger than the input (ci·H·W).
+  const std::int64_t pixels = input[2] * input[3];
+  return 16 * weight[1] <= pixels && input[1] * pixels <= (std::int64_t{2} << 20);
+}
+
 bool subpixel_preferred(const Shape& input, const Shape& weight, int stride, int padding) {
   if (input.size() != 4 || !subpixel_eligible(weight, stride, padding)) return false;
-  // The phase weights (16·ci·co floats) against the input (ci·H·W): where the weights are the
-  // smaller, the direct form walks its A panels against a stretch of input rows and beat GEMM +
-  // col2im on every FlowNet2 layer (docs/performance.md); where they are the larger (deconv5,
-  // deconv4, deconv3 of FlowNetC/S/SD at 512×384) neither sub-pixel form did.
-  return 16 * weight[1] <= input[2] * input[3];
+  if (subpixel_direct_preferred(input, weight)) return true;
+  // The window-grid form: where its border windows add at most 5 % (H·W ≥ 20·(H + W + 1)).
+  const std::int64_t h = input[2], w = input[3];
+  return h * w >= 20 * (h + w + 1);
 }
 
 PackedPanels subpixel_weights(Queue& queue, const Tensor& weight, Device* long_lived) {

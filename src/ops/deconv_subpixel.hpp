@@ -19,12 +19,17 @@ namespace inertialnet::detail {
 // sub-pixel form (kh = kw = 4, stride 2, padding 1).
 bool subpixel_eligible(const Shape& weight, int stride, int padding);
 
-// Whether an eligible layer on `input` [N, ci, H, W] runs the sub-pixel form (the direct one,
-// conv_transpose2d_subpixel_direct) by default: where its phase weights are no larger than the
-// input, 16·co ≤ H·W. Measured on FlowNet2 at 512×384 (docs/performance.md): the direct form
-// beats GEMM + col2im on deconv2, FlowNetFusion's deconv1/deconv0 and every upsampled_flow
-// layer; on the deep low-resolution layers (deconv5/deconv4/deconv3, weights 2–170 times their
-// input) it ties (6×8, 12×16) or loses (24×32), and so did the window-grid form.
+// Whether an eligible layer on `input` [N, ci, H, W] runs a sub-pixel form by default, and which.
+// Measured on FlowNet2 at 512×384 (docs/performance.md, both forms and GEMM + col2im per layer):
+// - the direct form (conv_transpose2d_subpixel_direct) where its phase weights are no larger
+//   than the input (16·co ≤ H·W) and the input fits the last-level cache (ci·H·W ≤ 2 Mi floats):
+//   every upsampled_flow layer (×0.45), FlowNetFusion's deconv1 (×0.92), deconv2 (even);
+// - else the window-grid form where its border windows add at most 5 % (H·W ≥ 20·(H + W + 1)):
+//   FlowNetFusion's deconv0 (192×256, ci = 162: the direct form's bordered copy of its 32 MB
+//   input cost more than it saved, ×1.1);
+// - else GEMM + col2im: the deep layers on small inputs (deconv5, deconv4, deconv3 of
+//   FlowNetC/S/SD), where both sub-pixel forms tied (6×8, 12×16) or lost (24×32).
+bool subpixel_direct_preferred(const Shape& input, const Shape& weight);
 bool subpixel_preferred(const Shape& input, const Shape& weight, int stride, int padding);
 
 // The [4·co × 4·ci] phase weights of W [ci, co, 4, 4] (each phase's co rows padded with zero

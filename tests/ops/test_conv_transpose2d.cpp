@@ -202,8 +202,9 @@ TEST(ConvTranspose2d, SubPixelDirectAtFlowNet2sRealSize) {
 }
 
 TEST(ConvTranspose2d, SubPixelIsTheDefaultOnlyWhereItMeasuredFaster) {
-  // FlowNet2 at 512×384: deconv5 (6×8) and deconv4 (12×16) tied, deconv3 (24×32) lost,
-  // deconv2 (48×64) and FlowNetFusion's layers (96×128, 192×256) won (docs/performance.md).
+  // FlowNet2 at 512×384: deconv5 (6×8), deconv4 (12×16) and deconv3 (24×32) stay on GEMM +
+  // col2im; deconv2 (48×64) and FlowNetFusion's layers (96×128, 192×256) run a sub-pixel form
+  // (docs/performance.md).
   const Shape weight{386, 64, 4, 4};
   EXPECT_FALSE(detail::subpixel_preferred({1, 386, 6, 8}, weight, 2, 1));
   EXPECT_FALSE(detail::subpixel_preferred({1, 386, 12, 16}, weight, 2, 1));
@@ -216,6 +217,14 @@ TEST(ConvTranspose2d, SubPixelIsTheDefaultOnlyWhereItMeasuredFaster) {
   EXPECT_FALSE(detail::subpixel_preferred({1, 770, 24, 32}, {770, 128, 4, 4}, 2, 1));
   EXPECT_FALSE(detail::subpixel_preferred({1, 1024, 6, 8}, {1024, 512, 4, 4}, 2, 1));
   EXPECT_TRUE(detail::subpixel_preferred({1, 162, 192, 256}, {162, 16, 4, 4}, 2, 1));
+  // Which form: the direct one on the upsampled_flow layers, deconv2 and FlowNetFusion's deconv1;
+  // the window grid on FlowNetFusion's deconv0, whose 162 × 192 × 256 input outgrows the cache.
+  EXPECT_TRUE(detail::subpixel_direct_preferred({1, 2, 6, 8}, {2, 2, 4, 4}));
+  EXPECT_TRUE(detail::subpixel_direct_preferred({1, 2, 192, 256}, {2, 2, 4, 4}));
+  EXPECT_TRUE(detail::subpixel_direct_preferred({1, 386, 48, 64}, {386, 64, 4, 4}));
+  EXPECT_TRUE(detail::subpixel_direct_preferred({1, 128, 96, 128}, {128, 32, 4, 4}));
+  EXPECT_FALSE(detail::subpixel_direct_preferred({1, 162, 192, 256}, {162, 16, 4, 4}));
+  EXPECT_FALSE(detail::subpixel_direct_preferred({1, 770, 24, 32}, {770, 128, 4, 4}));
   // Never where the layer has no sub-pixel form.
   EXPECT_FALSE(detail::subpixel_preferred({1, 386, 192, 256}, {386, 64, 3, 3}, 2, 1));
   EXPECT_FALSE(detail::subpixel_preferred({1, 386, 192, 256}, weight, 2, 0));

@@ -8,10 +8,10 @@
 // The columns are a pooled temporary of one sample's size.
 //
 // On the packed backends the 4×4 / stride 2 / padding 1 layers (every FlowNet up-convolution)
-// whose weights are no larger than their input run the sub-pixel decomposition instead: four
-// 2×2 convolutions, one per output phase, each a packed product over exactly its H·W windows
-// read straight from the input, stored into the interleaved output directly, with no column
-// matrix (src/ops/deconv_subpixel.hpp says when and why).
+// on inputs large enough run the sub-pixel decomposition instead: four 2×2 convolutions, one per
+// output phase, either as one packed GEMM over the (H+1)×(W+1) window grid or each over exactly
+// its H·W windows read straight from the input (the direct form), stored into the interleaved
+// output directly, with no column matrix (src/ops/deconv_subpixel.hpp says when and why).
 //
 // Input and output may be channel slices of larger tensors; they must not overlap.
 #pragma once
@@ -25,8 +25,9 @@
 
 namespace inertialnet {
 
-// How a layer runs: Default is the direct sub-pixel form on the packed backends where it has
-// that form and measured faster (16·co ≤ H·W, docs/performance.md), GEMM + col2im elsewhere; the others force one (tests). SubPixel (the window-grid GEMM) and SubPixelDirect
+// How a layer runs: Default is a sub-pixel form on the packed backends where the layer has that
+// form and it measured faster (detail::subpixel_preferred, docs/performance.md), GEMM + col2im
+// elsewhere; the others force one (tests). SubPixel (the window-grid GEMM) and SubPixelDirect
 // (each phase on its own windows, read from the input without im2col panels) on a layer
 // without that form are invalid_input; on the CLBlast backend they run the packed kernels.
 enum class DeconvAlgorithm { Default, Col2im, SubPixel, SubPixelDirect };
