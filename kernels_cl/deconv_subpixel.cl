@@ -160,10 +160,10 @@ inline void store_direct_row(__global float* out, const int out_offset, float16 
   store_direct_row(out, out_offset, lo##r, hi##r, c0 + r, channels, a0, b0, py, px, height, width, bias, bias_offset);
 
 // Work-groups of one work-item. Global size (A panels of the four phases, tiles across, tile
-// rows down) with -DTILES_FIRST=0, (tiles across, tile rows down, A panels) with 1: the first
+// rows down) with -DTILES_FIRST=0, (PANEL_BLOCK, tiles, A panel blocks) with 1: the first
 // walks the A panels against one stretch of input rows (large inputs, small weights), the
-// second the input against one A panel, which is then read from memory once (deep layers on
-// small inputs, whose weights are far larger than their input). A panels are phase-major,
+// second the input against a block of A panels, which is then read from memory once (deep
+// layers on small inputs, whose weights are far larger than their input). A panels are phase-major,
 // `phase_panels` of MR rows per phase (rows past co zero). The k loop runs i over ci and the
 // 2×2 taps (ty, tx), A's column i·4 + ty·2 + tx; B's values of a tap are the bordered input's
 // rows a0 + py + ty …, columns b0 + px + tx …: whole vectors, no packing.
@@ -174,7 +174,12 @@ __kernel void subpixel_direct(__global const float* restrict a_packed, const int
                               const int in_channels, const int channels, const int phase_panels,
                               const int height, const int width, const int padded_h, const int padded_w) {
 #if TILES_FIRST
-  const int panel = get_global_id(2), tile = get_global_id(0), tile_row = get_global_id(1);
+  // Blocks of PANEL_BLOCK A panels (kept in L2 together) walked against every tile: each tile's
+  // input rows serve the block's panels back to back, and the input is read once per block.
+  const int panel = get_global_id(2) * PANEL_BLOCK + get_global_id(0);
+  const int tile_index = get_global_id(1);
+  const int tiles_across = (width + SEG - 1) / SEG;
+  const int tile_row = tile_index / tiles_across, tile = tile_index - tile_row * tiles_across;
 #else
   const int panel = get_global_id(0), tile = get_global_id(1), tile_row = get_global_id(2);
 #endif

@@ -48,8 +48,8 @@ void conv_transpose2d_subpixel(Queue& queue, const Tensor& input, const PackedPa
 // zero-bordered copy of the input (no im2col panels), the products stored into their pixels.
 // A tile is 32 windows of one phase: 32 columns of a row, or 16 × 2 rows, or 8 × 4 rows, so
 // that the narrow inputs of the deep layers (6×8, 12×16) fill it. Where the phase weights
-// outweigh the input the tiles are walked against one A panel, so that the weights are read
-// from memory once (kernels_cl/deconv_subpixel.cl, subpixel_direct).
+// outweigh the input the tiles are walked against blocks of 4 A panels, so that the weights are
+// read from memory once (kernels_cl/deconv_subpixel.cl, subpixel_direct).
 void conv_transpose2d_subpixel_direct(Queue& queue, const Tensor& input, const PackedPanels& weights,
                                       const Tensor& bias, const Tensor& output,
                                       const ConvTranspose2dOptions& options);
