@@ -95,6 +95,9 @@ void conv_transpose2d_subpixel_direct(Queue& queue, const Tensor& input, const P
   // Walk the input against a block of A panels where the weights outweigh the bordered input:
   // the deep layers on small inputs then read their weights from memory once, not once per tile.
   const bool tiles_first = weights.data.numel() > static_cast<std::int64_t>(padded_floats);
+  const auto phase_panels = phase_rows / static_cast<std::size_t>(weights.width);
+  const std::size_t panels = 4 * phase_panels;
+  const std::size_t block = std::min<std::size_t>(kDirectPanelBlock, panels);
   const Tensor padded = Tensor::empty(queue, {static_cast<std::int64_t>(padded_floats)});
   Kernel& border = queue.kernel("deconv_subpixel", "subpixel_border");
   const bool has_bias = bias.defined();
@@ -103,12 +106,9 @@ void conv_transpose2d_subpixel_direct(Queue& queue, const Tensor& input, const P
                                     .add("MR", weights.width)
                                     .add("SEG", seg)
                                     .add("TILES_FIRST", tiles_first)
-                                    .add("PANEL_BLOCK", static_cast<int>(std::min<std::size_t>(kDirectPanelBlock, 4 * phase_rows / static_cast<std::size_t>(weights.width))))
+                                    .add("PANEL_BLOCK", static_cast<int>(block))
                                     .add("HAS_BIAS", has_bias)
                                     .add(activation_defines(options.activation)));
-  const auto phase_panels = phase_rows / static_cast<std::size_t>(weights.width);
-  const std::size_t panels = 4 * phase_panels;
-  const std::size_t block = std::min<std::size_t>(kDirectPanelBlock, panels);
   const Range global = tiles_first ? Range(block, static_cast<std::size_t>(tiles) * static_cast<std::size_t>(row_tiles),
                                            (panels + block - 1) / block)
                                    : Range(panels, static_cast<std::size_t>(tiles), static_cast<std::size_t>(row_tiles));
