@@ -61,24 +61,29 @@ void conv_transpose2d(Queue& queue, const Tensor& input, const Tensor& weight, c
 
   const GemmBackend backend = options.prepared ? options.prepared->backend : gemm_backend(queue.device().info());
   const bool eligible = detail::subpixel_eligible(weight.shape(), options.stride, options.padding);
-  if (options.algorithm == DeconvAlgorithm::SubPixel && !eligible) {
+  const bool forced_subpixel =
+      options.algorithm == DeconvAlgorithm::SubPixel || options.algorithm == DeconvAlgorithm::SubPixelDirect;
+  if (forced_subpixel && !eligible) {
     throw invalid_input("conv_transpose2d: the sub-pixel algorithm needs a 4×4 kernel, stride 2 and padding 1, got "
                         "weight " + to_string(weight.shape()) + ", stride " + std::to_string(options.stride) +
                         ", padding " + std::to_string(options.padding));
   }
-  bool subpixel = options.algorithm == DeconvAlgorithm::SubPixel;
+  bool subpixel = forced_subpixel;
+  bool direct = options.algorithm == DeconvAlgorithm::SubPixelDirect;
   if (options.algorithm == DeconvAlgorithm::Default && eligible && uses_packed_kernels(backend)) {
     // The form the layer's weights were prepared in, else the choice by shape (a weight set
     // prepared for another frame size keeps its form rather than packing on every call).
     if (options.prepared && options.prepared->subpixel.data.defined()) subpixel = true;
     else if (options.prepared && options.prepared->packed.data.defined()) subpixel = false;
     else subpixel = detail::subpixel_preferred(input.shape(), weight.shape(), options.stride, options.padding);
+    direct = subpixel && detail::subpixel_direct_preferred(input.shape(), weight.shape());
   }
   if (subpixel) {
     detail::report_backend(queue, to_string(GemmBackend::Packed));
     const bool prepared = options.prepared && options.prepared->subpixel.data.defined();
     const PackedPanels weights = prepared ? options.prepared->subpixel : detail::subpixel_weights(queue, weight, nullptr);
-    detail::conv_transpose2d_subpixel(queue, input, weights, bias, output, options);
+    if (direct) detail::conv_transpose2d_subpixel_direct(queue, input, weights, bias, output, options);
+    else detail::conv_transpose2d_subpixel(queue, input, weights, bias, output, options);
     return;
   }
 

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// conv_transpose2d (GEMM + gather col2im with fused bias/activation, and the sub-pixel form of
-// the 4×4 / stride 2 / padding 1 layers) against the scatter definition of tests/reference/conv.cpp:
+// conv_transpose2d (GEMM + gather col2im with fused bias/activation, and the two sub-pixel forms
+// of the 4×4 / stride 2 / padding 1 layers) against the scatter definition of tests/reference/conv.cpp:
 // every FlowNet2 up-convolution at a 64×64 input on each algorithm, other kernels/strides/paddings,
 // odd sizes, batches, channel slices, channel and window blocks, bad shapes.
 #include <algorithm>
@@ -84,6 +84,12 @@ TEST_P(FlowNetDeconvShapes, SubPixelMatchesTheReference) {
   expect_deconv_matches(GetParam(), p);
 }
 
+TEST_P(FlowNetDeconvShapes, SubPixelDirectMatchesTheReference) {
+  Placement p;
+  p.algorithm = DeconvAlgorithm::SubPixelDirect;
+  expect_deconv_matches(GetParam(), p);
+}
+
 TEST_P(FlowNetDeconvShapes, Col2imMatchesTheReference) {
   Placement p;
   p.algorithm = DeconvAlgorithm::Col2im;
@@ -157,15 +163,68 @@ TEST(ConvTranspose2d, SubPixelOnOddSizesSlicesAndWindowBlocks) {
                         {2, 1, 1, 2, 2, 4 * 5 * 32, sub});
 }
 
+TEST(ConvTranspose2d, SubPixelDirectOnOddSizesSlicesAndBothWalks) {
+  const auto direct = DeconvAlgorithm::SubPixelDirect;
+  // Widths around the tile shapes (8 × 4 rows up to 8, 16 × 2 rows up to 16, else rows of 32),
+  // heights that leave a partial group of tile rows, a batch.
+  for (const int w : {1, 7, 8, 9, 15, 16, 17, 31, 32, 33, 70}) {
+    expect_deconv_matches({"odd_w" + std::to_string(w), 5, 7, 11, w, 4, 2, 1, true, ActivationSpec::leaky_relu(0.1f)},
+                          {3, 0, 0, 0, 0, 0, direct});
+  }
+  expect_deconv_matches({"odd", 5, 7, 37, 23, 4, 2, 1, true, ActivationSpec::leaky_relu(0.1f)}, {3, 0, 0, 0, 0, 0, direct});
+  expect_deconv_matches({"single_pixel", 9, 3, 1, 1, 4, 2, 1, true, ActivationSpec::none()}, {3, 0, 0, 0, 0, 0, direct});
+  expect_deconv_matches({"one_row", 3, 13, 1, 41, 4, 2, 1, false, ActivationSpec::relu()}, {2, 0, 0, 0, 0, 0, direct});
+  expect_deconv_matches({"one_column", 3, 13, 19, 1, 4, 2, 1, false, ActivationSpec::relu()}, {2, 0, 0, 0, 0, 0, direct});
+  // FlowNet's upsample_flow: 2 channels in, 2 out (tiles of 2 rows), no bias, into the last
+  // channels of a concat; a slice read from and written into the middle of wider tensors.
+  expect_deconv_matches({"flow_up_slice", 2, 2, 9, 11, 4, 2, 1, false, ActivationSpec::none()}, {3, 1, 0, 9, 0, 0, direct});
+  expect_deconv_matches({"slice", 6, 10, 37, 23, 4, 2, 1, true, ActivationSpec::leaky_relu(0.1f)}, {3, 2, 3, 5, 4, 0, direct});
+  // Weights larger than the bordered input: the tiles are walked against one A panel (the deep
+  // layers' order), co not a multiple of the panel rows, widths of each tile shape.
+  for (const int w : {5, 13, 35}) {
+    expect_deconv_matches({"deep_w" + std::to_string(w), 70, 21, 3, w, 4, 2, 1, true, ActivationSpec::leaky_relu(0.1f)},
+                          {2, 0, 0, 0, 0, 0, direct});
+  }
+}
+
+// The direct form on FlowNet2's deep up-convolutions at their real size for a 512×384 input
+// (6×8, 12×16 and 24×32 inputs: every tile shape, tiles walked against one A panel) against the
+// reference.
+TEST(ConvTranspose2d, SubPixelDirectAtFlowNet2sRealSize) {
+  Placement p;
+  p.algorithm = DeconvAlgorithm::SubPixelDirect;
+  for (const auto& layer : flownet_layers::flownet2_layers(384, 512, flownet_layers::LayerKind::Deconv)) {
+    // deconv2 and FlowNetFusion's (48×64 and up) are left to the 64×64 cases: the scalar
+    // reference would take minutes, and they use no tile shape that the cases above do not.
+    if (layer.h > 24) continue;
+    expect_deconv_matches(from_layer(layer), p);
+  }
+}
+
 TEST(ConvTranspose2d, SubPixelIsTheDefaultOnlyWhereItMeasuredFaster) {
-  // FlowNet2 at 512×384: deconv5 (6×8) and deconv4 (12×16) lost, deconv3 (24×32) was even,
-  // deconv2 (48×64) and FlowNetFusion's layers (96×128, 192×256) won (docs/performance.md).
+  // FlowNet2 at 512×384: deconv5 (6×8), deconv4 (12×16) and deconv3 (24×32) stay on GEMM +
+  // col2im; deconv2 (48×64) and FlowNetFusion's layers (96×128, 192×256) run a sub-pixel form
+  // (docs/performance.md).
   const Shape weight{386, 64, 4, 4};
   EXPECT_FALSE(detail::subpixel_preferred({1, 386, 6, 8}, weight, 2, 1));
   EXPECT_FALSE(detail::subpixel_preferred({1, 386, 12, 16}, weight, 2, 1));
   EXPECT_FALSE(detail::subpixel_preferred({1, 386, 24, 32}, weight, 2, 1));
   EXPECT_TRUE(detail::subpixel_preferred({1, 386, 48, 64}, weight, 2, 1));
   EXPECT_TRUE(detail::subpixel_preferred({1, 386, 192, 256}, weight, 2, 1));
+  // FlowNet's upsampled_flow layers (2 → 2 channels) at every size; the deep layers never.
+  EXPECT_TRUE(detail::subpixel_preferred({1, 2, 6, 8}, {2, 2, 4, 4}, 2, 1));
+  EXPECT_TRUE(detail::subpixel_preferred({1, 2, 96, 128}, {2, 2, 4, 4}, 2, 1));
+  EXPECT_FALSE(detail::subpixel_preferred({1, 770, 24, 32}, {770, 128, 4, 4}, 2, 1));
+  EXPECT_FALSE(detail::subpixel_preferred({1, 1024, 6, 8}, {1024, 512, 4, 4}, 2, 1));
+  EXPECT_TRUE(detail::subpixel_preferred({1, 162, 192, 256}, {162, 16, 4, 4}, 2, 1));
+  // Which form: the direct one on the upsampled_flow layers, deconv2 and FlowNetFusion's deconv1;
+  // the window grid on FlowNetFusion's deconv0, whose 162 × 192 × 256 input outgrows the cache.
+  EXPECT_TRUE(detail::subpixel_direct_preferred({1, 2, 6, 8}, {2, 2, 4, 4}));
+  EXPECT_TRUE(detail::subpixel_direct_preferred({1, 2, 192, 256}, {2, 2, 4, 4}));
+  EXPECT_TRUE(detail::subpixel_direct_preferred({1, 386, 48, 64}, {386, 64, 4, 4}));
+  EXPECT_TRUE(detail::subpixel_direct_preferred({1, 128, 96, 128}, {128, 32, 4, 4}));
+  EXPECT_FALSE(detail::subpixel_direct_preferred({1, 162, 192, 256}, {162, 16, 4, 4}));
+  EXPECT_FALSE(detail::subpixel_direct_preferred({1, 770, 24, 32}, {770, 128, 4, 4}));
   // Never where the layer has no sub-pixel form.
   EXPECT_FALSE(detail::subpixel_preferred({1, 386, 192, 256}, {386, 64, 3, 3}, 2, 1));
   EXPECT_FALSE(detail::subpixel_preferred({1, 386, 192, 256}, weight, 2, 0));

@@ -14,7 +14,9 @@ environment (see README.md here for how to create it).
         [--device gpu --torch-device cuda] [--plan packed,winograd]
 
 With several `--plan`s, each round runs ours once per plan before PyTorch, and each plan gets its
-own row and ratio. Every round line carries the 1-minute load average read before it.
+own row and ratio. Every round line carries the 1-minute load average read before it, and a
+warning where a run's figures cannot be its plan's (no layer of its profile on that plan, or the
+same figures as another plan's run of the round).
 """
 
 from __future__ import annotations
@@ -36,6 +38,22 @@ def run_json(command: list[str], env: dict) -> dict:
         sys.stderr.write(done.stderr)
         raise SystemExit(f"compare: {' '.join(command)} failed with exit code {done.returncode}")
     return json.loads(done.stdout)
+
+
+def plan_check(plan: str, ours: dict, others: list) -> str:
+    """A note for the round line when a run's figures cannot be that plan's: a plan named with
+    --plan that no layer of the profiled pair ran on, or figures equal to another plan's run of
+    the same round to the microsecond (two runs of different plans never give those)."""
+    notes = []
+    if plan and plan != "auto":
+        backends = sorted({b for kind in ours.get("profile", {}).get("kinds", []) for b in kind.get("backends", []) if b})
+        if backends and plan not in backends:
+            notes.append(f"no layer ran on plan {plan} (the profile shows {', '.join(backends)})")
+    figures = (ours["stages"]["flow"], ours["seconds_per_pair"])
+    for other_plan, other in others:
+        if (other["stages"]["flow"], other["seconds_per_pair"]) == figures:
+            notes.append(f"figures identical to --plan {other_plan or 'default'}'s run: suspect")
+    return "; ".join(notes)
 
 
 def main() -> int:
@@ -83,20 +101,22 @@ def main() -> int:
             for plan in plans:
                 load = os.getloadavg()[0]
                 ours = run_json(ours_command + ["--model", model] + (["--plan", plan] if plan else []), env)["results"][0]
-                ours_runs.append((plan, load, ours))
+                ours_runs.append((plan, load, ours, plan_check(plan, ours, [(p, o) for p, _, o, _ in ours_runs])))
             load = os.getloadavg()[0]
             torch_run = run_json(torch_command + ["--model", model], env)
             torch_version, torch_device = torch_run["torch"], torch_run["torch_device"]
-            for plan, ours_load, ours in ours_runs:
+            for plan, ours_load, ours, note in ours_runs:
                 device = ours["device"]
                 run = runs[(model, plan)]
                 run["ours"].append(ours["stages"]["flow"])
                 run["ours_total"].append(ours["seconds_per_pair"])
                 run["torch"].append(torch_run["seconds_per_pair"])
                 run["load"].append([ours_load, load])
+                run.setdefault("notes", []).append(note)
                 print(f"round {round_index + 1} {model}{' --plan ' + plan if plan else ''}: ours {ours['stages']['flow']:.3f} s/pair "
                       f"(with upload, head, download {ours['seconds_per_pair']:.3f}, load {ours_load:.1f}), "
-                      f"PyTorch {torch_run['seconds_per_pair']:.3f} s/pair (load {load:.1f})", file=sys.stderr)
+                      f"PyTorch {torch_run['seconds_per_pair']:.3f} s/pair (load {load:.1f})"
+                      + (f" WARNING: {note}" if note else ""), file=sys.stderr)
 
     summary = []
     for (model, plan), run in runs.items():

@@ -8,9 +8,10 @@
 // The columns are a pooled temporary of one sample's size.
 //
 // On the packed backends the 4×4 / stride 2 / padding 1 layers (every FlowNet up-convolution)
-// on inputs large enough run the sub-pixel decomposition instead: four 2×2 convolutions in one
-// packed GEMM whose store writes the interleaved output directly, with no column matrix
-// (src/ops/deconv_subpixel.hpp says when and why).
+// on inputs large enough run the sub-pixel decomposition instead: four 2×2 convolutions, one per
+// output phase, either as one packed GEMM over the (H+1)×(W+1) window grid or each over exactly
+// its H·W windows read straight from the input (the direct form), stored into the interleaved
+// output directly, with no column matrix (src/ops/deconv_subpixel.hpp says when and why).
 //
 // Input and output may be channel slices of larger tensors; they must not overlap.
 #pragma once
@@ -24,11 +25,12 @@
 
 namespace inertialnet {
 
-// How a layer runs: Default is the sub-pixel form on the packed backends where it has that form
-// and measured faster (inputs of at least about 48×64, docs/performance.md), GEMM + col2im
-// elsewhere; the others force one (tests). SubPixel on a layer without that form is invalid_input; on
-// the CLBlast backend it runs the packed kernels.
-enum class DeconvAlgorithm { Default, Col2im, SubPixel };
+// How a layer runs: Default is a sub-pixel form on the packed backends where the layer has that
+// form and it measured faster (detail::subpixel_preferred, docs/performance.md), GEMM + col2im
+// elsewhere; the others force one (tests). SubPixel (the window-grid GEMM) and SubPixelDirect
+// (each phase on its own windows, read from the input without im2col panels) on a layer
+// without that form are invalid_input; on the CLBlast backend they run the packed kernels.
+enum class DeconvAlgorithm { Default, Col2im, SubPixel, SubPixelDirect };
 
 struct ConvTranspose2dOptions {
   int stride = 2;
