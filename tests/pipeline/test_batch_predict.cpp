@@ -39,7 +39,7 @@ TEST(BatchPredict, RefusesTwoSequencesOfOneNameAndLiveSources) {
 }
 
 // The provenance records the flow a weight-free run resolves to (default_flow), not the empty
-// setting: a rates file written under one default must not count as current under another.
+// setting: a rates file written when "" meant DIS must not count as current once "" means LK.
 TEST(BatchPredict, ProvenanceNamesTheWeightFreeFlowPredictRuns) {
   const fs::path root = fs::temp_directory_path() / "inertialnet_test_batch_provenance";
   fs::remove_all(root);
@@ -52,8 +52,8 @@ TEST(BatchPredict, ProvenanceNamesTheWeightFreeFlowPredictRuns) {
   };
   PredictSettings settings;
   settings.sequence = root / "seq";
-  EXPECT_EQ(flow_of(prediction_provenance(settings, 0)), "dis");
-  settings.readout_time_s = 0.03;  // the row-linear model: DIS too
+  EXPECT_EQ(flow_of(prediction_provenance(settings, 0)), "lk");
+  settings.readout_time_s = 0.03;  // the row-linear model: DIS
   EXPECT_EQ(flow_of(prediction_provenance(settings, 0)), "dis");
   settings.flow = "lk";  // given: as it is
   EXPECT_EQ(flow_of(prediction_provenance(settings, 0)), "lk");
