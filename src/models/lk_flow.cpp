@@ -54,6 +54,13 @@ std::string size_of(const HostImage& image) { return std::to_string(image.width)
 
 }  // namespace
 
+std::string to_string(const LkFlowOptions& o) {
+  std::ostringstream text;
+  text << "window " << o.window << ", levels " << o.levels << ", iterations " << o.iterations << ", epsilon "
+       << o.epsilon << ", min eigenvalue " << o.min_eigenvalue << ", smoothing " << o.smoothing << " px at 752 columns";
+  return text.str();
+}
+
 double lk_smoothing_px(double smoothing_at_752_columns, int width) { return smoothing_at_752_columns * width / 752.0; }
 
 int lk_grid_stride(int width) { return std::max(2, static_cast<int>(std::lround(8.0 * width / 752.0))); }

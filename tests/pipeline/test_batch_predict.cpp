@@ -57,5 +57,16 @@ TEST(BatchPredict, ProvenanceNamesTheWeightFreeFlowPredictRuns) {
   EXPECT_EQ(flow_of(prediction_provenance(settings, 0)), "dis");
   settings.flow = "lk";  // given: as it is
   EXPECT_EQ(flow_of(prediction_provenance(settings, 0)), "lk");
+  // LK's settings too (issue 24: a file from LK before its smoothing is not current); none for DIS.
+  const auto lk_of = [](const Provenance& provenance) {
+    for (const auto& entry : provenance) {
+      if (entry.first == "lk_flow") return entry.second;
+    }
+    return std::string("(absent)");
+  };
+  EXPECT_NE(lk_of(prediction_provenance(settings, 0)).find("smoothing 1 px at 752 columns"), std::string::npos)
+      << lk_of(prediction_provenance(settings, 0));
+  settings.flow = "dis";
+  EXPECT_EQ(lk_of(prediction_provenance(settings, 0)), "(absent)");
   fs::remove_all(root);
 }

@@ -10,6 +10,8 @@
 // this one class.
 #pragma once
 
+#include <string>
+
 #include "inertialnet/io/flow_io.hpp"
 #include "inertialnet/io/image_io.hpp"
 
@@ -42,6 +44,10 @@ struct LkFlowOptions {
   // (docs/real_cameras.md, "Lucas–Kanade with pre-smoothing").
   double smoothing = 1.0;
 };
+
+// The settings as one line ("window 9, levels 3, …"): a batch's provenance records those of the
+// LK it ran, so that rates from other settings (before the smoothing, say) are computed again.
+std::string to_string(const LkFlowOptions& options);
 
 // The standard deviation in pixels of LkFlowOptions::smoothing for a frame `width` pixels wide.
 double lk_smoothing_px(double smoothing_at_752_columns, int width);
