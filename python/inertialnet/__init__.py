@@ -174,8 +174,8 @@ def predict(sequence: SequenceLike, weights: Weights = (), *, options: PredictOp
     why the pair has no answer, e.g. ``"no_texture"``; its rates are then NaN), and what the CLI's
     rates CSV states: ``.estimator``, ``.frame``, ``.time_offset_s``, ``.readout_time_s``. With
     ``head="both"`` the geometric head's columns follow (``rates["wx_geometric"]``,
-    ``rates.head("geometric")``). The arguments are the CLI's options: without weights, DIS flow
-    and the geometric head; ``camera`` is ``--camera`` (a EuRoC sequence's cam0 or cam1);
+    ``rates.head("geometric")``). The arguments are the CLI's options: without weights, sparse
+    Lucas–Kanade flow (DIS with ``readout_time``) and the geometric head; ``camera`` is ``--camera`` (a EuRoC sequence's cam0 or cam1);
     ``calibration`` is ``--calibration`` (EuRoC sensor.yaml, Kalibr camchain, OpenCV YAML/XML;
     ``calibration_camera`` picks a camchain's camera) and ``fx``, ``fy``, ``cx``, ``cy`` are
     ``--fx`` … (None: not given; ``cx=0`` is a principal point at the corner);
@@ -184,8 +184,8 @@ def predict(sequence: SequenceLike, weights: Weights = (), *, options: PredictOp
     ``time_offset`` and ``readout_time`` are ``--time-offset`` and ``--readout-time`` (seconds;
     stated in the rates for :func:`evaluate`, the readout time also corrects the geometric head);
     ``flow`` is ``--flow``: ``"flownet2"``, ``"dis"`` or ``"lk"`` (sparse Lucas–Kanade at the
-    geometric head's sample points, for the geometric head only; None: flownet2 with weights, dis
-    without). ``flow_check`` is ``--flow-check`` (the DIS or LK forward-backward check for the
+    geometric head's sample points, for the geometric head only; None: flownet2 with weights, lk
+    without, dis without weights when ``readout_time`` is given). ``flow_check`` is ``--flow-check`` (the DIS or LK forward-backward check for the
     geometric head, pixels at 752 columns; 0: off). ``max_sigma`` is ``--max-sigma`` (deg/s: a geometric rate whose standard deviation
     along its least certain direction exceeds it gets the status ``"uncertain"``; 0: no limit) and
     ``smooth`` is ``--smooth`` (``"lag:2"``, the default: a fixed-lag smoother over the pairs using

@@ -45,7 +45,7 @@ def test_predict_flow_lk_matches_the_cli(cli, sequence, tmp_path):
 
 
 def test_dis_flow_and_geometric_head_step_by_step_match_the_cli(cli, sequence, tmp_path):
-    # pair by pair: the two-frame rates; DIS named (the dis_flow loop above is DIS whatever the default)
+    # pair by pair: the two-frame rates; DIS named (the weight-free default is Lucas-Kanade)
     _, expected = cli_rates(cli, sequence, tmp_path, "--smooth", "off", "--flow", "dis")
     seq = inertialnet.Sequence(sequence)
     camera, to_body, t = seq.camera, seq.camera_to_body, seq.timestamps_ns

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "inertialnet/io/live_source.hpp"
+#include "inertialnet/models/lk_flow.hpp"
 #include "inertialnet/pipeline/rate_settings.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/runtime/version.hpp"
@@ -177,6 +178,9 @@ Provenance prediction_provenance(const PredictSettings& s, std::size_t max_pairs
   for (auto& entry : p) {
     if (entry.first == "flow") entry.second = default_flow(s);
   }
+  // LK's own settings are no user setting but changed (issue 24: the smoothing): a file from
+  // another LK is not current. A file without this entry (from before it) is computed again.
+  if (default_flow(s) == "lk") p.emplace_back("lk_flow", to_string(LkFlowOptions{}));
   p.emplace_back("max_pairs", std::to_string(max_pairs));
   return p;
 }

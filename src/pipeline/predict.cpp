@@ -194,12 +194,14 @@ CameraChoice choose_camera(const PredictSettings& s, FrameSource& source, std::v
 
 }  // namespace
 
-// DIS, not LK, without weights: LK lost to DIS on a real rolling-shutter phone whose readout is
-// not given (y 1.17 → 1.86 deg/s; docs/real_cameras.md, "The weight-free default") and at 752×480
-// close range with one; LK is `--flow lk`, the real-time choice for global-shutter cameras.
+// LK without weights (issue 24: the real-time path). With a rolling-shutter readout given, LK
+// lost to DIS at 752×480 close range (x up to 2.3× DIS's RMSE), so DIS stays the default there.
+// LK on raw pixels also lost on a real phone recorded without a readout (y 1.17 → 1.86 deg/s);
+// its pre-smoothing (LkFlowOptions::smoothing) fixed that (docs/real_cameras.md, "Lucas–Kanade
+// with pre-smoothing").
 std::string default_flow(const PredictSettings& s) {
   if (!s.flow.empty() || !s.weights.empty()) return s.flow;
-  return "dis";
+  return s.readout_time_s > 0 ? "dis" : "lk";
 }
 
 Prediction::Prediction(const PredictSettings& s) : settings_(s) {
@@ -215,7 +217,7 @@ Prediction::Prediction(const PredictSettings& s) : settings_(s) {
   if (!have_weights && (processor_.flow == FlowMethod::FlowNet || processor_.inertialnet_head)) {
     throw invalid_input(std::string("--flow flownet2 and --head inertialnet need weights: --weights FILE with the "
                                     "FlowNet2 and InertialNet head tensors (safetensors). ") + kNoWeightsHelp +
-                        ". Without weights, predict runs DIS (or --flow lk) flow + the geometric head.");
+                        ". Without weights, predict runs Lucas-Kanade (or DIS) flow + the geometric head.");
   }
   // A trained head says which flow it learned from and how its input is scaled (its metadata
   // "inertialnet.head_input"; none: the paper's convention): that flow is the default, another one

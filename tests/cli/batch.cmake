@@ -45,6 +45,8 @@ endforeach()
 file(READ "${WORK}/out/s1.csv.json" sidecar)
 expect_json("${sidecar}" provenance inputs)
 expect_json("${sidecar}" provenance flow_check_px)
+# Weight-free, the default LK: its own settings too (issue 24; a file from LK before its smoothing is stale).
+expect_json("${sidecar}" provenance lk_flow)
 fingerprint(first s1)
 
 # 2. Fixed and rerun: only the remaining two are computed; the first is left as it was.

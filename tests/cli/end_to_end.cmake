@@ -79,9 +79,9 @@ expect_match("head.fc1 +linear")
 run(2 ${CLI} predict seq --head inertialnet)
 expect_match("need weights")
 
-# Without weights: DIS flow + the geometric head, said in one line; both heads side by side.
+# Without weights: Lucas-Kanade flow + the geometric head, said in one line; both heads side by side.
 run(0 ${CLI} predict seq -o geometric.csv)
-expect_match("no weights given: weight-free DIS optical flow \\+ geometric head")
+expect_match("no weights given: weight-free Lucas-Kanade optical flow \\+ geometric head")
 run(0 ${CLI} eval geometric.csv seq)
 expect_match("frames evaluated: 5")
 # Synthetic FlowNet2-C weights give a flow no rotation explains: the geometric head's σ says so

@@ -35,10 +35,11 @@ run(0 ${CLI} predict rotation --flow lk --max-pairs 1 -o one.csv)
 expect_match("no weights given: weight-free Lucas-Kanade optical flow \\+ geometric head")
 expect_match("Lucas-Kanade flow \\+ geometric head")
 
-# The default without weights: DIS, with or without a readout (LK lost on a real rolling-shutter
-# phone; docs/real_cameras.md, "The weight-free default"). An explicit --flow wins either way.
+# The default without weights: LK; DIS where a rolling-shutter readout is given (the row-linear
+# model wants DIS's denser field; docs/real_cameras.md, "DIS or Lucas-Kanade"). An explicit
+# --flow wins either way.
 run(0 ${CLI} predict rotation --max-pairs 1 -o default.csv)
-expect_match("no weights given: weight-free DIS optical flow \\+ geometric head")
+expect_match("no weights given: weight-free Lucas-Kanade optical flow \\+ geometric head")
 run(0 ${CLI} predict rotation --readout-time 0.02 --max-pairs 1 -o default_rs.csv)
 expect_match("no weights given: weight-free DIS optical flow \\+ geometric head")
 run(0 ${CLI} predict rotation --readout-time 0.02 --flow lk --max-pairs 1 -o lk_rs.csv)

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <string>
 #include <utility>
 
 #include "inertialnet/ops/motion_field.hpp"
@@ -205,6 +206,80 @@ TEST(LkFlow, RefusesFramesAndSettingsItCannotUse) {
   EXPECT_EQ(lk_grid_stride(752), 8);
   EXPECT_EQ(lk_grid_stride(376), 4);
   EXPECT_EQ(lk_grid_stride(40), 2);
+}
+
+// Issue 24: on a real phone recording (JPEG, sensor noise) LK on raw pixels lost more than half of
+// its points to the forward-backward check and its rates were worse than DIS's; the smoothing
+// (LkFlowOptions::smoothing, σ 1 px at 752 columns) is what fixed it. Here at about EuRoC's size: a
+// known translation of the texture under independent per-pixel noise (±12 grey levels, the same
+// in every run), tracked with and without it.
+TEST(LkFlow, SmoothingKeepsPixelNoiseOutOfTheTrack) {
+  const int w = 753, h = 479, stride = lk_grid_stride(w);  // odd sizes: σ 1.001 px, stride 8
+  const double du = 2.3, dv = -1.6;
+  const auto noisy = [](double value, int x, int y, int frame_index) {
+    const double n = lattice(x + 7919LL * frame_index, y - 104729LL * frame_index) - 0.5;  // uniform in ±0.5
+    return static_cast<float>(std::clamp(value + 24 * n, 0.0, 255.0));
+  };
+  const HostImage first = frame(w, h, [&](double x, double y) {
+    return noisy(texture(x, y), static_cast<int>(x), static_cast<int>(y), 1);
+  });
+  const HostImage second = frame(w, h, [&](double x, double y) {
+    return noisy(texture(x - du, y - dv), static_cast<int>(x), static_cast<int>(y), 2);
+  });
+  struct Track {
+    int known = 0, wrong = 0;  // kept, and kept but off by more than 0.5 px
+    double rms = 0;            // of the kept vectors that are not wrong
+  };
+  const auto track = [&](double smoothing) {
+    LkFlowOptions options;
+    options.smoothing = smoothing;
+    const FlowField flow = LkFlow(options).compute(first, second, stride, 0.5);
+    Track t;
+    double sum_sq = 0;
+    for (std::size_t i = 0; i < flow.u.size(); ++i) {
+      if (is_unknown_flow(flow.u[i], flow.v[i])) continue;
+      ++t.known;
+      const double e2 = std::pow(flow.u[i] - du, 2) + std::pow(flow.v[i] - dv, 2);
+      if (e2 > 0.25) {
+        ++t.wrong;
+      } else {
+        sum_sq += e2;
+      }
+    }
+    t.rms = std::sqrt(sum_sq / std::max(t.known - t.wrong, 1));
+    return t;
+  };
+  const Track raw = track(0), smoothed = track(LkFlowOptions{}.smoothing);
+  const int points = SampleGrid::of(w, h, stride).count();
+  std::printf("[ lk flow  ] noise: raw %d of %d kept, %d wrong, RMS %.3f px; smoothed %d kept, %d wrong, RMS %.3f px\n",
+              raw.known, points, raw.wrong, raw.rms, smoothed.known, smoothed.wrong, smoothed.rms);
+  // Measured: raw 5558 kept of 5640, 134 of them off by more than 0.5 px, the rest 0.184 px RMS;
+  // smoothed 5536 kept, 70 off, 0.172 px. The noise passes the round trip alike in both
+  // directions, so the check alone cannot remove what the smoothing does.
+  EXPECT_EQ(LkFlowOptions{}.smoothing, 1.0);
+  EXPECT_LT(3 * smoothed.wrong, 2 * raw.wrong) << "wrong vectors kept: smoothed " << smoothed.wrong << ", raw " << raw.wrong;
+  EXPECT_LT(smoothed.rms, raw.rms);
+  EXPECT_LT(smoothed.rms, 0.2) << "pixels, RMS";
+  EXPECT_GE(smoothed.known, points * 9 / 10);
+}
+
+TEST(LkFlow, RefusesASmoothingOutsideItsRangeNamingIt) {
+  for (const double bad : {-1.0, kLkMaxSmoothing + 1, std::nan(""), HUGE_VAL}) {
+    LkFlowOptions options;
+    options.smoothing = bad;
+    try {
+      LkFlow{options};
+      ADD_FAILURE() << "accepted smoothing " << bad;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("smoothing should be from 0 (off) to 8"), std::string::npos) << e.what();
+    }
+  }
+  LkFlowOptions off;
+  off.smoothing = 0;
+  EXPECT_NO_THROW(LkFlow{off});
+  // σ scales with the width like the grid's stride and the check's threshold.
+  EXPECT_DOUBLE_EQ(lk_smoothing_px(1.0, 752), 1.0);
+  EXPECT_DOUBLE_EQ(lk_smoothing_px(1.0, 376), 0.5);
 }
 
 }  // namespace

@@ -81,7 +81,7 @@ TEST(BatchPredict, SequencesWithTheirManifestLinesAndTheMissingOneNamed) {
 }
 
 // The provenance records the flow a weight-free run resolves to (default_flow), not the empty
-// setting: a rates file written under one default must not count as current under another.
+// setting: a rates file written when "" meant DIS must not count as current once "" means LK.
 TEST(BatchPredict, ProvenanceNamesTheWeightFreeFlowPredictRuns) {
   const fs::path root = fs::temp_directory_path() / "inertialnet_test_batch_provenance";
   fs::remove_all(root);
@@ -94,10 +94,21 @@ TEST(BatchPredict, ProvenanceNamesTheWeightFreeFlowPredictRuns) {
   };
   PredictSettings settings;
   settings.sequence = root / "seq";
-  EXPECT_EQ(flow_of(prediction_provenance(settings, 0)), "dis");
-  settings.readout_time_s = 0.03;  // the row-linear model: DIS too
+  EXPECT_EQ(flow_of(prediction_provenance(settings, 0)), "lk");
+  settings.readout_time_s = 0.03;  // the row-linear model: DIS
   EXPECT_EQ(flow_of(prediction_provenance(settings, 0)), "dis");
   settings.flow = "lk";  // given: as it is
   EXPECT_EQ(flow_of(prediction_provenance(settings, 0)), "lk");
+  // LK's settings too (issue 24: a file from LK before its smoothing is not current); none for DIS.
+  const auto lk_of = [](const Provenance& provenance) {
+    for (const auto& entry : provenance) {
+      if (entry.first == "lk_flow") return entry.second;
+    }
+    return std::string("(absent)");
+  };
+  EXPECT_NE(lk_of(prediction_provenance(settings, 0)).find("smoothing 1 px at 752 columns"), std::string::npos)
+      << lk_of(prediction_provenance(settings, 0));
+  settings.flow = "dis";
+  EXPECT_EQ(lk_of(prediction_provenance(settings, 0)), "(absent)");
   fs::remove_all(root);
 }

@@ -442,8 +442,9 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
                  "weights (safetensors) holding FlowNet2 and/or the InertialNet head; repeat for several files");
   app.add_option("--model", o->model, "flow network (default FlowNet2)")->transform(choice("model", flow_model_names()));
   app.add_option("--flow", o->flow,
-                 "flownet2 (default with weights), dis (OpenCV DIS; default without weights) or lk (sparse "
-                 "Lucas-Kanade at the geometric head's sample points, about 3x DIS's pairs/s; geometric head only)")
+                 "flownet2 (default with weights), dis (OpenCV DIS; default without weights when --readout-time is "
+                 "given) or lk (sparse Lucas-Kanade at the geometric head's sample points; geometric head only; "
+                 "default without weights otherwise)")
       ->transform(choice("flow method", {"flownet2", "dis", "lk"}));
   app.add_option("--head", o->head, "inertialnet (default with weights), geometric (default without), or both")
       ->transform(choice("head", {"inertialnet", "geometric", "both"}));

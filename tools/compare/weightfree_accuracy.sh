@@ -10,6 +10,8 @@
 #
 # METHODS: dis, lk, or `default` (no --flow). Sequences are kept in $WORK (default: a temporary
 # folder, removed at the end); CONDITIONS (space-separated names from the list below) picks some.
+# c752rsnr_*: the same rolling-shutter sequences as c752rs_*, predicted WITHOUT --readout-time (a
+# phone recording as users make it: the readout is not known), issue 24.
 set -euo pipefail
 build=${1:-build}
 shift || true
@@ -25,6 +27,9 @@ conditions=(
   "c752rs_s3|--motion close --readout-time 0.03 --exposure-time 0.01 --seed 3|--readout-time 0.03"
   "c752rs_s4|--motion close --readout-time 0.03 --exposure-time 0.01 --seed 4|--readout-time 0.03"
   "c752rs_s5|--motion close --readout-time 0.03 --exposure-time 0.01 --seed 5|--readout-time 0.03"
+  "c752rsnr_s3|--motion close --readout-time 0.03 --exposure-time 0.01 --seed 3|"
+  "c752rsnr_s4|--motion close --readout-time 0.03 --exposure-time 0.01 --seed 4|"
+  "c752rsnr_s5|--motion close --readout-time 0.03 --exposure-time 0.01 --seed 5|"
   "rot376|--size 376x240 --seed 3|"
   "gen376|--size 376x240 --motion general --seed 3|"
   "cblur376|--size 376x240 --motion close --exposure-time 0.01 --seed 3|"

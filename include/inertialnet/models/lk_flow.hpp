@@ -10,6 +10,8 @@
 // this one class.
 #pragma once
 
+#include <string>
+
 #include "inertialnet/io/flow_io.hpp"
 #include "inertialnet/io/image_io.hpp"
 
@@ -17,6 +19,9 @@ namespace inertialnet {
 
 // Smaller frames leave no pyramid level above the tracking window; the same bound as DIS's.
 constexpr int kLkMinimumSide = 16;
+
+// The largest LkFlowOptions::smoothing accepted, pixels at 752 columns.
+constexpr double kLkMaxSmoothing = 8;
 
 // The sample grid's stride the LK path uses for a frame `width` pixels wide: 8 pixels at EuRoC's
 // 752 columns, scaled with the width (at least 2), so that the grid has the same number of points
@@ -32,7 +37,20 @@ struct LkFlowOptions {
   // divided by the window's pixel count, intensities / 255) below this is not tracked: a
   // textureless window has no defined flow. OpenCV's default.
   double min_eigenvalue = 1e-4;
+  // Both frames' luminance is smoothed with a Gaussian of this standard deviation, in pixels at
+  // 752 columns (scaled with the width like the grid and the check), before the pyramids; 0: none.
+  // A 9×9 window on raw pixels follows sensor noise, JPEG blocks and aliased fine texture: on a
+  // real phone recording more than half of its points failed the forward-backward check
+  // (docs/real_cameras.md, "Lucas–Kanade with pre-smoothing").
+  double smoothing = 1.0;
 };
+
+// The settings as one line ("window 9, levels 3, …"): a batch's provenance records those of the
+// LK it ran, so that rates from other settings (before the smoothing, say) are computed again.
+std::string to_string(const LkFlowOptions& options);
+
+// The standard deviation in pixels of LkFlowOptions::smoothing for a frame `width` pixels wide.
+double lk_smoothing_px(double smoothing_at_752_columns, int width);
 
 class LkFlow {
  public:
@@ -48,7 +66,8 @@ class LkFlow {
   // Throws invalid_input when the frames differ in size, lack their three planes, are smaller than
   // kLkMinimumSide on a side, or for a stride below 1 or a negative or non-finite check setting.
   // Keeps no state between calls. The second frame is scaled to the first's mean luminance first
-  // (Lucas-Kanade assumes constant brightness; an exposure change would bias every vector).
+  // (Lucas-Kanade assumes constant brightness; an exposure change would bias every vector), then
+  // both are smoothed (LkFlowOptions::smoothing).
   FlowField compute(const HostImage& first, const HostImage& second, int stride, double px_at_752_columns,
                     int* rejected = nullptr) const;
 

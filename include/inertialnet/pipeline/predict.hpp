@@ -135,10 +135,11 @@ class Prediction {
 };
 
 // The flow method `settings` run with when `flow` is "": with weights, "" (FlowNet2, or the flow
-// the trained head's metadata names: known only from the weights); without, "dis" (LK is about
-// 3× faster and as accurate or better on most synthetic conditions, but lost on a real
-// rolling-shutter phone and at close range with a readout: docs/real_cameras.md). A given `flow`
-// is returned as it is; batches record the resolved one.
+// the trained head's metadata names: known only from the weights); without, "lk" (sparse
+// Lucas–Kanade on pre-smoothed frames, about 3× DIS's pairs/s and within 5 % of DIS or better on
+// the synthetic conditions of docs/real_cameras.md and on the real phone and GoPro recordings),
+// or "dis" where a readout time is given (the row-linear rolling-shutter model wants DIS's
+// denser field: LK lost there). A given `flow` is returned as it is; batches record the resolved one.
 std::string default_flow(const PredictSettings& settings);
 
 // One pair as a rates CSV row of Prediction::layout(): the first estimator's rates and status,
