@@ -3,7 +3,7 @@
 # The README's main command: set up, build, and run the main job on the bundled default — a
 # synthetic EuRoC-layout sequence with exact gyro ground truth (rendered on the first run into
 # data/synthetic-rotation/), angular rates for every frame pair, and the paper's metrics.
-# Without weights, predict uses DIS optical flow and the geometric head; pass weights with
+# Without weights, predict uses Lucas-Kanade flow and the geometric head; pass weights with
 #   bash tools/quickstart.sh --weights flownet2.safetensors --weights head.safetensors
 set -euo pipefail
 cd "$(dirname "$0")/.."

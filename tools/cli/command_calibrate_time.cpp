@@ -4,7 +4,7 @@
 // time offset and rotation correction (include/inertialnet/eval/time_offset.hpp,
 // rotation_fit.hpp) and, when it predicts the rates itself, the rolling-shutter readout time
 // (readout_fit.hpp), each with its uncertainty and a confidence rating. Without a rates file the
-// weight-free path (DIS flow + geometric head) predicts them first.
+// weight-free path (DIS flow by name + geometric head) predicts them first.
 // `inertialnet calibrate-time` is the same without the readout search (the command's first name;
 // its --json keeps the schema inertialnet.calibrate-time/1).
 #include <cmath>

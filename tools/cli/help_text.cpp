@@ -10,7 +10,7 @@ std::string help_examples(const std::string& subcommand) {
       {"",
        "  inertialnet devices                                  # which OpenCL devices there are\n"
        "  inertialnet synth data/seq --frames 40               # a synthetic EuRoC sequence\n"
-       "  inertialnet predict data/seq -o rates.csv            # weight-free: DIS flow + geometric head\n"
+       "  inertialnet predict data/seq -o rates.csv            # weight-free: LK flow + geometric head\n"
        "  inertialnet eval rates.csv data/seq --plot rates.png # the paper's metrics and plots\n"
        "  inertialnet predict --help                           # the options of one subcommand\n"},
       {"devices",
