@@ -150,7 +150,10 @@ class InertialNetHead:
         ``camera``, which it then needs). Every vector must be finite and known: NaN (what
         ``dis_flow(flow_check=…)`` and the flow readers give for unknown flow), infinity or a value
         above 1e9 is a ``ValueError`` naming the first such index. A paper head (``"paper"``)
-        ignores ``camera`` and ``dt``."""
+        ignores ``camera`` and ``dt``. The rates are in the frame ``config["frame"]`` names:
+        ``"camera"`` for a head trained on camera-frame targets (what ``train`` writes for the
+        normalized input; turn them with the rig's camera-to-IMU rotation for the gyro's frame, as
+        ``predict`` does), ``"body"`` for the IMU frame of the rig the head was trained on."""
         return self._head.rates(flow, float(dt) if dt is not None else 0.0,
                                 float(camera.fx) if camera is not None else 0.0,
                                 float(camera.fy) if camera is not None else 0.0)

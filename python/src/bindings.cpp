@@ -723,6 +723,9 @@ class PyInertialNetHead {
     d["input_height"] = c.input_height;
     d["input"] = to_string(input_.convention);  // "normalized" or "paper" (models/head_input.hpp)
     d["flow"] = input_.flow;                     // the flow it was trained on; "" when unknown
+    // The frame of its rates: "camera" (trained on camera-frame targets), or "body": the IMU frame
+    // of the rig it was trained on (models/head_input.hpp).
+    d["frame"] = input_.camera_frame ? "camera" : "body";
     d["members"] = 1 + static_cast<int>(members_.size());  // an ensemble's heads (models/head_ensemble.hpp)
     return d;
   }

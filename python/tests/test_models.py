@@ -105,6 +105,12 @@ def test_a_head_of_normalized_input_needs_camera_and_interval(cli, tmp_path):
     paper = inertialnet.InertialNetHead.load(paper_file)
     normalized = inertialnet.InertialNetHead.load(normalized_file)
     assert (normalized.config["input"], normalized.config["flow"]) == ("normalized", "dis")
+    # Written without "frame" (before heads learned camera-frame rates): its training rig's body frame.
+    assert paper.config["frame"] == "body" and normalized.config["frame"] == "body"
+    camera_file = tmp_path / "camera.safetensors"
+    with_metadata(paper_file, camera_file, "inertialnet.head_input",
+                  '{"convention":"normalized","flow":"dis","frame":"camera"}')
+    assert inertialnet.InertialNetHead.load(camera_file).config["frame"] == "camera"
     camera = inertialnet.Camera(64, 48, 40.0, 30.0, 31.5, 23.5)
     flow = np.full((48, 64, 2), (2.0, -1.2), np.float32)  # pixels at 64x48, 0.05 s apart
     # At 32x24 the vectors halve and so do the focal lengths: u/(fx·dt) = 2/(40·0.05) = 1.

@@ -31,6 +31,9 @@ constexpr const char* kStateBest = "inertialnet.train.best_rmse";
 // then told by its second moments, which only Adam fills).
 constexpr const char* kStateOptimizer = "inertialnet.train.optimizer";
 constexpr const char* kStateBestEpoch = "inertialnet.train.best_epoch";
+// The frame of the targets the state was trained on ("camera" or "body", train/training_set.hpp's
+// camera_frame_targets); a state without it was trained on body-frame targets (all were, before).
+constexpr const char* kStateTargetFrame = "inertialnet.train.target_frame";
 
 // A metadata number of a training state, whole and within [lo, hi]; otherwise invalid_input naming
 // the file, the key and the value (a state is a file the user hands us: never "stoi").
@@ -253,6 +256,16 @@ bool Trainer::train(const TrainingSet& train_set, const TrainingSet& val_set, co
                         std::to_string(options_.head.input_width) + "x" + std::to_string(options_.head.input_height));
   }
   if (train_set.size() == 0) throw invalid_input("training: the training set has no samples");
+  // A resumed state's moments and parameters point at rates in its own frame: continuing them on
+  // targets in the other frame would train a head that is neither, under this run's metadata.
+  const bool camera_frame = camera_frame_targets(train_set.input());
+  if (resumed_camera_frame_ && *resumed_camera_frame_ != camera_frame) {
+    const auto frame = [](bool camera) { return camera ? std::string("camera") : std::string("body"); };
+    throw invalid_input(resumed_from_ + " was trained on " + frame(*resumed_camera_frame_) +
+                        "-frame targets, this run's are " + frame(camera_frame) +
+                        "-frame (docs/training.md, \"The frame of a head's rates\"); start afresh without --resume");
+  }
+  target_camera_frame_ = camera_frame;
   const bool rotate = options_.rotation_augmentation_deg_s > 0;
   if (rotate) {
     for (std::size_t s = 0; s < train_set.size(); ++s) {
@@ -409,7 +422,8 @@ void Trainer::save_state(const std::filesystem::path& path) const {
                      {kStateSteps, std::to_string(steps_)},
                      {kStateBest, best},
                      {kStateBestEpoch, std::to_string(best_.epoch)},
-                     {kStateOptimizer, to_string(options_.optimizer)}});
+                     {kStateOptimizer, to_string(options_.optimizer)},
+                     {kStateTargetFrame, target_camera_frame_.value_or(resumed_camera_frame_.value_or(false)) ? "camera" : "body"}});
 }
 
 void Trainer::resume(const std::filesystem::path& path) {
@@ -476,9 +490,19 @@ void Trainer::resume(const std::filesystem::path& path) {
                         to_string(options_.optimizer) + ": their moments mean different things; resume with " +
                         saved + " or start afresh");
   }
+  bool camera_frame = false;  // a state without the key: body-frame targets, as every state before it
+  if (const auto it = meta.find(kStateTargetFrame); it != meta.end()) {
+    if (it->second != "camera" && it->second != "body") {
+      throw invalid_input(path.string() + ": the training state's " + std::string(kStateTargetFrame) + " is '" +
+                          it->second.substr(0, 40) + "', expected camera or body");
+    }
+    camera_frame = it->second == "camera";
+  }
   for (const auto& [prefix, group] : groups) {
     for (auto& [name, t] : *group) t = Tensor::from_host(*queue_, t.shape(), values.at(prefix + name));
   }
+  resumed_camera_frame_ = camera_frame;
+  resumed_from_ = path.string();
   epoch_ = epoch;
   steps_ = steps;
   best_rmse_ = best_rmse;

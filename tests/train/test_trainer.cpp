@@ -457,6 +457,7 @@ TEST(Trainer, ResumeChecksTheStateBeforeUsingIt) {
   edit_state(good, legacy, [](auto&, auto& meta) {
     meta.erase("inertialnet.train.optimizer");
     meta.erase("inertialnet.train.best_epoch");
+    meta.erase("inertialnet.train.target_frame");
   });
   testing::expect_invalid_input([&] { Trainer(testing::test_device(), sgd).resume(legacy); },
                                 "was trained with the optimizer adam, this run asks for sgd");
@@ -464,10 +465,22 @@ TEST(Trainer, ResumeChecksTheStateBeforeUsingIt) {
   resumed.resume(legacy);
   EXPECT_EQ(resumed.epochs_done(), 1);
   EXPECT_EQ(resumed.best().epoch, 0);  // the legacy state does not say which epoch was best
+  // A state without its target frame was trained on body-frame targets (every state before the
+  // frame was recorded); these sets are normalized, so camera-frame: refused, not mixed.
+  testing::expect_invalid_input([&] { resumed.train(*s.val, *s.val, {}); },
+                                "legacy.state.safetensors was trained on body-frame targets, this run's are "
+                                "camera-frame");
+  EXPECT_EQ(resumed.epochs_done(), 1);
+  const fs::path bad_frame = dir / "bad_frame.state.safetensors";
+  edit_state(good, bad_frame, [](auto&, auto& meta) { meta["inertialnet.train.target_frame"] = "world"; });
+  testing::expect_invalid_input([&] { Trainer(testing::test_device(), adam).resume(bad_frame); },
+                                "inertialnet.train.target_frame is 'world', expected camera or body");
   Trainer resumed_new(testing::test_device(), adam);
   resumed_new.resume(good);
   EXPECT_EQ(resumed_new.best().epoch, 1);
   EXPECT_FALSE(resumed_new.finished());
+  EXPECT_TRUE(resumed_new.train(*s.val, *s.val, {}));  // the same frame: it goes on
+  EXPECT_EQ(resumed_new.epochs_done(), 2);
   adam.epochs = 1;
   Trainer done(testing::test_device(), adam);
   done.resume(good);

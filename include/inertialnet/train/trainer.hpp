@@ -20,6 +20,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -134,7 +135,8 @@ class Trainer {
   // Parameters, optimiser state and progress; resume() reads it back (options must match). resume()
   // checks everything before it changes anything: the head configuration, every tensor's shape and
   // finiteness, the metadata numbers (invalid_input naming the file and key), and the optimiser
-  // (a state of SGD is not resumed as Adam, nor the reverse).
+  // (a state of SGD is not resumed as Adam, nor the reverse); train() then refuses a training set
+  // whose targets are in another frame than the state's (camera or body).
   void save_state(const std::filesystem::path& path) const;
   void resume(const std::filesystem::path& path);
 
@@ -154,6 +156,10 @@ class Trainer {
   int epoch_ = 0;
   double best_rmse_ = -1;
   EpochReport best_, last_;
+  // The frame of the targets: of the state resume() read (and its file), and of the set train()
+  // ran on; save_state() records it, train() refuses a set in the other frame than the state's.
+  std::optional<bool> resumed_camera_frame_, target_camera_frame_;
+  std::string resumed_from_;
   HeadBackprop& head_for(std::int64_t batch);
 };
 
