@@ -14,7 +14,7 @@ namespace {
 
 // Runs per product after the warm-up (median): one product of a few milliseconds moved by a
 // quarter between runs of bench with 3 (docs/performance.md, "The packed GEMM's reference").
-constexpr int kReferenceRuns = 5;
+constexpr int kReferenceRuns = 3;
 
 }  // namespace
 
