@@ -68,7 +68,7 @@ foreach(i RANGE ${last})
   endforeach()
   string(JSON kind GET "${out}" results 0 profile kinds ${i} kind)
   list(APPEND seen "${kind}")
-  # The kind's work and, for GEMM kinds, the packed GEMM's rate on its heaviest product beside it:
+  # The kind's work and, for GEMM kinds, the packed GEMM's rate on its products beside it:
   # present and finite (not timings: any positive rate passes).
   expect_field(results 0 profile kinds ${i} gflop)
   expect_finite("${value}" "kinds[${i}].gflop")
