@@ -38,6 +38,18 @@ __kernel void subpixel_weights(__global const float* restrict w, const int w_off
 
 #ifdef MR
 
+// A tile row's 32 values with the bias of its channel and the activation, into t (both stores).
+inline void finish_tile_row(float16 lo, float16 hi, const int c, __global const float* bias, const int bias_offset,
+                            float* t) {
+#if HAS_BIAS
+  const float b = bias[bias_offset + c];
+  lo += b;
+  hi += b;
+#endif
+  vstore16(ACTIVATE(lo), 0, t);
+  vstore16(ACTIVATE(hi), 0, t + 16);
+}
+
 // One row of a tile (phase·phase_rows + c) over windows [first, first + cols) of the (H+1)×(W+1) grid.
 inline void store_phase_row(__global float* out, const int out_offset, float16 lo, float16 hi, const int row,
                             const int m, const int channels, const int phase_rows, const int first, const int cols,
@@ -47,16 +59,8 @@ inline void store_phase_row(__global float* out, const int out_offset, float16 l
   const int c = row - phase * phase_rows;
   if (c >= channels) return;
   const int py = phase >> 1, px = phase & 1;
-#if HAS_BIAS
-  const float b = bias[bias_offset + c];
-  lo += b;
-  hi += b;
-#endif
-  lo = ACTIVATE(lo);
-  hi = ACTIVATE(hi);
   float t[32];
-  vstore16(lo, 0, t);
-  vstore16(hi, 0, t + 16);
+  finish_tile_row(lo, hi, c, bias, bias_offset, t);
   const int grid_w = width + 1;
   const int out_w = 2 * width;
   __global float* plane = out + out_offset + (size_t)c * (2 * height) * out_w;
@@ -95,22 +99,7 @@ __kernel void gemm_packed_subpixel(__global const float* restrict a_packed, cons
 #endif
 
 // ---- The direct form: each phase's own 2×2 windows over exactly H×W outputs, read straight
-// from a zero-bordered copy of the input (no im2col panels, no border windows, no column matrix).
-//
-// `subpixel_border` copies one [ci, H, W] sample into [ci, padded_h, padded_w] with zeros
-// around it: padded row y + 1 holds input row y, padded column x + 1 input column x; padded_h and
-// padded_w cover the tiles' widest reach, so the product below loads whole vectors unchecked.
-__kernel void subpixel_border(__global const float* restrict x, const int x_offset,
-                              __global float* restrict padded, const int padded_offset,
-                              const int height, const int width, const int padded_h, const int padded_w) {
-  const int px = get_global_id(0), py = get_global_id(1), i = get_global_id(2);
-  if (px >= padded_w || py >= padded_h) return;
-  const int y = py - 1, xx = px - 1;
-  const bool inside = y >= 0 && y < height && xx >= 0 && xx < width;
-  padded[padded_offset + ((size_t)i * padded_h + py) * padded_w + px] =
-      inside ? x[x_offset + ((size_t)i * height + y) * width + xx] : 0.0f;
-}
-
+// from the input (no im2col panels, no border windows, no column matrix).
 #if defined(MR) && defined(SEG)
 
 // A tile is 32 windows of one phase: 32 / SEG input rows × SEG columns (SEG 32, 16 or 8, so that
@@ -137,16 +126,8 @@ inline void store_direct_row(__global float* out, const int out_offset, float16 
                              const int channels, const int a0, const int b0, const int py, const int px,
                              const int height, const int width, __global const float* bias, const int bias_offset) {
   if (c >= channels) return;
-#if HAS_BIAS
-  const float bv = bias[bias_offset + c];
-  lo += bv;
-  hi += bv;
-#endif
-  lo = ACTIVATE(lo);
-  hi = ACTIVATE(hi);
   float t[32];
-  vstore16(lo, 0, t);
-  vstore16(hi, 0, t + 16);
+  finish_tile_row(lo, hi, c, bias, bias_offset, t);
   const int out_w = 2 * width;
   const int cols = min(SEG, width - b0);
   __global float* plane = out + out_offset + (size_t)c * (2 * height) * out_w;
@@ -156,53 +137,100 @@ inline void store_direct_row(__global float* out, const int out_offset, float16 
   }
 }
 
-#define STORE_DIRECT(r) \
-  store_direct_row(out, out_offset, lo##r, hi##r, c0 + r, channels, a0, b0, py, px, height, width, bias, bias_offset);
+// One work-item computes one tile of windows (TILE_ROWS × SEG input pixels) for every panel of a
+// block of PANEL_BLOCK A panels (phases included), over the input channels in blocks of
+// CHANNEL_BLOCK: each channel block's input rows (TILE_ROWS + 2 rows of SEG + 2 columns, zeros
+// outside the image) are copied into a private buffer, which then serves every panel of the
+// block and each of its 2×2 taps from L1 (the packed GEMM's B panel, k = 162 for the reference,
+// is L1-resident the same way); the panels' accumulators are parked in a private array between
+// channel blocks. A panels are phase-major, `phase_panels` of MR rows per phase (rows past co
+// zero); A's column i·4 + ty·2 + tx is tap (ty, tx) of input channel i, whose B values are the
+// buffer's rows py + ty …, columns px + tx …: whole vectors, no packing.
+// Build options: -DMR, -DSEG, -DPANEL_BLOCK, -DCHANNEL_BLOCK, -DHAS_BIAS, -DACTIVATION.
 
-// Work-groups of one work-item. Global size (A panels of the four phases, tiles across, tile
-// rows down) with -DTILES_FIRST=0, (PANEL_BLOCK, tiles, A panel blocks) with 1: the first
-// walks the A panels against one stretch of input rows (large inputs, small weights), the
-// second the input against a block of A panels, which is then read from memory once (deep
-// layers on small inputs, whose weights are far larger than their input). A panels are phase-major,
-// `phase_panels` of MR rows per phase (rows past co zero). The k loop runs i over ci and the
-// 2×2 taps (ty, tx), A's column i·4 + ty·2 + tx; B's values of a tap are the bordered input's
-// rows a0 + py + ty …, columns b0 + px + tx …: whole vectors, no packing.
+#define BUF_W (SEG + 2)
+#define BUF_ROWS (TILE_ROWS + 2)
+#define BUF_PLANE (BUF_ROWS * BUF_W)
+
+#define PARK_LOAD(r) float16 lo##r = acc[(p * MR + r) * 2], hi##r = acc[(p * MR + r) * 2 + 1];
+#define PARK_STORE(r) acc[(p * MR + r) * 2] = lo##r; acc[(p * MR + r) * 2 + 1] = hi##r;
+#define STORE_DIRECT(r)                                                                                     \
+  store_direct_row(out, out_offset, acc[(p * MR + r) * 2], acc[(p * MR + r) * 2 + 1], c0 + r, channels, a0, \
+                   b0, py, px, height, width, bias, bias_offset);
+
+// Global size (tiles across · tile rows, A panel blocks), work-groups of one work-item: the tiles
+// of one panel block run back to back, so the block's weights stay in L2 while the input passes.
 __kernel void subpixel_direct(__global const float* restrict a_packed, const int a_offset,
-                              __global const float* restrict padded, const int padded_offset,
+                              __global const float* restrict x, const int x_offset,
                               __global float* restrict out, const int out_offset,
                               __global const float* restrict bias, const int bias_offset,
                               const int in_channels, const int channels, const int phase_panels,
-                              const int height, const int width, const int padded_h, const int padded_w) {
-#if TILES_FIRST
-  // Blocks of PANEL_BLOCK A panels (kept in L2 together) walked against every tile: each tile's
-  // input rows serve the block's panels back to back, and the input is read once per block.
-  const int panel = get_global_id(2) * PANEL_BLOCK + get_global_id(0);
-  const int tile_index = get_global_id(1);
+                              const int height, const int width) {
   const int tiles_across = (width + SEG - 1) / SEG;
+  const int tile_index = get_global_id(0);
   const int tile_row = tile_index / tiles_across, tile = tile_index - tile_row * tiles_across;
-#else
-  const int panel = get_global_id(0), tile = get_global_id(1), tile_row = get_global_id(2);
-#endif
-  const int phase = panel / phase_panels;
-  const int c0 = (panel - phase * phase_panels) * MR;
-  const int py = phase >> 1, px = phase & 1;
+  const int first_panel = get_global_id(1) * PANEL_BLOCK;
+  const int panels = min(PANEL_BLOCK, 4 * phase_panels - first_panel);
   const int a0 = tile_row * TILE_ROWS, b0 = tile * SEG;
-  if (phase >= 4 || b0 >= width || a0 >= height) return;
+  if (a0 >= height || panels <= 0) return;
   const int k = 4 * in_channels;
-  __global const float* ap = a_packed + a_offset + (size_t)panel * k * MR;
-  const size_t plane = (size_t)padded_h * padded_w;
-  __global const float* bp = padded + padded_offset + (size_t)(a0 + py) * padded_w + b0 + px;
-  EACH_ROW(DECLARE)
-  for (int i = 0; i < in_channels; ++i) {
-    for (int t = 0; t < 4; ++t) {
-      __global const float* src = bp + (t >> 1) * padded_w + (t & 1);
-      LOAD_B(src, padded_w)
-      EACH_ROW(ACCUMULATE)
-      ap += MR;
+  const size_t plane = (size_t)height * width;
+  float16 acc[PANEL_BLOCK * MR * 2];
+  for (int q = 0; q < PANEL_BLOCK * MR * 2; ++q) acc[q] = (float16)(0.0f);
+  float buf[CHANNEL_BLOCK * BUF_PLANE];
+  // The SEG middle columns as whole vectors where the tile's columns are all inside the image.
+  const bool full = b0 + SEG <= width;
+  for (int i0 = 0; i0 < in_channels; i0 += CHANNEL_BLOCK) {
+    const int count = min(CHANNEL_BLOCK, in_channels - i0);
+    for (int i = 0; i < count; ++i) {
+      __global const float* src = x + x_offset + (size_t)(i0 + i) * plane;
+      for (int r = 0; r < BUF_ROWS; ++r) {
+        float* dst = buf + i * BUF_PLANE + r * BUF_W;
+        const int y = a0 - 1 + r;
+        if (y < 0 || y >= height) {
+          for (int q = 0; q < BUF_W; ++q) dst[q] = 0.0f;
+          continue;
+        }
+        __global const float* row = src + (size_t)y * width;
+        dst[0] = b0 > 0 ? row[b0 - 1] : 0.0f;
+        if (full) {
+#if SEG == 8
+          vstore8(vload8(0, row + b0), 0, dst + 1);
+#else
+          for (int q = 0; q < SEG; q += 16) vstore16(vload16(0, row + b0 + q), 0, dst + 1 + q);
+#endif
+        } else {
+          for (int q = 0; q < SEG; ++q) dst[1 + q] = b0 + q < width ? row[b0 + q] : 0.0f;
+        }
+        dst[SEG + 1] = b0 + SEG < width ? row[b0 + SEG] : 0.0f;
+      }
     }
-    bp += plane;
+    for (int p = 0; p < panels; ++p) {
+      const int panel = first_panel + p;
+      const int phase = panel / phase_panels;
+      const int py = phase >> 1, px = phase & 1;
+      __global const float* ap = a_packed + a_offset + (size_t)panel * k * MR + (size_t)i0 * 4 * MR;
+      EACH_ROW(PARK_LOAD)
+      const float* bp = buf + py * BUF_W + px;
+      for (int i = 0; i < count; ++i) {
+        for (int t = 0; t < 4; ++t) {
+          const float* src = bp + (t >> 1) * BUF_W + (t & 1);
+          LOAD_B(src, BUF_W)
+          EACH_ROW(ACCUMULATE)
+          ap += MR;
+        }
+        bp += BUF_PLANE;
+      }
+      EACH_ROW(PARK_STORE)
+    }
   }
-  EACH_ROW(STORE_DIRECT)
+  for (int p = 0; p < panels; ++p) {
+    const int panel = first_panel + p;
+    const int phase = panel / phase_panels;
+    const int py = phase >> 1, px = phase & 1;
+    const int c0 = (panel - phase * phase_panels) * MR;
+    EACH_ROW(STORE_DIRECT)
+  }
 }
 
-#endif
+#endif  // MR && SEG

@@ -16,20 +16,17 @@ bool subpixel_eligible(const Shape& weight, int stride, int padding) {
 
 bool subpixel_direct_preferred(const Shape& input, const Shape& weight) {
   if (input.size() != 4 || weight.size() != 4) return false;
-  // The direct form reads its B values from a zero-bordered copy of the input: one more pass over
-  // it, cheap while the input stays in the last-level cache (≤ 2 Mi floats, 8 MiB), and it walks
-  // its A panels against the input, which pays where the phase weights (16·ci·co floats) are no
-  // larger than the input (ci·H·W).
+  // The direct form reads its input once per block of 8 A panels and its weights once per tile;
+  // it pays everywhere but on the deepest layer on the smallest input (FlowNet's deconv5:
+  // 1024 → 512 channels on 6×8, whose 33 MB of phase weights are read once per tile there, once
+  // in all by GEMM + col2im): the direct form from 128 input pixels, or where the phase weights
+  // (16·co per input channel) are no larger than the input (the upsampled_flow layers).
   const std::int64_t pixels = input[2] * input[3];
-  return 16 * weight[1] <= pixels && input[1] * pixels <= (std::int64_t{2} << 20);
+  return pixels >= 128 || 16 * weight[1] <= pixels;
 }
 
 bool subpixel_preferred(const Shape& input, const Shape& weight, int stride, int padding) {
-  if (input.size() != 4 || !subpixel_eligible(weight, stride, padding)) return false;
-  if (subpixel_direct_preferred(input, weight)) return true;
-  // The window-grid form: where its border windows add at most 5 % (H·W ≥ 20·(H + W + 1)).
-  const std::int64_t h = input[2], w = input[3];
-  return h * w >= 20 * (h + w + 1);
+  return input.size() == 4 && subpixel_eligible(weight, stride, padding) && subpixel_direct_preferred(input, weight);
 }
 
 PackedPanels subpixel_weights(Queue& queue, const Tensor& weight, Device* long_lived) {
@@ -55,11 +52,15 @@ PackedPanels subpixel_weights(Queue& queue, const Tensor& weight, Device* long_l
 
 namespace {
 
-// A panels walked together against the input by the direct form's deep-layer walk: 4 panels of
-// MR = 8 rows of a 4·ci = 4096 deep layer are 512 KiB, within a core's L2 with the input rows.
-// Measured on FlowNetC's deconv3 (24×32, forced direct, load 3.8–4.0): 35 ms with blocks of one
-// panel, 22–23 ms with 4 or 8 (GEMM + col2im: 22 ms).
-constexpr std::size_t kDirectPanelBlock = 4;
+// The direct form's blocks (kernels_cl/deconv_subpixel.cl, subpixel_direct): a work-item runs
+// one tile for kDirectPanelBlock A panels (every phase of FlowNetFusion's deconv0, whose four
+// phases of 16 channels are 8 panels of MR = 8), over the input channels kDirectChannelBlock at a
+// time: 16 channels of a 32-wide tile's three input rows are 6.5 KiB, so they serve the 8 panels'
+// 4 taps from L1, and the 8 panels' parked accumulators are 8 KiB. Measured per layer at
+// 512×384 (docs/performance.md, "Issue 24, fifth pass"): blocks of 8 panels against 4 and 16,
+// of 16 channels against 8 and 32.
+constexpr std::size_t kDirectPanelBlock = 8;
+constexpr int kDirectChannelBlock = 16;
 
 // The phase weights' rows per phase (co padded to whole A panels), checked against the layer.
 std::size_t checked_phase_rows(const Tensor& input, const PackedPanels& weights, const Tensor& output) {
@@ -89,46 +90,32 @@ void conv_transpose2d_subpixel_direct(Queue& queue, const Tensor& input, const P
   const int seg = width <= 8 ? 8 : width <= 16 ? 16 : 32;
   const int tile_rows = 32 / seg;
   const int tiles = (width + seg - 1) / seg, row_tiles = (height + tile_rows - 1) / tile_rows;
-  // A tile's loads reach from bordered row a0 to a0 + tile_rows + 1 and column b0 to b0 + seg + 1.
-  const int padded_w = tiles * seg + 2, padded_h = row_tiles * tile_rows + 2;
-  const std::size_t padded_floats = static_cast<std::size_t>(in_channels) * padded_h * padded_w;
-  // Walk the input against a block of A panels where the weights outweigh the bordered input:
-  // the deep layers on small inputs then read their weights from memory once, not once per tile.
-  const bool tiles_first = weights.data.numel() > static_cast<std::int64_t>(padded_floats);
   const auto phase_panels = phase_rows / static_cast<std::size_t>(weights.width);
   const std::size_t panels = 4 * phase_panels;
-  const std::size_t block = std::min<std::size_t>(kDirectPanelBlock, panels);
-  const Tensor padded = Tensor::empty(queue, {static_cast<std::int64_t>(padded_floats)});
-  Kernel& border = queue.kernel("deconv_subpixel", "subpixel_border");
+  const std::size_t block = std::min(kDirectPanelBlock, panels);
   const bool has_bias = bias.defined();
   Kernel& kernel = queue.kernel("deconv_subpixel", "subpixel_direct",
                                 KernelDefines()
                                     .add("MR", weights.width)
                                     .add("SEG", seg)
-                                    .add("TILES_FIRST", tiles_first)
                                     .add("PANEL_BLOCK", static_cast<int>(block))
+                                    .add("CHANNEL_BLOCK", kDirectChannelBlock)
                                     .add("HAS_BIAS", has_bias)
                                     .add(activation_defines(options.activation)));
-  const Range global = tiles_first ? Range(block, static_cast<std::size_t>(tiles) * static_cast<std::size_t>(row_tiles),
-                                           (panels + block - 1) / block)
-                                   : Range(panels, static_cast<std::size_t>(tiles), static_cast<std::size_t>(row_tiles));
+  const Range global(static_cast<std::size_t>(tiles) * static_cast<std::size_t>(row_tiles), (panels + block - 1) / block);
   for (std::int64_t n = 0; n < input.n(); ++n) {
     const Tensor in_n = input.sample(n);
     const Tensor out_n = output.sample(n);
-    border.set_args(in_n, padded, height, width, padded_h, padded_w);
-    queue.launch(border, Range(static_cast<std::size_t>(padded_w), static_cast<std::size_t>(padded_h),
-                               static_cast<std::size_t>(in_channels)));
     // Without a bias the kernel never reads its bias argument; any valid buffer will do.
     const Tensor bias_arg = has_bias ? bias : out_n;
-    kernel.set_args(weights.data, padded, out_n, bias_arg, in_channels, out_channels, static_cast<int>(phase_panels),
-                    height, width, padded_h, padded_w);
-    queue.launch(kernel, global, Range(1, 1, 1));
+    kernel.set_args(weights.data, in_n, out_n, bias_arg, in_channels, out_channels, static_cast<int>(phase_panels),
+                    height, width);
+    queue.launch(kernel, global, Range(1, 1));
   }
 }
 
 void conv_transpose2d_subpixel(Queue& queue, const Tensor& input, const PackedPanels& weights, const Tensor& bias,
                                const Tensor& output, const ConvTranspose2dOptions& options) {
-  const auto in_channels = static_cast<std::size_t>(input.c());
   const auto out_channels = static_cast<std::size_t>(output.c());
   const std::size_t phase_rows = checked_phase_rows(input, weights, output);
   const int height = static_cast<int>(input.h()), width = static_cast<int>(input.w());

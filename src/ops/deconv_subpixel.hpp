@@ -20,15 +20,13 @@ namespace inertialnet::detail {
 bool subpixel_eligible(const Shape& weight, int stride, int padding);
 
 // Whether an eligible layer on `input` [N, ci, H, W] runs a sub-pixel form by default, and which.
-// Measured on FlowNet2 at 512×384 (docs/performance.md, both forms and GEMM + col2im per layer):
-// - the direct form (conv_transpose2d_subpixel_direct) where its phase weights are no larger
-//   than the input (16·co ≤ H·W) and the input fits the last-level cache (ci·H·W ≤ 2 Mi floats):
-//   every upsampled_flow layer (×0.45), FlowNetFusion's deconv1 (×0.92), deconv2 (even);
-// - else the window-grid form where its border windows add at most 5 % (H·W ≥ 20·(H + W + 1)):
-//   FlowNetFusion's deconv0 (192×256, ci = 162: the direct form's bordered copy of its 32 MB
-//   input cost more than it saved, ×1.1);
-// - else GEMM + col2im: the deep layers on small inputs (deconv5, deconv4, deconv3 of
-//   FlowNetC/S/SD), where both sub-pixel forms tied (6×8, 12×16) or lost (24×32).
+// Measured on FlowNet2 at 512×384 (docs/performance.md, "Issue 24, fifth pass", every form per
+// layer): the direct form (conv_transpose2d_subpixel_direct) from 128 input pixels (deconv4 and
+// up, FlowNetFusion's deconv0 included) or where its phase weights are no larger than the input
+// (16·co ≤ H·W: every upsampled_flow layer); GEMM + col2im on the rest (deconv5: 6×8 input,
+// 1024 → 512 channels, whose 33 MB of weights the direct form reads once per tile). The window-grid
+// form (conv_transpose2d_subpixel) is no layer's default any more: the direct one beat it on
+// every layer it ran (forced, it stays tested).
 bool subpixel_direct_preferred(const Shape& input, const Shape& weight);
 bool subpixel_preferred(const Shape& input, const Shape& weight, int stride, int padding);
 
@@ -44,12 +42,13 @@ void conv_transpose2d_subpixel(Queue& queue, const Tensor& input, const PackedPa
                                const Tensor& output, const ConvTranspose2dOptions& options);
 
 // The same from the same phase weights, each phase on its own: a phase's 2×2 windows over
-// exactly H·W outputs (no border windows), its B values loaded as whole vectors straight from a
-// zero-bordered copy of the input (no im2col panels), the products stored into their pixels.
-// A tile is 32 windows of one phase: 32 columns of a row, or 16 × 2 rows, or 8 × 4 rows, so
-// that the narrow inputs of the deep layers (6×8, 12×16) fill it. Where the phase weights
-// outweigh the input the tiles are walked against blocks of 4 A panels, so that the weights are
-// read from memory once (kernels_cl/deconv_subpixel.cl, subpixel_direct).
+// exactly H·W outputs (no border windows), its B values loaded as whole vectors from a private
+// copy of the tile's input rows (no im2col panels), the products stored into their pixels.
+// A tile is 32 windows: 32 columns of a row, or 16 × 2 rows, or 8 × 4 rows, so that the narrow
+// inputs of the deep layers (6×8, 12×16) fill it. A work-item runs one tile for a block of 8 A
+// panels (all four phases of a layer of ≤ 16 channels), over the input channels 16 at a time:
+// the tile's input rows then serve the block from L1, the weights are read once per tile and the
+// input once per block (kernels_cl/deconv_subpixel.cl, subpixel_direct).
 void conv_transpose2d_subpixel_direct(Queue& queue, const Tensor& input, const PackedPanels& weights,
                                       const Tensor& bias, const Tensor& output,
                                       const ConvTranspose2dOptions& options);

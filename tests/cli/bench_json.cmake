@@ -68,7 +68,7 @@ foreach(i RANGE ${last})
   endforeach()
   string(JSON kind GET "${out}" results 0 profile kinds ${i} kind)
   list(APPEND seen "${kind}")
-  # The kind's work and, for GEMM kinds, the packed GEMM's rate on its heaviest product beside it:
+  # The kind's work and, for GEMM kinds, the packed GEMM's rate on its products beside it:
   # present and finite (not timings: any positive rate passes).
   expect_field(results 0 profile kinds ${i} gflop)
   expect_finite("${value}" "kinds[${i}].gflop")
@@ -92,6 +92,17 @@ foreach(i RANGE ${last})
     expect_finite("${value}" "kinds[${i}].packed_gemm.gflops")
     if(NOT value GREATER 0)
       message(FATAL_ERROR "kinds[${i}].packed_gemm.gflops is ${value}")
+    endif()
+    # The rate covers the products of the kind's flow layers, not the heaviest alone (the
+    # reference of one product moved by a quarter between runs): all 18 deconvolutions of
+    # FlowNet2; at most the kind's layers elsewhere (the head's two 3×3 convolutions have none).
+    expect_field(results 0 profile kinds ${i} packed_gemm products)
+    string(JSON kind_layers GET "${out}" results 0 profile kinds ${i} layers)
+    if(NOT value GREATER 0 OR value GREATER kind_layers)
+      message(FATAL_ERROR "kinds[${i}] (${kind}) has ${kind_layers} layers; its packed_gemm covers ${value} products")
+    endif()
+    if(kind STREQUAL "deconv 4×4 s2" AND NOT value EQUAL 18)
+      message(FATAL_ERROR "the deconvolutions' packed_gemm covers ${value} products, FlowNet2 has 18 deconvolutions")
     endif()
     expect_field(results 0 profile kinds ${i} of_packed_gemm)
     expect_finite("${value}" "kinds[${i}].of_packed_gemm")

@@ -179,17 +179,24 @@ TEST(ConvTranspose2d, SubPixelDirectOnOddSizesSlicesAndBothWalks) {
   // channels of a concat; a slice read from and written into the middle of wider tensors.
   expect_deconv_matches({"flow_up_slice", 2, 2, 9, 11, 4, 2, 1, false, ActivationSpec::none()}, {3, 1, 0, 9, 0, 0, direct});
   expect_deconv_matches({"slice", 6, 10, 37, 23, 4, 2, 1, true, ActivationSpec::leaky_relu(0.1f)}, {3, 2, 3, 5, 4, 0, direct});
-  // Weights larger than the bordered input: the tiles are walked against one A panel (the deep
-  // layers' order), co not a multiple of the panel rows, widths of each tile shape.
+  // Blocks of 8 A panels and of 16 input channels with a partial last block: co not a multiple
+  // of the panel rows (21: 3 panels per phase, 12 in all), ci 70 (4 blocks of 16 and 6), widths of
+  // each tile shape.
   for (const int w : {5, 13, 35}) {
     expect_deconv_matches({"deep_w" + std::to_string(w), 70, 21, 3, w, 4, 2, 1, true, ActivationSpec::leaky_relu(0.1f)},
+                          {2, 0, 0, 0, 0, 0, direct});
+  }
+  // Whole channel blocks (ci 32) and whole panel blocks (co 16: 8 panels, FlowNetFusion's
+  // deconv0) on rows of whole and partial 32-wide tiles, the first and last rows at the border.
+  for (const int w : {64, 65}) {
+    expect_deconv_matches({"blocks_w" + std::to_string(w), 32, 16, 5, w, 4, 2, 1, true, ActivationSpec::leaky_relu(0.1f)},
                           {2, 0, 0, 0, 0, 0, direct});
   }
 }
 
 // The direct form on FlowNet2's deep up-convolutions at their real size for a 512×384 input
-// (6×8, 12×16 and 24×32 inputs: every tile shape, tiles walked against one A panel) against the
-// reference.
+// (6×8, 12×16 and 24×32 inputs: every tile shape, many blocks of A panels and of channels)
+// against the reference.
 TEST(ConvTranspose2d, SubPixelDirectAtFlowNet2sRealSize) {
   Placement p;
   p.algorithm = DeconvAlgorithm::SubPixelDirect;
@@ -202,29 +209,28 @@ TEST(ConvTranspose2d, SubPixelDirectAtFlowNet2sRealSize) {
 }
 
 TEST(ConvTranspose2d, SubPixelIsTheDefaultOnlyWhereItMeasuredFaster) {
-  // FlowNet2 at 512×384: deconv5 (6×8), deconv4 (12×16) and deconv3 (24×32) stay on GEMM +
-  // col2im; deconv2 (48×64) and FlowNetFusion's layers (96×128, 192×256) run a sub-pixel form
-  // (docs/performance.md).
+  // FlowNet2 at 512×384 (docs/performance.md, "Issue 24, fifth pass"): the direct form on every
+  // deconvolution from deconv4 (12×16) up, FlowNetFusion's deconv0 (192×256) included; GEMM +
+  // col2im on deconv5 (6×8, 1024 → 512 channels).
   const Shape weight{386, 64, 4, 4};
   EXPECT_FALSE(detail::subpixel_preferred({1, 386, 6, 8}, weight, 2, 1));
-  EXPECT_FALSE(detail::subpixel_preferred({1, 386, 12, 16}, weight, 2, 1));
-  EXPECT_FALSE(detail::subpixel_preferred({1, 386, 24, 32}, weight, 2, 1));
+  EXPECT_FALSE(detail::subpixel_preferred({1, 1024, 6, 8}, {1024, 512, 4, 4}, 2, 1));
+  EXPECT_TRUE(detail::subpixel_preferred({1, 1026, 12, 16}, {1026, 256, 4, 4}, 2, 1));
+  EXPECT_TRUE(detail::subpixel_preferred({1, 770, 24, 32}, {770, 128, 4, 4}, 2, 1));
   EXPECT_TRUE(detail::subpixel_preferred({1, 386, 48, 64}, weight, 2, 1));
-  EXPECT_TRUE(detail::subpixel_preferred({1, 386, 192, 256}, weight, 2, 1));
-  // FlowNet's upsampled_flow layers (2 → 2 channels) at every size; the deep layers never.
+  EXPECT_TRUE(detail::subpixel_preferred({1, 162, 192, 256}, {162, 16, 4, 4}, 2, 1));
+  // FlowNet's upsampled_flow layers (2 → 2 channels) at every size.
   EXPECT_TRUE(detail::subpixel_preferred({1, 2, 6, 8}, {2, 2, 4, 4}, 2, 1));
   EXPECT_TRUE(detail::subpixel_preferred({1, 2, 96, 128}, {2, 2, 4, 4}, 2, 1));
-  EXPECT_FALSE(detail::subpixel_preferred({1, 770, 24, 32}, {770, 128, 4, 4}, 2, 1));
-  EXPECT_FALSE(detail::subpixel_preferred({1, 1024, 6, 8}, {1024, 512, 4, 4}, 2, 1));
-  EXPECT_TRUE(detail::subpixel_preferred({1, 162, 192, 256}, {162, 16, 4, 4}, 2, 1));
-  // Which form: the direct one on the upsampled_flow layers, deconv2 and FlowNetFusion's deconv1;
-  // the window grid on FlowNetFusion's deconv0, whose 162 × 192 × 256 input outgrows the cache.
+  // Which form: the direct one wherever a sub-pixel form runs (the window grid lost to it on
+  // every layer, FlowNetFusion's deconv0 included).
   EXPECT_TRUE(detail::subpixel_direct_preferred({1, 2, 6, 8}, {2, 2, 4, 4}));
   EXPECT_TRUE(detail::subpixel_direct_preferred({1, 2, 192, 256}, {2, 2, 4, 4}));
   EXPECT_TRUE(detail::subpixel_direct_preferred({1, 386, 48, 64}, {386, 64, 4, 4}));
   EXPECT_TRUE(detail::subpixel_direct_preferred({1, 128, 96, 128}, {128, 32, 4, 4}));
-  EXPECT_FALSE(detail::subpixel_direct_preferred({1, 162, 192, 256}, {162, 16, 4, 4}));
-  EXPECT_FALSE(detail::subpixel_direct_preferred({1, 770, 24, 32}, {770, 128, 4, 4}));
+  EXPECT_TRUE(detail::subpixel_direct_preferred({1, 162, 192, 256}, {162, 16, 4, 4}));
+  EXPECT_TRUE(detail::subpixel_direct_preferred({1, 770, 24, 32}, {770, 128, 4, 4}));
+  EXPECT_FALSE(detail::subpixel_direct_preferred({1, 1024, 6, 8}, {1024, 512, 4, 4}));
   // Never where the layer has no sub-pixel form.
   EXPECT_FALSE(detail::subpixel_preferred({1, 386, 192, 256}, {386, 64, 3, 3}, 2, 1));
   EXPECT_FALSE(detail::subpixel_preferred({1, 386, 192, 256}, weight, 2, 0));

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "bench_gemm_reference.hpp"
 
+#include <cstddef>
 #include <map>
 #include <tuple>
 
@@ -9,6 +10,14 @@
 
 namespace inertialnet::cli {
 
+namespace {
+
+// Runs per product after the warm-up (median): one product of a few milliseconds moved by a
+// quarter between runs of bench with 3 (docs/performance.md, "The packed GEMM's reference").
+constexpr int kReferenceRuns = 3;
+
+}  // namespace
+
 std::vector<KindGemmReference> packed_gemm_references(Queue& queue, ModelKind model, std::int64_t width,
                                                       std::int64_t height, const std::vector<LayerTime>& layers) {
   std::map<std::string, const GemmShape*> product_of;  // layer name → its product
@@ -16,16 +25,23 @@ std::vector<KindGemmReference> packed_gemm_references(Queue& queue, ModelKind mo
   for (const GemmShape& shape : shapes) {
     for (const std::string& layer : shape.layers) product_of[layer] = &shape;
   }
-  // The heaviest layer of each kind that has a product, in the order kinds first appear.
+  // Per kind: every layer of the profiled pair that has a product, and the heaviest of them
+  // (named in the report), in the order kinds first appear.
   std::vector<KindGemmReference> references;
   std::map<std::string, std::size_t> index;
   std::map<std::string, double> heaviest;
+  std::vector<std::vector<const GemmShape*>> products_of_kind;
   for (const LayerTime& l : layers) {
     const auto found = product_of.find(l.layer.name);
     if (found == product_of.end()) continue;
     const GemmShape& s = *found->second;
     auto [at, inserted] = index.emplace(l.layer.kind, references.size());
-    if (inserted) references.push_back({l.layer.kind});
+    if (inserted) {
+      references.emplace_back();
+      references.back().kind = l.layer.kind;
+      products_of_kind.emplace_back();
+    }
+    products_of_kind[at->second].push_back(&s);
     if (inserted || s.flops() > heaviest[l.layer.kind]) {
       heaviest[l.layer.kind] = s.flops();
       KindGemmReference& r = references[at->second];
@@ -35,14 +51,25 @@ std::vector<KindGemmReference> packed_gemm_references(Queue& queue, ModelKind mo
       r.k = s.k;
     }
   }
-  // Products timed once each, however many kinds share one.
+  // The kind's rate is its layers' work over the time the packed GEMM takes for their products,
+  // each layer counted once (FlowNet2 runs several layers of one size): the GEMM's own rate on
+  // the kind's shapes, as the kind's own rate is over all of its layers. Products timed once
+  // each, however many layers and kinds share one.
   std::map<std::tuple<std::size_t, std::size_t, std::size_t>, double> seconds;
-  for (KindGemmReference& r : references) {
-    const auto key = std::make_tuple(r.m, r.n, r.k);
-    auto found = seconds.find(key);
-    if (found == seconds.end()) found = seconds.emplace(key, packed_gemm_seconds(queue, r.m, r.n, r.k)).first;
-    const double flops = 2.0 * static_cast<double>(r.m) * static_cast<double>(r.n) * static_cast<double>(r.k);
-    r.gflops = found->second > 0 ? flops * 1e-9 / found->second : 0;
+  for (std::size_t i = 0; i < references.size(); ++i) {
+    KindGemmReference& r = references[i];
+    double flops = 0, total = 0;
+    for (const GemmShape* s : products_of_kind[i]) {
+      const auto key = std::make_tuple(s->m, s->n, s->k);
+      auto found = seconds.find(key);
+      if (found == seconds.end()) {
+        found = seconds.emplace(key, packed_gemm_seconds(queue, s->m, s->n, s->k, kReferenceRuns)).first;
+      }
+      flops += 2.0 * static_cast<double>(s->m) * static_cast<double>(s->n) * static_cast<double>(s->k);
+      total += found->second;
+    }
+    r.products = products_of_kind[i].size();
+    r.gflops = total > 0 ? flops * 1e-9 / total : 0;
   }
   return references;
 }

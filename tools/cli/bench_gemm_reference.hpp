@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: Apache-2.0
 // The packed GEMM's own rate beside each GEMM-based layer kind of a `bench` profile: for every
-// kind, the product (M×N×K) of its heaviest layer is timed on the packed kernel alone, so a run
+// kind, the product (M×N×K) of each of its layers is timed on the packed kernel alone, so a run
 // shows how far the layers (with their im2col, col2im, transforms and stores) are from what the
-// device's GEMM reaches on the same product (issue 24's "≥ 80 % of the packed GEMM's rate").
+// device's GEMM reaches on the same products (issue 24's "≥ 80 % of the packed GEMM's rate").
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -16,9 +17,10 @@ namespace inertialnet::cli {
 
 struct KindGemmReference {
   std::string kind;
-  std::string layer;  // the heaviest layer of the kind, whose product was timed
+  std::string layer;  // the heaviest layer of the kind and its product
   std::size_t m = 0, n = 0, k = 0;
-  double gflops = 0;  // the packed GEMM's rate on m×n×k
+  std::size_t products = 0;  // the kind's layers whose products were timed (all that have one)
+  double gflops = 0;         // the packed GEMM's rate on them: their work over its summed time
 };
 
 // One entry per kind of `layers` that has a GEMM-based layer of `model` at width×height (the

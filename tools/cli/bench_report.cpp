@@ -61,7 +61,7 @@ std::string format_bench_text(const BenchResult& r, bool layers) {
   out += "per layer kind (one profiled pair, device time " + fixed(profiled_seconds(r.layers), 3) + " s):\n";
   out += format_kind_table(group_by_kind(r.layers));
   if (!r.gemm_references.empty()) {
-    out += "\nthe packed GEMM alone on each kind's heaviest product (operands packed beforehand):\n";
+    out += "\nthe packed GEMM alone on each kind's products (operands packed beforehand; heaviest named):\n";
     const TextTable table({{"kind", 22, true, 0}, {"GFLOP/s", 9, false, 1}, {"of GEMM", 9, false, 1},
                            {"M×N×K", 24, true, 2}, {"layer", 0, true, 1}});
     out += table.header();
@@ -126,6 +126,7 @@ std::string format_bench_json(const std::vector<BenchResult>& results) {
                                {"m", reference->m},
                                {"n", reference->n},
                                {"k", reference->k},
+                               {"products", reference->products},
                                {"gflops", reference->gflops}};
         kind["of_packed_gemm"] = reference->gflops > 0 ? gflops / reference->gflops : 0;
       }

@@ -29,11 +29,14 @@
 //         "seconds": number                  the sum over layers
 //         "kinds": [ { "kind", "layers", "seconds", "share", "gflops", "backends": [string],
 //                      "gflop": number       the kind's work in the profiled pair (GFLOP)
-//                      "packed_gemm": { "layer", "m", "n", "k", "gflops" } | null
-//                                            the packed GEMM kernel alone on the product of the
-//                                            kind's heaviest layer (operands packed beforehand:
-//                                            the best that product reaches on this device); null
-//                                            for kinds without a GEMM (bench_gemm_reference.hpp)
+//                      "packed_gemm": { "layer", "m", "n", "k", "products", "gflops" } | null
+//                                            the packed GEMM kernel alone on the products of the
+//                                            kind's layers (operands packed beforehand: the best
+//                                            those products reach on this device; "products" of
+//                                            them, each the median of 5 runs; gflops their work
+//                                            over their summed time); layer, m, n, k name the
+//                                            heaviest; null for kinds without a GEMM
+//                                            (bench_gemm_reference.hpp)
 //                      "of_packed_gemm": number | null   gflops / packed_gemm.gflops } ]
 //         "layers": [ { "name", "kind", "seconds", "flops", "gflops", "backend" } ]
 //       } } ] }
