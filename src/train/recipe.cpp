@@ -81,7 +81,7 @@ constexpr Row kGeneral[] = {
 // answered in EuRoC's body frame).
 // Version 3: the same sequences, settings and seeds on DIS refined down to the full resolution
 // (FlowMethod::DISFine, models/dis_flow.hpp): at the recipe's 128–240-column cameras the MEDIUM
-// preset matched its patches on a half-size image, and the geometric head on that flow was 3–7×
+// preset matched its patches on a half-size image, and the geometric head on that flow was 2–7×
 // worse than on the fine one (docs/training.md, "A finer DIS for the learned head").
 constexpr int kGeneralVersion = 3;
 constexpr int kGeneralSequencesVersion = 1;

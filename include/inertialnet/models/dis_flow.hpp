@@ -26,11 +26,11 @@ enum class DisVariant {
   // PRESET_MEDIUM as OpenCV defines it: 8×8 patches matched and refined from the coarsest pyramid
   // level down to the half-resolution one (finest scale 1), then upsampled and variationally
   // refined. At the small sizes an InertialNet head is trained on (128–240 columns) the patches are
-  // matched on a 64–120-column image: the geometric head on it is 3–6× worse than on LK's points.
+  // matched on a 64–120-column image: the geometric head on it is 2–4× worse than on LK's points.
   Medium,
   // The same preset with the patch search carried down to the full resolution (finest scale 0),
   // nothing else changed. Chosen on synthetic sequences (docs/training.md, "A finer DIS for the
-  // learned head"): the geometric head's RMSE on it falls 3–7× on 200–320-column cameras.
+  // learned head"): the geometric head's RMSE on it falls 2–7× on 200–320-column cameras.
   Fine,
 };
 
