@@ -71,7 +71,8 @@ const Fixture& fixture() {
     trainer.save_head(out.body_head, {{kMetadataHeadInput, head_input_to_json({HeadInput::Normalized, "dis", false})}});
     // The same weights as a head of the fine DIS (the weights do not matter to which flow it gets).
     out.fine_head = out.root / "fine_head.safetensors";
-    trainer.save_head(out.fine_head, {{kMetadataHeadInput, head_input_to_json({HeadInput::Normalized, "dis-fine", true})}});
+    trainer.save_head(out.fine_head,
+                      {{kMetadataHeadInput, head_input_to_json({HeadInput::Normalized, "dis-fine", true})}});
     return out;
   }();
   return f;

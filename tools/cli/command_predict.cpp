@@ -202,7 +202,9 @@ int predict_one(const PredictOptions& given, const GlobalOptions& global, const 
   const auto& infos = prediction.device_infos();
   if (!have_weights) {
     info(std::string("no weights given: weight-free ") +
-         (processor.flow == FlowMethod::LK ? "Lucas-Kanade" : processor.flow == FlowMethod::DISFine ? "DIS (fine)" : "DIS") +
+         (processor.flow == FlowMethod::LK        ? "Lucas-Kanade"
+          : processor.flow == FlowMethod::DISFine ? "DIS (fine)"
+                                                  : "DIS") +
          " optical flow + geometric head");
   }
   const std::string count = !live      ? std::to_string(pairs) + " pairs"
