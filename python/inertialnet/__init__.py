@@ -186,8 +186,10 @@ def predict(sequence: SequenceLike, weights: Weights = (), *, options: PredictOp
     ``--camera-info-topic`` (None: a :class:`Sequence`'s own, else the bag's only image topic);
     ``time_offset`` and ``readout_time`` are ``--time-offset`` and ``--readout-time`` (seconds;
     stated in the rates for :func:`evaluate`, the readout time also corrects the geometric head);
-    ``flow`` is ``--flow``: ``"flownet2"``, ``"dis"`` or ``"lk"`` (sparse Lucas–Kanade at the
-    geometric head's sample points, for the geometric head only; None: flownet2 with weights, lk
+    ``flow`` is ``--flow``: ``"flownet2"``, ``"dis"``, ``"dis-fine"`` (DIS down to the full resolution,
+    the flow of recipe heads since v3) or ``"lk"`` (sparse Lucas–Kanade at the
+    geometric head's sample points, for the geometric head only; None: a trained head's own flow (its
+    metadata), flownet2 with other weights, lk
     without, dis without weights when ``readout_time`` is given). ``flow_check`` is ``--flow-check`` (the DIS or LK forward-backward check for the
     geometric head, pixels at 752 columns; 0: off). ``max_sigma`` is ``--max-sigma`` (deg/s: a geometric rate whose standard deviation
     along its least certain direction exceeds it gets the status ``"uncertain"``; 0: no limit) and

@@ -494,14 +494,18 @@ class PyFlowNet {
 };
 
 py::array_t<float> dis_flow(const py::array& first, const py::array& second, const std::string& order,
-                            double flow_check) {
+                            double flow_check, const std::string& method) {
+  // "dis-fine": the DIS a recipe head since v3 learned from (models/dis_flow.hpp, DisVariant).
+  if (method != "dis" && method != "dis-fine") {
+    throw invalid_input("method '" + method.substr(0, 40) + "': expected dis or dis-fine");
+  }
   const auto a = images_of(first, order, "img1");
   const auto b = images_of(second, order, "img2");
   if (a.size() != b.size()) throw invalid_input("img1 and img2 hold different numbers of images.");
   require_flow_check_setting(flow_check, "flow_check");
   std::vector<FlowField> flows;
   run_interruptibly([&](const std::atomic<bool>& stop) {
-    DisFlow dis;
+    DisFlow dis(method == "dis-fine" ? DisVariant::Fine : DisVariant::Medium);
     for (std::size_t i = 0; i < a.size() && !stop; ++i) {
       flows.push_back(dis.compute(a[i], b[i]));
       dis.check(flows.back(), a[i], b[i], flow_check);
@@ -1303,7 +1307,10 @@ PYBIND11_MODULE(_inertialnet, m) {
       .def_property_readonly("synthetic", &PyFlowNet::synthetic);
 
   m.def("dis_flow", &dis_flow, py::arg("img1"), py::arg("img2"), py::arg("order") = "rgb", py::arg("flow_check") = 0.0,
+        py::arg("method") = "dis",
         "OpenCV DIS optical flow (no weights) from img1 to img2: float32 (H, W, 2), or (N, H, W, 2) for batches.\n"
+        "method='dis-fine' refines it down to the full resolution (--flow dis-fine: the flow of a head whose\n"
+        "config['flow'] is 'dis-fine').\n"
         "flow_check > 0 also computes the flow back and marks each vector whose round trip misses by more than\n"
         "that many pixels (at 752 columns, scaled with the width) as unknown (NaN), as predict does for the\n"
         "geometric head (its default 0.5); GeometricHead.rates skips unknown vectors.");

@@ -40,7 +40,7 @@ def test_predict_flow_lk_matches_the_cli(cli, sequence, tmp_path):
         assert [csv_text(v) for v in rates[name]] == [csv_text(v) for v in expected[:, i]]
     dis = inertialnet.predict(sequence, flow="dis")
     assert not np.array_equal(dis.w, rates.w)
-    with pytest.raises(ValueError, match="expected flownet2, dis or lk"):
+    with pytest.raises(ValueError, match="expected flownet2, dis, dis-fine or lk"):
         inertialnet.predict(sequence, flow="sparse")
 
 
@@ -72,6 +72,20 @@ def test_cli_flow_dis_matches_dis_flow_bit_for_bit(cli, sequence, tmp_path):
                                  np.stack([inertialnet.read_image(f) for f in frames[1:3]]))
     assert batch.shape == (2, 96, 128, 2)
     np.testing.assert_array_equal(batch[0], ours)
+
+
+def test_cli_flow_dis_fine_matches_dis_flow_method_dis_fine(cli, sequence, tmp_path):
+    """Issue 23: the fine DIS (a recipe v3 head's flow) from Python is the CLI's, and another field
+    than the MEDIUM preset's."""
+    frames = sorted((sequence / "mav0" / "cam0" / "data").glob("*.png"))
+    cli("flow", frames[0], frames[1], "--flow", "dis-fine", "-o", tmp_path / "fine.flo")
+    from_cli = inertialnet.read_flo(tmp_path / "fine.flo")
+    a, b = inertialnet.read_image(frames[0]), inertialnet.read_image(frames[1])
+    fine = inertialnet.dis_flow(a, b, method="dis-fine")
+    np.testing.assert_array_equal(fine.view(np.uint32), from_cli.view(np.uint32))
+    assert not np.array_equal(fine, inertialnet.dis_flow(a, b))
+    with pytest.raises(ValueError, match="method 'farneback': expected dis or dis-fine"):
+        inertialnet.dis_flow(a, b, method="farneback")
 
 
 def test_save_flow_matches_keep_flow(cli, sequence, tmp_path):

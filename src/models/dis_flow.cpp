@@ -23,7 +23,9 @@ struct DisFlow::State {
   cv::Ptr<cv::DISOpticalFlow> dis = cv::DISOpticalFlow::create(cv::DISOpticalFlow::PRESET_MEDIUM);
 };
 
-DisFlow::DisFlow() : state_(std::make_unique<State>()) {}
+DisFlow::DisFlow(DisVariant variant) : state_(std::make_unique<State>()) {
+  if (variant == DisVariant::Fine) state_->dis->setFinestScale(0);
+}
 DisFlow::~DisFlow() = default;
 
 FlowField DisFlow::compute(const HostImage& first, const HostImage& second) {

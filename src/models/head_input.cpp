@@ -38,8 +38,9 @@ HeadInputInfo head_input_from_json(const std::string& text) {
     if (key == "convention") {
       info.convention = parse_head_input(v);
     } else if (key == "flow") {
-      if (!v.empty() && v != "dis" && v != "flownet2") {
-        throw invalid_input("\"flow\" is '" + v.substr(0, 40) + "'; expected dis or flownet2");
+      // "dis-fine" (DisVariant::Fine) is another flow than "dis": an older reader refuses it here.
+      if (!v.empty() && v != "dis" && v != "dis-fine" && v != "flownet2") {
+        throw invalid_input("\"flow\" is '" + v.substr(0, 40) + "'; expected dis, dis-fine or flownet2");
       }
       info.flow = v;
     } else if (key == "frame") {

@@ -308,7 +308,8 @@ std::size_t Prediction::pairs(std::size_t max_pairs) const {
 }
 
 std::string Prediction::method() const {
-  std::string method = processor_.flow == FlowMethod::DIS  ? std::string("DIS flow")
+  std::string method = processor_.flow == FlowMethod::DIS       ? std::string("DIS flow")
+                       : processor_.flow == FlowMethod::DISFine ? std::string("DIS flow (fine: full resolution)")
                        : processor_.flow == FlowMethod::LK ? std::string("Lucas-Kanade flow")
                                                            : to_string(processor_.flow_model);
   method += processor_.inertialnet_head && processor_.geometric_head ? " + InertialNet and geometric heads"

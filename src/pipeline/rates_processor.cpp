@@ -61,7 +61,7 @@ class RatesProcessor : public PairProcessor {
   RatesProcessor(Device& device, const WeightSet* weights, const RatesProcessorOptions& options)
       : options_(options), weights_(weights), queue_(device.create_queue()) {
     if (options.flow == FlowMethod::FlowNet) flownet_ = std::make_unique<FlowNet>(device, options.flow_model, *weights);
-    if (options.flow == FlowMethod::DIS) dis_ = std::make_unique<DisFlow>();
+    if (is_dis(options.flow)) dis_ = std::make_unique<DisFlow>(dis_variant(options.flow));
     if (options.inertialnet_head) {
       head_ = std::make_unique<InertialNetHead>(device, *weights);
       // Member 0 is the file's plain head; the others are its ensemble.<k>.* tensors.
@@ -333,6 +333,7 @@ class RatesProcessor : public PairProcessor {
 std::string to_string(FlowMethod method) {
   switch (method) {
     case FlowMethod::DIS: return "dis";
+    case FlowMethod::DISFine: return "dis-fine";
     case FlowMethod::LK: return "lk";
     case FlowMethod::FlowNet: break;
   }
@@ -342,8 +343,15 @@ std::string to_string(FlowMethod method) {
 FlowMethod parse_flow_method(const std::string& text) {
   if (text == "flownet2" || text == "flownet") return FlowMethod::FlowNet;
   if (text == "dis") return FlowMethod::DIS;
+  if (text == "dis-fine") return FlowMethod::DISFine;
   if (text == "lk") return FlowMethod::LK;
-  throw invalid_input("unknown flow method '" + text + "'; expected flownet2, dis or lk");
+  throw invalid_input("unknown flow method '" + text + "'; expected flownet2, dis, dis-fine or lk");
+}
+
+bool is_dis(FlowMethod method) { return method == FlowMethod::DIS || method == FlowMethod::DISFine; }
+
+DisVariant dis_variant(FlowMethod method) {
+  return method == FlowMethod::DISFine ? DisVariant::Fine : DisVariant::Medium;
 }
 
 ProcessorFactory rates_processor(const std::map<const Device*, const WeightSet*>& weights,
@@ -360,7 +368,7 @@ ProcessorFactory rates_processor(const std::map<const Device*, const WeightSet*>
   }
   if (options.flow == FlowMethod::LK && options.inertialnet_head) {
     throw invalid_input("--flow lk tracks the geometric head's sample points only; the InertialNet head needs a dense "
-                        "flow field: use --flow flownet2 or dis with it");
+                        "flow field: use --flow flownet2, dis or dis-fine with it");
   }
   if (options.fuse && !(options.inertialnet_head && options.geometric_head)) {
     throw invalid_input("--fuse combines the InertialNet and the geometric head: it needs --head both");

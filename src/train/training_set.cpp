@@ -43,7 +43,8 @@ std::string cache_key(const std::filesystem::path& root, const EurocSequence& se
     const auto& kinds = o.flownet_weights->models();
     key << ':' << to_string(kinds.empty() ? ModelKind::FlowNet2 : kinds.front());
   } else {
-    key << ":medium";  // DisFlow's preset
+    // DisFlow's settings (models/dis_flow.hpp, DisVariant); "dis" keeps its keys of before.
+    key << (o.flow == FlowMethod::DISFine ? ":medium-finest-scale-0" : ":medium");
   }
   key << '|' << o.weights_id << "|resize:area-or-bilinear|" << o.width << 'x' << o.height << '|'
       << sequence.frames.size() << '|' << o.bag_input.bag.image;  // a bag's frames: its file and topic
@@ -158,8 +159,8 @@ std::vector<std::uint16_t> TrainingSet::pair_flows(const EurocSequence& sequence
   std::unique_ptr<DisFlow> dis;
   std::unique_ptr<FlowNet> flownet;
   std::unique_ptr<Queue> queue;
-  if (options_.flow == FlowMethod::DIS) {
-    dis = std::make_unique<DisFlow>();
+  if (is_dis(options_.flow)) {
+    dis = std::make_unique<DisFlow>(dis_variant(options_.flow));
   } else {
     // The family member the weight file declares (FlowNet2 when it says nothing).
     const auto& kinds = options_.flownet_weights->models();

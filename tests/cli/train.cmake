@@ -230,7 +230,7 @@ expect_match("nowhere is not a EuRoC sequence")
 # the first's rendered sequences and cached flows: one file, metadata included.
 run(0 ${CLI} train --recipe general --recipe-scale tiny -o recipe1/head.safetensors --work recipe_work1
     --cache recipe_cache1)
-expect_match("recipe general v2 \\(tiny\\): 3 training and 1 validation sequences in recipe_work1 \\(4 rendered now\\)")
+expect_match("recipe general v3 \\(tiny\\): 3 training and 1 validation sequences in recipe_work1 \\(4 rendered now\\)")
 run(0 ${CLI} train --recipe general --recipe-scale tiny -o recipe2/head.safetensors --work recipe_work2
     --cache recipe_cache2)
 run(0 ${CLI} train --recipe general --recipe-scale tiny -o recipe3/head.safetensors --work recipe_work1
@@ -245,7 +245,9 @@ foreach(n 2 3)
   endif()
 endforeach()
 run(0 ${CLI} weights --info recipe1/head.safetensors)
-expect_match("inertialnet.recipe = \\{\"name\":\"general\",\"scale\":\"tiny\",\"version\":2\\}")
+expect_match("inertialnet.recipe = \\{\"name\":\"general\",\"scale\":\"tiny\",\"version\":3\\}")
+# Version 3 trains on the fine DIS and says so: predict gives its head that flow (test_head_input_predict).
+expect_match("inertialnet.head_input = \\{\"convention\":\"normalized\",\"flow\":\"dis-fine\",\"frame\":\"camera\"\\}")
 expect_match("\"train_sequences\":\\[\"general-160x100\",\"close-200x150\",\"rotation-224x126\"\\]")
 # The user's sequences are added to the recipe's.
 run(0 ${CLI} train --recipe general --recipe-scale tiny --train a --val b -o recipe4/head.safetensors
@@ -322,3 +324,16 @@ run(2 ${CLI} train --train a --val b --ensemble 0 -o ens_bad/head.safetensors)
 expect_match("--ensemble")
 run(2 ${CLI} train --recipe general --ensemble 3 -o recipe_bad/head.safetensors --work recipe_work_bad)
 expect_match("--ensemble with --recipe general: the recipe fixes it")
+
+# --- issue 23, the fine DIS (`--flow dis-fine`): a head trained on it says so, predict runs it
+# without --flow, and the other DIS asked for is refused (the head never saw it) both ways.
+run(0 ${CLI} train --train a --val b --flow dis-fine --head-size 64x48 --optimizer adam --lr 1e-3 --epochs 1
+    -o fine/head.safetensors --cache cache)
+run(0 ${CLI} weights --info fine/head.safetensors)
+expect_match("inertialnet.head_input = \\{\"convention\":\"normalized\",\"flow\":\"dis-fine\",\"frame\":\"camera\"\\}")
+run(0 ${CLI} predict a -w fine/head.safetensors --smooth off -o fine/rates.csv)
+expect_match("DIS flow \\(fine: full resolution\\) \\+ InertialNet head")
+run(2 ${CLI} predict a -w fine/head.safetensors --flow dis -o fine/x.csv)
+expect_match("--flow dis: the InertialNet head in fine/head.safetensors was trained on dis-fine flow .*give --flow dis-fine")
+run(2 ${CLI} predict a -w head.safetensors --flow dis-fine -o fine/y.csv)
+expect_match("was trained on dis flow .*give --flow dis")

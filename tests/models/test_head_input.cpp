@@ -106,6 +106,12 @@ TEST(HeadInput, MetadataRoundTripAndRefusals) {
   EXPECT_TRUE(back.camera_frame);
   EXPECT_FALSE(head_input_from_json(head_input_to_json({HeadInput::Paper, "", false})).camera_frame);
   EXPECT_EQ(head_input_from_json("{\"convention\":\"paper\"}").convention, HeadInput::Paper);
+  // The fine DIS is its own flow name (recipe v3), kept as written; "dis" stays the MEDIUM preset.
+  const HeadInputInfo fine{HeadInput::Normalized, "dis-fine", true};
+  EXPECT_EQ(head_input_to_json(fine), "{\"convention\":\"normalized\",\"flow\":\"dis-fine\",\"frame\":\"camera\"}");
+  EXPECT_EQ(head_input_from_json(head_input_to_json(fine)).flow, "dis-fine");
+  testing::expect_invalid_input([] { head_input_from_json("{\"convention\":\"normalized\",\"flow\":\"dis-coarse\"}"); },
+                                "\"flow\" is 'dis-coarse'; expected dis, dis-fine or flownet2");
   // Written before the frame was recorded: such a head answers in its training rig's body frame.
   EXPECT_FALSE(head_input_from_json("{\"convention\":\"normalized\",\"flow\":\"dis\"}").camera_frame);
   try {

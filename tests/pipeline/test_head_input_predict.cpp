@@ -4,6 +4,7 @@
 // the head's input by the same head_input(): resized, divided by the interval and the focal
 // lengths). The only difference allowed is the training set's float16 storage of its flows.
 // And a DIS-trained head needs no flow option: its metadata says dis; flownet2 asked for is refused.
+// A head of the fine DIS ("dis-fine", issue 23's recipe v3) gets that flow, never the other DIS.
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -30,7 +31,7 @@ namespace fs = std::filesystem;
 constexpr int kHeadWidth = 320, kHeadHeight = 180;
 
 struct Fixture {
-  fs::path root, sequence, head, body_head;
+  fs::path root, sequence, head, body_head, fine_head;
 };
 
 // A 1280×720 sequence of 5 frames and a head trained on it for one epoch at 320×180 (normalized
@@ -68,6 +69,10 @@ const Fixture& fixture() {
     // The same weights as a head written before the frame was recorded (body frame of its rig).
     out.body_head = out.root / "body_head.safetensors";
     trainer.save_head(out.body_head, {{kMetadataHeadInput, head_input_to_json({HeadInput::Normalized, "dis", false})}});
+    // The same weights as a head of the fine DIS (the weights do not matter to which flow it gets).
+    out.fine_head = out.root / "fine_head.safetensors";
+    trainer.save_head(out.fine_head,
+                      {{kMetadataHeadInput, head_input_to_json({HeadInput::Normalized, "dis-fine", true})}});
     return out;
   }();
   return f;
@@ -155,6 +160,70 @@ TEST(HeadInputPredict, AnotherFlowThanTheHeadWasTrainedOnIsRefusedNamingIt) {
   }
   settings.flow = "dis";  // the same as the metadata: fine
   EXPECT_NO_THROW(Prediction{settings});
+  // The other DIS is another flow: refused both ways.
+  settings.flow = "dis-fine";
+  testing::expect_invalid_input([&] { Prediction{settings}; }, "was trained on dis flow");
+  settings.weights = {f.fine_head.string()};
+  settings.flow = "dis";
+  testing::expect_invalid_input([&] { Prediction{settings}; },
+                                "--flow dis: the InertialNet head in " + f.fine_head.string() +
+                                    " was trained on dis-fine flow (its metadata inertialnet.head_input); leave --flow "
+                                    "out or give --flow dis-fine");
+  settings.flow = "dis-fine";
+  EXPECT_NO_THROW(Prediction{settings});
+}
+
+// The head's rates on the flows of a training set of `flow` (the same frames, sizes and input).
+std::vector<Vec3> rates_on_training_flows(const Fixture& f, FlowMethod flow, const Mat3& camera_to_body) {
+  TrainingSetOptions o;
+  o.width = kHeadWidth;
+  o.height = kHeadHeight;
+  o.flow = flow;
+  o.input = HeadInput::Normalized;
+  TrainingSet set(o);
+  set.add_sequence(f.sequence);
+  const WeightSet weights = WeightSet::load(testing::test_device(), {f.fine_head.string()});
+  InertialNetHead head(testing::test_device(), weights);
+  Queue& queue = testing::test_queue();
+  std::vector<float> input(set.flow_floats());
+  std::vector<Vec3> out;
+  for (std::size_t i = 0; i < set.size(); ++i) {
+    set.flow(i, input.data());
+    const auto w = head.compute(queue, Tensor::from_host(queue, {1, 2, kHeadHeight, kHeadWidth}, input)).to_host(queue);
+    out.push_back(mul(camera_to_body, Vec3{w[0], w[1], w[2]}));
+  }
+  return out;
+}
+
+TEST(HeadInputPredict, AHeadOfTheFineDisGetsTheFineDisWithoutAFlowOption) {
+  const Fixture& f = fixture();
+  PredictSettings settings;
+  settings.sequence = f.sequence;
+  settings.weights = {f.fine_head.string()};
+  Prediction prediction(settings);
+  EXPECT_EQ(prediction.processor().flow, FlowMethod::DISFine);
+  ASSERT_TRUE(prediction.processor().camera_to_body.has_value());
+  const Mat3 camera_to_body = *prediction.processor().camera_to_body;
+  std::vector<PairResult> results;
+  prediction.run([&](const PairResult& r) { results.push_back(r); });
+  ASSERT_EQ(results.size(), 4u);
+  const auto fine = rates_on_training_flows(f, FlowMethod::DISFine, camera_to_body);
+  const auto medium = rates_on_training_flows(f, FlowMethod::DIS, camera_to_body);
+  ASSERT_EQ(fine.size(), 4u);
+  ASSERT_EQ(medium.size(), 4u);
+  double apart = 0;  // how far the head's answers on the two DIS settings are, in units of the bound
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    ASSERT_TRUE(results[i].rates.front().ok());
+    for (std::size_t a = 0; a < 3; ++a) {
+      // The float16 bound of the test above: predict ran the fine DIS, as the training set did.
+      const double bound = 5e-5 * std::abs(fine[i][a]) + 1e-5;
+      EXPECT_NEAR(results[i].rates.front().w[a], fine[i][a], bound) << i << " " << a;
+      apart = std::max(apart, std::abs(fine[i][a] - medium[i][a]) / bound);
+    }
+  }
+  // The two settings give inputs the (one-epoch) head answers differently to, several times that
+  // bound apart: had predict run the medium DIS, the comparison above would have failed.
+  EXPECT_GT(apart, 3.0);
 }
 
 }  // namespace

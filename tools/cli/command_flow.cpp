@@ -71,7 +71,7 @@ Command register_flow(CLI::App& app, const GlobalOptions& global) {
   app.add_option("image2", o->image2, "second frame (same size)")->required()->check(CLI::ExistingFile);
   app.add_option("-w,--weights", o->weights, "FlowNet2-family weights (safetensors); repeatable");
   app.add_option("--flow", o->flow, "flownet2 (default with weights) or dis (OpenCV DIS; default without weights)")
-      ->transform(choice("flow method", {"flownet2", "dis"}));
+      ->transform(choice("flow method", {"flownet2", "dis", "dis-fine"}));
   app.add_option("--model", o->model, "flow network (default: from the weights)")
       ->transform(choice("model", flow_model_names()));
   app.add_option("-o,--output", o->flo, "write the flow as Middlebury .flo (folders created as needed)");
@@ -88,12 +88,13 @@ Command register_flow(CLI::App& app, const GlobalOptions& global) {
                           "x" + std::to_string(second.height));
     }
     const FlowMethod method = parse_flow_method(o->flow.empty() ? (o->weights.empty() ? "dis" : "flownet2") : o->flow);
-    if (method == FlowMethod::DIS && (!o->weights.empty() || o->profile || !o->model.empty())) {
-      throw invalid_input("--flow dis takes no --weights, --model or --profile: DIS runs on the host without weights");
+    if (is_dis(method) && (!o->weights.empty() || o->profile || !o->model.empty())) {
+      throw invalid_input("--flow " + to_string(method) +
+                          " takes no --weights, --model or --profile: DIS runs on the host without weights");
     }
-    if (method == FlowMethod::DIS) {
+    if (is_dis(method)) {
       const auto start = std::chrono::steady_clock::now();
-      const FlowField flow = DisFlow().compute(first, second);
+      const FlowField flow = DisFlow(dis_variant(method)).compute(first, second);
       const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       report(flow, "DIS (OpenCV, no weights)", first, seconds);
       write_outputs(*o, flow);

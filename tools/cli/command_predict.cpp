@@ -202,7 +202,10 @@ int predict_one(const PredictOptions& given, const GlobalOptions& global, const 
   const auto& infos = prediction.device_infos();
   if (!have_weights) {
     info(std::string("no weights given: weight-free ") +
-         (processor.flow == FlowMethod::LK ? "Lucas-Kanade" : "DIS") + " optical flow + geometric head");
+         (processor.flow == FlowMethod::LK        ? "Lucas-Kanade"
+          : processor.flow == FlowMethod::DISFine ? "DIS (fine)"
+                                                  : "DIS") +
+         " optical flow + geometric head");
   }
   const std::string count = !live      ? std::to_string(pairs) + " pairs"
                             : pairs > 0 ? "up to " + std::to_string(pairs) + " pairs"
@@ -445,7 +448,7 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
                  "flownet2 (default with weights), dis (OpenCV DIS; default without weights when --readout-time is "
                  "given) or lk (sparse Lucas-Kanade at the geometric head's sample points; geometric head only; "
                  "default without weights otherwise)")
-      ->transform(choice("flow method", {"flownet2", "dis", "lk"}));
+      ->transform(choice("flow method", {"flownet2", "dis", "dis-fine", "lk"}));
   app.add_option("--head", o->head, "inertialnet (default with weights), geometric (default without), or both")
       ->transform(choice("head", {"inertialnet", "geometric", "both"}));
   app.add_option("--solver", o->solver, "geometric head's solver")

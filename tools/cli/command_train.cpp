@@ -138,7 +138,10 @@ Command register_train(CLI::App& app, const GlobalOptions& global) {
   app.add_option("--T-cam-imu", o->T_cam_imu,
                  "for ROS bags: IMU-to-camera transform, 16 numbers (4x4 row-major, Kalibr's T_cam_imu) or a YAML file "
                  "with T_cam_imu (or T_BS as cam0/sensor.yaml writes it); default: identity");
-  app.add_option("--flow", o->flow, "dis (weight-free) or flownet2 (needs --weights)")->capture_default_str();
+  app.add_option("--flow", o->flow,
+                 "dis (weight-free), dis-fine (DIS down to the full resolution: recipe general's since v3) "
+                 "or flownet2 (needs --weights)")
+      ->capture_default_str();
   app.add_option("--weights", o->weights, "FlowNet2 weights, for --flow flownet2");
   app.add_option("--epochs", o->epochs, "epochs")->capture_default_str()->check(CLI::Range(1, 100000));
   app.add_option("--batch", o->batch, "mini-batch size")->capture_default_str()->check(CLI::Range(1, 100000));

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // The weight-free flow estimator: OpenCV's DIS optical flow (Kroeger et al., "Fast Optical Flow
-// using Dense Inverse Search", 2016) at its MEDIUM preset, on the frames' BT.601 luminance.
+// using Dense Inverse Search", 2016) at its MEDIUM preset, on the frames' BT.601 luminance; or
+// that preset refined down to the full resolution (DisVariant::Fine, `--flow dis-fine`).
 //
 // It runs through OpenCV's T-API (UMat), so on OpenCL where OpenCV can. `predict --flow dis`,
 // `flow --flow dis` and the Python package's dis_flow() all go through this one class, so they
@@ -18,9 +19,24 @@ namespace inertialnet {
 // assertion. Twice the patch leaves one pyramid level to refine.
 constexpr int kDisMinimumSide = 16;
 
+// Which settings DIS runs with. They are part of what a trained InertialNet head learned (a head
+// fed another DIS than its own sees another error pattern), so each is its own flow method with
+// its own name (`--flow dis`, `--flow dis-fine`; a head's metadata "flow"), never a silent switch.
+enum class DisVariant {
+  // PRESET_MEDIUM as OpenCV defines it: 8×8 patches matched and refined from the coarsest pyramid
+  // level down to the half-resolution one (finest scale 1), then upsampled and variationally
+  // refined. At the small sizes an InertialNet head is trained on (128–240 columns) the patches are
+  // matched on a 64–120-column image: the geometric head on it is 2–4× worse than on LK's points.
+  Medium,
+  // The same preset with the patch search carried down to the full resolution (finest scale 0),
+  // nothing else changed. Chosen on synthetic sequences (docs/training.md, "A finer DIS for the
+  // learned head"): the geometric head's RMSE on it falls 2–7× on 200–320-column cameras.
+  Fine,
+};
+
 class DisFlow {
  public:
-  DisFlow();
+  explicit DisFlow(DisVariant variant = DisVariant::Medium);
   ~DisFlow();
   DisFlow(const DisFlow&) = delete;
   DisFlow& operator=(const DisFlow&) = delete;

@@ -28,9 +28,10 @@ HeadInput parse_head_input(const std::string& text);  // invalid_input listing t
 inline constexpr const char* kMetadataHeadInput = "inertialnet.head_input";
 
 // How a head was trained: its input convention, the flow method it learned from ("dis",
-// "flownet2"; empty when unknown), and the frame of the rates it answers in. A head trained on
-// body-frame (gyro) targets has learned its training rig's camera-to-IMU rotation with the motion:
-// on another rig its rates come out in the wrong frame. A normalized head is therefore trained on
+// "dis-fine", "flownet2"; empty when unknown: each is another flow, pipeline/rates_processor.hpp),
+// and the frame of the rates it answers in. A head trained on body-frame (gyro) targets has
+// learned its training rig's camera-to-IMU rotation with the motion: on another rig its rates
+// come out in the wrong frame. A normalized head is therefore trained on
 // camera-frame targets and `predict` turns its answer into the body frame with the sequence's own
 // rotation; paper heads (and normalized heads written before, without "frame") answer in the body
 // frame of the rig they were trained on.

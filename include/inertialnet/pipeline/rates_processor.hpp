@@ -13,6 +13,7 @@
 #include <optional>
 
 #include "inertialnet/io/camera.hpp"
+#include "inertialnet/models/dis_flow.hpp"
 #include "inertialnet/models/geometric_head.hpp"
 #include "inertialnet/models/head_input.hpp"
 #include "inertialnet/models/head_uncertainty.hpp"
@@ -24,10 +25,15 @@
 
 namespace inertialnet {
 
-// LK: sparse, for the geometric head alone (the InertialNet head needs a dense field).
-enum class FlowMethod { FlowNet, DIS, LK };
-std::string to_string(FlowMethod method);           // "flownet2", "dis", "lk"
+// LK: sparse, for the geometric head alone (the InertialNet head needs a dense field). DIS and
+// DISFine are OpenCV's DIS at two settings (models/dis_flow.hpp, DisVariant): one method each, so
+// that a head trained on one is never fed the other.
+enum class FlowMethod { FlowNet, DIS, LK, DISFine };
+std::string to_string(FlowMethod method);           // "flownet2", "dis", "lk", "dis-fine"
 FlowMethod parse_flow_method(const std::string& text);  // invalid_input listing the choices
+// Whether the method is DIS at either of its settings, and which.
+bool is_dis(FlowMethod method);
+DisVariant dis_variant(FlowMethod method);  // DisVariant::Medium for a method that is not DIS
 
 struct RatesProcessorOptions {
   FlowMethod flow = FlowMethod::FlowNet;
