@@ -2,13 +2,15 @@
 // The split-K convolution forms for GPUs (src/ops/conv2d_splitk.hpp), forced on the test device
 // (PoCL in CI, where the plan never chooses them) against the direct convolution of
 // tests/reference/conv.cpp with the bounds of test_conv2d: odd sizes, a single pixel, channel
-// slices, batches, FlowNet2's real layer shapes; and the selection rule (GPU devices only).
+// slices, batches, FlowNet2's real layer shapes; and the selection rules (GPU devices only).
+// The sliced form runs its products on the plan's backend: the suite runs under every plan.
 #include <cmath>
 #include <string>
 #include <vector>
 
 #include "inertialnet/ops/conv2d.hpp"
 #include "inertialnet/ops/gemm/plan.hpp"
+#include "ops/conv2d_slices.hpp"
 #include "ops/conv2d_splitk.hpp"
 #include "ops/op_testing.hpp"
 #include "reference/conv.hpp"
@@ -26,6 +28,7 @@ struct SplitCase {
   int batch = 1;
   // Extra channels around the input and the output view (0: plain contiguous tensors).
   int in_before = 0, in_after = 0, out_before = 0, out_after = 0;
+  std::size_t max_column_floats = 0;
 };
 
 SplitCase from_layer(const flownet_layers::LayerShape& l) {
@@ -47,7 +50,7 @@ void expect_form_matches(const SplitCase& c, Conv2dAlgorithm algorithm) {
       testing::make_sliced(queue, {c.batch, c.co, oh, ow}, c.out_before, c.out_before + c.out_after, 205);
   const Tensor w = Tensor::from_host(queue, {c.co, c.ci, c.k, c.k}, weight);
   const Tensor b = c.bias ? Tensor::from_host(queue, {c.co}, bias) : Tensor();
-  Conv2dOptions options{c.stride, c.padding, c.activation};
+  Conv2dOptions options{c.stride, c.padding, c.activation, c.max_column_floats};
   options.algorithm = algorithm;
   conv2d(queue, in.view, w, b, out.view, options);
   EXPECT_TRUE(testing::untouched_outside(queue, out)) << "elements outside the output slice were written";
@@ -132,6 +135,69 @@ TEST(Conv2dSplitKGroup, ChosenOnGpusOnlyForFewOutputChannels) {
   if (testing::test_device().info().type == DeviceType::CPU) {
     EXPECT_FALSE(detail::splitk_group_preferred(testing::test_device().info(), predict_flow6));
   }
+}
+
+// --- split-K in slices (deep reductions on small images) ------------------------------------------
+
+TEST(Conv2dSplitKSlices, SliceCountDividesTheReduction) {
+  EXPECT_EQ(detail::splitk_slice_count(9 * 512), 8u);
+  EXPECT_EQ(detail::splitk_slice_count(9 * 1024), 8u);
+  EXPECT_EQ(detail::splitk_slice_count(9 * 7), 7u);
+  EXPECT_EQ(detail::splitk_slice_count(9 * 5), 5u);
+  EXPECT_EQ(detail::splitk_slice_count(13), 1u);  // a prime beyond 8: one slice
+  EXPECT_EQ(detail::splitk_slice_count(1), 1u);
+}
+
+// Reductions that split into 7, 5, 3 and 1 slices (odd ci, K prime), a single output pixel,
+// odd planes, strides and windows, a partial-pixel budget (several pixel ranges per sample).
+TEST(Conv2dSplitKSlices, OddSizes) {
+  const auto leaky = ActivationSpec::leaky_relu(0.1f);
+  const auto form = Conv2dAlgorithm::SplitKSlices;
+  expect_form_matches({"k3_ci7_s7", 7, 9, 13, 11, 3, 1, 1, true, leaky}, form);
+  expect_form_matches({"k3_ci5_s5_nobias", 5, 6, 9, 7, 3, 2, 1, false, ActivationSpec::none()}, form);
+  expect_form_matches({"k1_ci13_prime", 13, 5, 5, 3, 1, 1, 0, true, ActivationSpec::relu()}, form);
+  expect_form_matches({"one_pixel", 11, 4, 1, 1, 3, 1, 1, true, leaky}, form);
+  expect_form_matches({"k5s2", 3, 7, 17, 9, 5, 2, 2, true, ActivationSpec::relu()}, form);
+  expect_form_matches({"deep_odd", 515, 9, 5, 3, 3, 1, 1, true, leaky}, form);
+  SplitCase ranges{"pixel_ranges", 7, 9, 13, 11, 3, 1, 1, true, leaky, 2};
+  ranges.max_column_floats = 7 * 9 * 20;  // 20 pixels per range: 8 ranges, the last partial
+  expect_form_matches(ranges, form);
+}
+
+TEST(Conv2dSplitKSlices, BatchesAndChannelSlices) {
+  const auto leaky = ActivationSpec::leaky_relu(0.1f);
+  expect_form_matches({"slices", 6, 10, 7, 9, 3, 1, 1, true, leaky, 3, 2, 3, 1, 4}, Conv2dAlgorithm::SplitKSlices);
+}
+
+// FlowNet2's deep layers on small images (K ≥ 9·512 and ≤ 192 output pixels: conv4_1…conv6_1
+// and FlowNetSD's deep ones) at a 192×256 network input, half the real size so that the
+// float64 reference stays quick; the reduction lengths and channel counts are the real ones.
+TEST(Conv2dSplitKSlices, FlowNet2DeepLayerShapes) {
+  int layers = 0;
+  for (const auto& layer : flownet_layers::flownet2_layers(192, 256, flownet_layers::LayerKind::Conv)) {
+    const auto depth = static_cast<std::size_t>(layer.ci) * layer.k * layer.k;
+    const auto pixels = static_cast<std::size_t>(layer.out_h()) * layer.out_w();
+    if (layer.co <= kDirectConvMaxChannels || depth < detail::kSlicedMinDepth || pixels > detail::kSlicedMaxPixels) {
+      continue;
+    }
+    expect_form_matches(from_layer(layer), Conv2dAlgorithm::SplitKSlices);
+    ++layers;
+  }
+  EXPECT_GE(layers, 6);
+}
+
+// Chosen on non-CPU devices on the CLBlast backend for deep reductions on small images only.
+TEST(Conv2dSplitKSlices, ChosenOnGpusOnlyForDeepSmallLayers) {
+  const DeviceInfo gpu = device_of_type(DeviceType::GPU), cpu = device_of_type(DeviceType::CPU);
+  const Shape conv6_1{1024, 1024, 3, 3}, conv5{512, 512, 3, 3};
+  EXPECT_TRUE(detail::splitk_slices_preferred(gpu, GemmBackend::CLBlast, conv6_1, 48));
+  EXPECT_TRUE(detail::splitk_slices_preferred(gpu, GemmBackend::CLBlast, conv5, 192));
+  EXPECT_FALSE(detail::splitk_slices_preferred(gpu, GemmBackend::CLBlast, conv5, 193));  // a larger image
+  EXPECT_FALSE(detail::splitk_slices_preferred(gpu, GemmBackend::CLBlast, {512, 256, 3, 3}, 48));  // K 2,304
+  EXPECT_FALSE(detail::splitk_slices_preferred(gpu, GemmBackend::CLBlast, {2, 1024, 3, 3}, 48));   // predict_flow
+  EXPECT_FALSE(detail::splitk_slices_preferred(gpu, GemmBackend::Packed, conv6_1, 48));  // a forced packed plan
+  EXPECT_FALSE(detail::splitk_slices_preferred(cpu, GemmBackend::CLBlast, conv6_1, 48));
+  EXPECT_FALSE(detail::splitk_slices_preferred(cpu, GemmBackend::Packed, conv6_1, 48));
 }
 
 }  // namespace

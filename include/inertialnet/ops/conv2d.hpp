@@ -25,8 +25,10 @@ namespace inertialnet {
 // direct kernel for ≤ kDirectConvMaxChannels outputs; on other devices the split-K forms where
 // their rules say, src/ops/conv2d_splitk.hpp); the others force one (tests). SplitKGroup (one
 // work-group per few pixels, the reduction split across its work-items) on a layer of more than
-// kDirectConvMaxChannels outputs is invalid_input.
-enum class Conv2dAlgorithm { Default, SplitKGroup };
+// kDirectConvMaxChannels outputs is invalid_input. SplitKSlices (the reduction cut into slices
+// run as one strided-batched GEMM on the device's backend, then summed with bias and activation,
+// src/ops/conv2d_slices.hpp) takes any layer.
+enum class Conv2dAlgorithm { Default, SplitKGroup, SplitKSlices };
 
 struct Conv2dOptions {
   int stride = 1;
