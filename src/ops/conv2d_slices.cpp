@@ -7,6 +7,7 @@
 #include "inertialnet/ops/gemm/gemm.hpp"
 #include "inertialnet/ops/gemm/plan.hpp"
 #include "inertialnet/runtime/device.hpp"
+#include "ops/conv2d_splitk.hpp"
 #include "ops/op_support.hpp"
 
 namespace inertialnet::detail {
@@ -22,7 +23,7 @@ constexpr std::size_t kMaxSlices = 8;
 
 bool splitk_slices_preferred(const DeviceInfo& device, GemmBackend backend, const Shape& weight,
                              std::size_t output_pixels) {
-  if (device.type == DeviceType::CPU || backend != GemmBackend::CLBlast || weight.size() != 4) return false;
+  if (splitk_forms_disabled() || device.type == DeviceType::CPU || backend != GemmBackend::CLBlast || weight.size() != 4) return false;
   const auto depth = static_cast<std::size_t>(weight[1] * weight[2] * weight[3]);
   return weight[0] > kDirectConvMaxChannels && depth >= kSlicedMinDepth && output_pixels <= kSlicedMaxPixels;
 }

@@ -26,7 +26,8 @@ inline constexpr std::size_t kSlicedMaxPixels = 192;
 // Whether a convolution with weights [co, ci, kh, kw] and `output_pixels` outputs per channel
 // and sample runs the sliced form by default: on a non-CPU device, on the CLBlast backend (the
 // GPU backend; a plan that forces the packed kernels keeps them), co > kDirectConvMaxChannels,
-// K ≥ kSlicedMinDepth and output_pixels ≤ kSlicedMaxPixels.
+// K ≥ kSlicedMinDepth and output_pixels ≤ kSlicedMaxPixels; never under INERTIALNET_SPLITK=0
+// (conv2d_splitk.hpp).
 bool splitk_slices_preferred(const DeviceInfo& device, GemmBackend backend, const Shape& weight,
                              std::size_t output_pixels);
 

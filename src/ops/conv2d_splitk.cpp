@@ -2,6 +2,7 @@
 #include "ops/conv2d_splitk.hpp"
 
 #include <cstdint>
+#include <cstdlib>
 #include <string>
 
 #include "inertialnet/ops/gemm/plan.hpp"
@@ -22,7 +23,13 @@ constexpr std::size_t kGroupSize = 64;
 
 }  // namespace
 
+bool splitk_forms_disabled() {
+  const char* setting = std::getenv(kSplitKEnvironmentVariable);
+  return setting && std::string(setting) == "0";
+}
+
 bool splitk_group_preferred(const DeviceInfo& device, const Shape& weight) {
+  if (splitk_forms_disabled()) return false;
   return device.type != DeviceType::CPU && weight.size() == 4 && weight[0] <= kDirectConvMaxChannels;
 }
 

@@ -16,9 +16,16 @@
 
 namespace inertialnet::detail {
 
+// INERTIALNET_SPLITK=0 keeps both split-K forms (this one and conv2d_slices.hpp's) out of the
+// default choice, so that a GPU run can measure the paths they replace in the same binary,
+// interleaved (docs/performance.md, "Split-K forms for GPUs"); forcing one still runs it.
+inline constexpr const char* kSplitKEnvironmentVariable = "INERTIALNET_SPLITK";
+bool splitk_forms_disabled();
+
 // Whether a convolution with weights [co, ci, kh, kw] runs the split-K form by default on
 // `device`: every non-CPU device (as gemv_rows for one-sample linear layers), co ≤
-// kDirectConvMaxChannels (the layers the direct kernel takes on CPUs), under any plan.
+// kDirectConvMaxChannels (the layers the direct kernel takes on CPUs), under any plan, unless
+// INERTIALNET_SPLITK=0.
 bool splitk_group_preferred(const DeviceInfo& device, const Shape& weight);
 
 // output = activation(conv(input, weight) + bias) with the split-K kernel; shapes checked by the

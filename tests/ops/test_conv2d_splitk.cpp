@@ -200,5 +200,20 @@ TEST(Conv2dSplitKSlices, ChosenOnGpusOnlyForDeepSmallLayers) {
   EXPECT_FALSE(detail::splitk_slices_preferred(cpu, GemmBackend::Packed, conv6_1, 48));
 }
 
+// INERTIALNET_SPLITK=0 takes both forms out of the default choice (to measure the paths they
+// replace on a GPU); any other value, or none, leaves the rules as they are.
+TEST(Conv2dSplitK, EnvironmentTurnsTheDefaultChoiceOff) {
+  const DeviceInfo gpu = device_of_type(DeviceType::GPU);
+  const Shape predict_flow6{2, 1024, 3, 3}, conv6_1{1024, 1024, 3, 3};
+  {
+    const testing::ScopedEnvironment off(detail::kSplitKEnvironmentVariable, "0");
+    EXPECT_FALSE(detail::splitk_group_preferred(gpu, predict_flow6));
+    EXPECT_FALSE(detail::splitk_slices_preferred(gpu, GemmBackend::CLBlast, conv6_1, 48));
+  }
+  const testing::ScopedEnvironment other(detail::kSplitKEnvironmentVariable, "1");
+  EXPECT_TRUE(detail::splitk_group_preferred(gpu, predict_flow6));
+  EXPECT_TRUE(detail::splitk_slices_preferred(gpu, GemmBackend::CLBlast, conv6_1, 48));
+}
+
 }  // namespace
 }  // namespace inertialnet
