@@ -23,9 +23,10 @@ constexpr std::size_t kMaxSlices = 8;
 
 bool splitk_slices_preferred(const DeviceInfo& device, GemmBackend backend, const Shape& weight,
                              std::size_t output_pixels) {
-  if (splitk_forms_disabled() || device.type == DeviceType::CPU || backend != GemmBackend::CLBlast || weight.size() != 4) return false;
+  if (device.type == DeviceType::CPU || backend != GemmBackend::CLBlast || weight.size() != 4) return false;
   const auto depth = static_cast<std::size_t>(weight[1] * weight[2] * weight[3]);
-  return weight[0] > kDirectConvMaxChannels && depth >= kSlicedMinDepth && output_pixels <= kSlicedMaxPixels;
+  return weight[0] > kDirectConvMaxChannels && depth >= kSlicedMinDepth && output_pixels <= kSlicedMaxPixels &&
+         !splitk_forms_disabled();
 }
 
 std::size_t splitk_slice_count(std::size_t depth) {

@@ -29,8 +29,9 @@ bool splitk_forms_disabled() {
 }
 
 bool splitk_group_preferred(const DeviceInfo& device, const Shape& weight) {
-  if (splitk_forms_disabled()) return false;
-  return device.type != DeviceType::CPU && weight.size() == 4 && weight[0] <= kDirectConvMaxChannels;
+  // The device type first: CPU runs never read the environment for it.
+  if (device.type == DeviceType::CPU || weight.size() != 4 || weight[0] > kDirectConvMaxChannels) return false;
+  return !splitk_forms_disabled();
 }
 
 void conv2d_splitk_group(Queue& queue, const Tensor& input, const Tensor& weight, const Tensor& bias,
