@@ -47,8 +47,11 @@ void conv2d_slices(Queue& queue, const Tensor& input, const Tensor& weight, cons
   const std::size_t pixels = out_h * out_w;     // GEMM n (per sample)
   const std::size_t slices = splitk_slice_count(depth);
   const std::size_t slice_depth = depth / slices;
-  // A range of output pixels at a time within the column budget, as the unsliced GEMM path.
-  const std::size_t chunk = std::clamp<std::size_t>(column_budget(device, options.max_column_floats) / depth, 1, pixels);
+  // A range of output pixels at a time within the column budget, as the unsliced GEMM path; the
+  // S·co partial rows per pixel count against it too (conv6: 8·1,024 of them against K = 4,608).
+  const std::size_t rows_per_pixel = std::max(depth, slices * out_channels);
+  const std::size_t chunk =
+      std::clamp<std::size_t>(column_budget(device, options.max_column_floats) / rows_per_pixel, 1, pixels);
   const Tensor columns = Tensor::empty(queue, {static_cast<std::int64_t>(depth), static_cast<std::int64_t>(chunk)});
   const Tensor partial =
       Tensor::empty(queue, {static_cast<std::int64_t>(slices * out_channels), static_cast<std::int64_t>(chunk)});

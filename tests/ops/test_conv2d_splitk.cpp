@@ -162,6 +162,10 @@ TEST(Conv2dSplitKSlices, OddSizes) {
   SplitCase ranges{"pixel_ranges", 7, 9, 13, 11, 3, 1, 1, true, leaky, 2};
   ranges.max_column_floats = 7 * 9 * 20;  // 20 pixels per range: 8 ranges, the last partial
   expect_form_matches(ranges, form);
+  // More partial rows (7 slices × 30 channels) than K (63): they set the range, 3 pixels.
+  SplitCase wide{"partials_set_the_range", 7, 30, 13, 11, 3, 1, 1, true, leaky};
+  wide.max_column_floats = 7 * 30 * 3;
+  expect_form_matches(wide, form);
 }
 
 TEST(Conv2dSplitKSlices, BatchesAndChannelSlices) {
