@@ -8,6 +8,8 @@
 #include "inertialnet/runtime/device.hpp"
 #include "inertialnet/ops/bias_activation.hpp"
 #include "inertialnet/ops/gemm/gemm.hpp"
+#include "ops/conv2d_slices.hpp"
+#include "ops/conv2d_splitk.hpp"
 #include "ops/op_support.hpp"
 #include "ops/winograd.hpp"
 
@@ -117,7 +119,21 @@ void conv2d(Queue& queue, const Tensor& input, const Tensor& weight, const Tenso
   }
 
   Device& device = queue.device();
+  if (options.algorithm == Conv2dAlgorithm::SplitKGroup ||
+      (options.algorithm == Conv2dAlgorithm::Default && detail::splitk_group_preferred(device.info(), weight.shape()))) {
+    detail::report_backend(queue, "splitk");
+    detail::conv2d_splitk_group(queue, input, weight, bias, output, options);
+    return;
+  }
   const GemmBackend backend = options.prepared ? options.prepared->backend : gemm_backend(device.info());
+  const auto output_pixels = static_cast<std::size_t>(expected[2] * expected[3]);
+  if (options.algorithm == Conv2dAlgorithm::SplitKSlices ||
+      (options.algorithm == Conv2dAlgorithm::Default &&
+       detail::splitk_slices_preferred(device.info(), backend, weight.shape(), output_pixels))) {
+    detail::report_backend(queue, "splitk_slices");
+    detail::conv2d_slices(queue, input, weight, bias, output, options);
+    return;
+  }
   // Prepared weights say which form the layer runs (prepare_conv2d_weights applied the shape
   // rule); without them the rule decides here.
   const bool winograd = backend == GemmBackend::Winograd &&

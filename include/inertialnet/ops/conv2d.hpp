@@ -21,6 +21,15 @@
 
 namespace inertialnet {
 
+// How a layer runs: Default is the plan's choice (the backend's GEMM or Winograd form; on CPUs the
+// direct kernel for ≤ kDirectConvMaxChannels outputs; on other devices the split-K forms where
+// their rules say, src/ops/conv2d_splitk.hpp); the others force one (tests). SplitKGroup (one
+// work-group per few pixels, the reduction split across its work-items) on a layer of more than
+// kDirectConvMaxChannels outputs is invalid_input. SplitKSlices (the reduction cut into slices
+// run as one strided-batched GEMM on the device's backend, then summed with bias and activation,
+// src/ops/conv2d_slices.hpp) takes any layer.
+enum class Conv2dAlgorithm { Default, SplitKGroup, SplitKSlices };
+
 struct Conv2dOptions {
   int stride = 1;
   int padding = 0;  // zeros on every side
@@ -32,6 +41,7 @@ struct Conv2dOptions {
   // The weights prepared for their backend once per layer (ops/gemm/plan.hpp); null: the
   // device's backend, with the weights packed on this call when it needs them packed.
   const GemmWeights* prepared = nullptr;
+  Conv2dAlgorithm algorithm = Conv2dAlgorithm::Default;
 };
 
 // The output shape [N, co, Ho, Wo] of `input` [N, ci, H, W] convolved with `weight`
