@@ -133,7 +133,7 @@ inline RowLayout row_layout(std::initializer_list<const Tensor*> tensors) {
 }
 
 // Tells a profiling queue which implementation ran the current layer ("clblast", "packed",
-// "direct", "gemv"), so per-layer profiles show the plan as it ran, not as it was assumed.
+// "winograd", "direct", "gemv", "splitk", "splitk_slices"), so per-layer profiles show the plan as it ran, not as it was assumed.
 inline void report_backend(const Queue& queue, const char* backend) {
   if (LayerProfiler* profiler = queue.profiler()) profiler->set_backend(queue, backend);
 }

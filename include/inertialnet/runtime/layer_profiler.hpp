@@ -26,7 +26,8 @@ struct LayerInfo {
   std::string name;
   std::string kind;
   double flops = 0;
-  std::string backend;  // "clblast", "packed", "direct", "gemv" for GEMM-based layers; "" for the others
+  std::string backend;  // "clblast", "packed", "winograd", "direct", "gemv", "splitk", "splitk_slices"
+                        // for GEMM-based layers; "" for the others
 };
 
 struct LayerTime {
