@@ -15,6 +15,10 @@ namespace {
 constexpr std::size_t kElements = kWinogradElements;  // a 6×6 transform: one GEMM per element
 constexpr std::size_t kTile = 4;                      // output pixels per tile side
 constexpr std::size_t kTileWidth = kPackedColumns;
+// Input channels per work-item of the input transform (kernels_cl/winograd.cl): enough work per
+// work-group that starting one costs little beside it, few enough blocks of channels that the
+// deep layers' single panel of tiles still gives both cores work (ci = 512: 64 work-items).
+constexpr std::size_t kInputChannelBlock = 8;
 
 int checked_int(std::size_t value, const char* what) {
   if (value > static_cast<std::size_t>(INT32_MAX)) {
@@ -93,9 +97,11 @@ void conv2d_winograd(Queue& queue, const Tensor& input, const std::vector<Packed
       const std::size_t count_floats = PackedPanels::floats(count, channels, static_cast<int>(kTileWidth));
       forward.set_args(in_n, v, checked_int(channels, "channels"), static_cast<int>(input.h()),
                        static_cast<int>(input.w()), checked_int(tiles_w, "tiles"), checked_int(first, "tile"),
-                       checked_int(count, "tiles"), checked_int(count_floats, "panels"));
-      // 16 tiles per work-item, one per vector lane (kernels_cl/winograd.cl).
-      queue.launch(forward, Range(padded / 16, channels), Range(1, 1));
+                       checked_int(count, "tiles"), checked_int(count_floats, "panels"),
+                       static_cast<int>(kInputChannelBlock));
+      // A panel of 32 tiles in a block of channels per work-item (kernels_cl/winograd.cl).
+      queue.launch(forward, Range(padded / kTileWidth, (channels + kInputChannelBlock - 1) / kInputChannelBlock),
+                   Range(1, 1));
       // Without a bias the kernel never reads its bias argument; any valid buffer will do.
       product.set_args(u.data, v, checked_int(count_floats, "panels"), out_n, has_bias ? bias : v,
                        checked_int(out_channels, "channels"), checked_int(channels, "channels"),
