@@ -40,6 +40,11 @@ bool winograd_preferred(const Shape& input, const Shape& weight, int stride) {
   return ((input[2] + 3) / 4) * ((input[3] + 3) / 4) >= kWinogradMinTiles;
 }
 
+int winograd_tile_rows(std::int64_t co, std::int64_t ci, int device_rows) {
+  if (ci >= kWinogradDeepChannels && device_rows >= 8) return kWinogradDeepTileRows;
+  return packed_gemm_tile_rows(static_cast<std::size_t>(co), 0, device_rows);
+}
+
 std::vector<PackedPanels> winograd_weights(Queue& queue, const Tensor& weight, Device* long_lived) {
   if (!winograd_eligible(weight.shape(), 1) || !weight.contiguous()) {
     throw invalid_input("winograd: the weights must be a contiguous [co ≥ 16, ci ≥ 32, 3, 3] tensor, got " +
@@ -48,7 +53,8 @@ std::vector<PackedPanels> winograd_weights(Queue& queue, const Tensor& weight, D
   const auto co = static_cast<std::size_t>(weight.dim(0)), ci = static_cast<std::size_t>(weight.dim(1));
   // Each element's matrix is padded to whole MR-row panels, so that the 36 of them pack as one
   // matrix of 36·padded rows whose panels never straddle two elements.
-  const auto rows = static_cast<std::size_t>(packed_gemm_tile_rows(co, 0, packed_gemm_setting(queue.device(), "MR")));
+  const auto rows = static_cast<std::size_t>(winograd_tile_rows(weight.dim(0), weight.dim(1),
+                                                                 packed_gemm_setting(queue.device(), "MR")));
   const std::size_t padded = (co + rows - 1) / rows * rows;
   const std::size_t pairs = padded * ci;
   const Tensor u = Tensor::empty(queue, {static_cast<std::int64_t>(kElements * pairs)});
