@@ -48,9 +48,9 @@ bool winograd_preferred(const Shape& input, const Shape& weight, int stride);
 // Input channels from which the products run on the widest register tile, kWinogradDeepTileRows
 // rows of U per 32 tiles instead of the device's MR: a work-item's 36 B panels (36·32·ci floats,
 // 1.7 MiB at ci = 384) no longer stay in the core's cache between work-items, and more rows per
-// B vector load need fewer of them per FMA (docs/performance.md, "Issue 24, fifth pass": the
-// 512×384 layers of ci ≥ 386 ran their products 12–25 % faster with 12 or 14 rows than with 8,
-// those of ci ≤ 256 no faster or slower, the padding of small co to 14 rows included).
+// B vector load need fewer of them per FMA (docs/performance.md, "Issue 24, fifth pass
+// (Winograd)": the 512×384 layers of ci ≥ 386 ran their products 11–30 % faster with 14 rows
+// than with 8, those of ci ≤ 256 no faster or slower, the padding of small co included).
 inline constexpr std::int64_t kWinogradDeepChannels = 384;
 inline constexpr int kWinogradDeepTileRows = 14;
 
