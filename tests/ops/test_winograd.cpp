@@ -186,6 +186,9 @@ TEST(Winograd, DeepLayersUseTheWidestRegisterTile) {
   const auto leaky = ActivationSpec::leaky_relu(0.1f);
   expect_winograd_matches({"deep_co20", 390, 20, 11, 9, 1, 1, true, leaky}, {2});
   expect_winograd_matches({"deep_co30_tiles", 384, 30, 16, 40, 1, 1, false, ActivationSpec::none()}, {1}, true, true);
+  // 24×32 outputs as FlowNet2's conv4_1: 48 tiles, the second 32-tile panel half padding, whose
+  // products run on its low 16 columns alone (kernels_cl/winograd_gemm.cl); batch 2.
+  expect_winograd_matches({"conv4_1_like", 384, 16, 24, 32, 1, 1, true, leaky}, {2}, true, true);
   Queue& queue = testing::test_queue();
   const Tensor w = Tensor::from_host(queue, {30, 384, 3, 3}, testing::random_vector(30 * 384 * 9, 7));
   const GemmWeights prepared = prepare_conv2d_weights(queue, w, GemmBackend::Winograd, 1, Shape{});
