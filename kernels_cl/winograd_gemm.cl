@@ -5,7 +5,8 @@
 // (packed_tile.cl) over the ci input channels, U_e's A panel against V_e's B panel (its low 16
 // columns alone where the other 16 are padding), and parks the MR×32 product in local memory
 // (36·MR·32 floats: 36 KiB at MR = 8, reused by every work-group a thread runs, so it stays in the
-// core's cache); then Y = Aᵀ m A, bias and activation go from there straight into the output. The 36 products never reach global memory.
+// core's cache); then Y = Aᵀ m A, bias and activation go from there straight into the output.
+// The 36 products never reach global memory.
 //
 // U: the 36 matrices [co_pad × ci] (co_pad = co rounded up to MR) packed as one matrix of
 // 36·co_pad rows in MR-row panels: element e's panel p is panel e·(co_pad / MR) + p.
