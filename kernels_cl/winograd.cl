@@ -73,67 +73,86 @@ inline float16 every_fourth(const float16 a, const float16 b, const float16 c, c
 
 // V = Bᵀ d B of the 6×6 input windows of tiles [first, first + count) of one sample, written as
 // 36 matrices [channels × count] packed in panels of 32 columns (gemm_packed.cl's B layout),
-// matrix e = 6·i + k at e·element_floats. Work-item (g, c) takes the 16 tiles from 16·g of the
-// range in channel c, one float16 lane per tile, and writes 16 consecutive floats of each matrix;
-// tiles past `count` are zeros, so every panel is whole. When the 16 tiles lie side by side in
-// one tile row, each window row is one stretch of 68 input floats, read as vectors and split into
-// the 6 columns by shuffles; otherwise every lane reads its own window.
-// Launch (ceil(count / 32) · 2, channels) work-items in work-groups of one.
+// matrix e = 6·i + k at e·element_floats. Work-item (p, b) takes the 32 tiles of panel p in
+// channels [b·channel_block, (b + 1)·channel_block): channel by channel, both halves of the
+// panel (16 tiles each, one float16 lane per tile) one after the other, so that it reads each
+// window row as one stretch and writes 32 consecutive floats of each matrix per channel, the
+// channels of its block one after another (one stretch of 32·channel_block floats per matrix);
+// tiles past `count` are zeros, so every panel is whole. (A work-item per 16 tiles and channel,
+// as this kernel first had, ran FlowNetFusion inter_conv0's transform in 63k work-groups and
+// took 1.4–2× as long: docs/performance.md.) When the 16 tiles lie side by side in one tile
+// row, each window row is one stretch of 68 input floats, read as whole vectors (element by
+// element only in a vector that crosses the plane's left or right edge: at the 48×64 and 96×128
+// layers every group of 16 tiles touches an edge) and split into the 6 columns by shuffles;
+// otherwise every lane reads its own window.
+// Launch (ceil(count / 32), ceil(channels / channel_block)) work-items in work-groups of one.
 __kernel void winograd_input(__global const float* restrict in, const int in_offset, __global float* restrict v,
                              const int v_offset, const int channels, const int height, const int width,
-                             const int tiles_w, const int first, const int count, const int element_floats) {
-  const int g = get_global_id(0), c = get_global_id(1);
-  const int lane0 = 16 * g;  // the first tile of this work-item within the range
-  const int lanes = clamp(count - lane0, 0, 16);
-  const int tile0 = first + lane0;
-  const int ty = tile0 / tiles_w, tx = tile0 - ty * tiles_w;
-  const bool whole = lanes == 16 && tx + 16 <= tiles_w;
-  __global const float* plane = in + in_offset + (size_t)c * height * width;
-  float16 e[WINDOW][WINDOW];  // d B: row r of every window
-  for (int r = 0; r < WINDOW; ++r) {
-    float16 d[WINDOW];  // column q of window row r, per lane
-    if (whole) {
-      const int y = TILE * ty + r - PAD, x0 = TILE * tx - PAD;
-      float row[80];  // input columns x0 … x0 + 67 of row y (the rest unused), zeros outside the plane
-      if (y >= 0 && y < height && x0 >= 0 && x0 + 80 <= width) {
-        __global const float* src = plane + (size_t)y * width + x0;
-        for (int k = 0; k < 5; ++k) vstore16(vload16(k, src), k, row);
-      } else {
-        const bool row_in = y >= 0 && y < height;
-        for (int k = 0; k < 68; ++k) {
-          const int x = x0 + k;
-          row[k] = row_in && x >= 0 && x < width ? plane[(size_t)y * width + x] : 0.0f;
+                             const int tiles_w, const int first, const int count, const int element_floats,
+                             const int channel_block) {
+  const int p = get_global_id(0);
+  const int c_first = get_global_id(1) * channel_block, c_end = min(channels, c_first + channel_block);
+  for (int c = c_first; c < c_end; ++c) {
+    for (int part = 0; part < 2; ++part) {
+      const int lane0 = 32 * p + 16 * part;  // the first tile of these 16 within the range
+      const int lanes = clamp(count - lane0, 0, 16);
+      const int tile0 = first + lane0;
+      const int ty = tile0 / tiles_w, tx = tile0 - ty * tiles_w;
+      const bool whole = lanes == 16 && tx + 16 <= tiles_w;
+      __global const float* plane = in + in_offset + (size_t)c * height * width;
+      float16 e[WINDOW][WINDOW];  // d B: row r of every window
+      for (int r = 0; r < WINDOW; ++r) {
+        float16 d[WINDOW];  // column q of window row r, per lane
+        if (whole) {
+          const int y = TILE * ty + r - PAD, x0 = TILE * tx - PAD;
+          float16 row[5];  // input columns x0 … x0 + 79 of row y (68 used), zeros outside the plane
+          if (y >= 0 && y < height) {
+            __global const float* src = plane + (size_t)y * width;
+            for (int k = 0; k < 5; ++k) {
+              const int x = x0 + 16 * k;
+              if (x >= 0 && x + 16 <= width) {
+                row[k] = vload16(0, src + x);
+              } else {
+                float piece[16];
+                for (int j = 0; j < 16; ++j) piece[j] = x + j >= 0 && x + j < width ? src[x + j] : 0.0f;
+                row[k] = vload16(0, piece);
+              }
+            }
+          } else {
+            for (int k = 0; k < 5; ++k) row[k] = (float16)(0.0f);
+          }
+          // Columns 4 … 67: the same vectors shifted by 4 lanes.
+          const uint16 by4 = (uint16)(4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19);
+          const float16 a4 = shuffle2(row[0], row[1], by4), b4 = shuffle2(row[1], row[2], by4),
+                        c4 = shuffle2(row[2], row[3], by4), d4 = shuffle2(row[3], row[4], by4);
+          d[0] = every_fourth(row[0], row[1], row[2], row[3], 0);
+          d[1] = every_fourth(row[0], row[1], row[2], row[3], 1);
+          d[2] = every_fourth(row[0], row[1], row[2], row[3], 2);
+          d[3] = every_fourth(row[0], row[1], row[2], row[3], 3);
+          d[4] = every_fourth(a4, b4, c4, d4, 0);
+          d[5] = every_fourth(a4, b4, c4, d4, 1);
+        } else {
+          float window[WINDOW][16];
+          for (int j = 0; j < 16; ++j) {
+            const int tile = tile0 + j;
+            const int y = TILE * (tile / tiles_w) + r - PAD, x0 = TILE * (tile % tiles_w) - PAD;
+            const bool row_in = j < lanes && y >= 0 && y < height;
+            for (int q = 0; q < WINDOW; ++q) {
+              const int x = x0 + q;
+              window[q][j] = row_in && x >= 0 && x < width ? plane[(size_t)y * width + x] : 0.0f;
+            }
+          }
+          for (int q = 0; q < WINDOW; ++q) d[q] = vload16(0, window[q]);
         }
+        transform_bt16(d, e[r]);
       }
-      const float16 a = vload16(0, row), b = vload16(1, row), cc = vload16(2, row), dd = vload16(3, row);
-      const float16 a4 = vload16(0, row + 4), b4 = vload16(1, row + 4), c4 = vload16(2, row + 4),
-                    d4 = vload16(3, row + 4);
-      d[0] = every_fourth(a, b, cc, dd, 0);
-      d[1] = every_fourth(a, b, cc, dd, 1);
-      d[2] = every_fourth(a, b, cc, dd, 2);
-      d[3] = every_fourth(a, b, cc, dd, 3);
-      d[4] = every_fourth(a4, b4, c4, d4, 0);
-      d[5] = every_fourth(a4, b4, c4, d4, 1);
-    } else {
-      float window[WINDOW][16];
-      for (int j = 0; j < 16; ++j) {
-        const int tile = tile0 + j;
-        const int y = TILE * (tile / tiles_w) + r - PAD, x0 = TILE * (tile % tiles_w) - PAD;
-        const bool row_in = j < lanes && y >= 0 && y < height;
-        for (int q = 0; q < WINDOW; ++q) {
-          const int x = x0 + q;
-          window[q][j] = row_in && x >= 0 && x < width ? plane[(size_t)y * width + x] : 0.0f;
-        }
+      __global float* out = v + v_offset + (size_t)p * channels * 32 + (size_t)c * 32 + 16 * part;
+      for (int k = 0; k < WINDOW; ++k) {
+        float16 col[WINDOW], w[WINDOW];  // Bᵀ (d B): column k
+        for (int r = 0; r < WINDOW; ++r) col[r] = e[r][k];
+        transform_bt16(col, w);
+        for (int i = 0; i < WINDOW; ++i) vstore16(w[i], 0, out + (size_t)(WINDOW * i + k) * element_floats);
       }
-      for (int q = 0; q < WINDOW; ++q) d[q] = vload16(0, window[q]);
     }
-    transform_bt16(d, e[r]);
-  }
-  __global float* out = v + v_offset + (size_t)(lane0 / 32) * channels * 32 + (size_t)c * 32 + lane0 % 32;
-  for (int k = 0; k < WINDOW; ++k) {
-    float16 col[WINDOW], w[WINDOW];  // Bᵀ (d B): column k
-    for (int r = 0; r < WINDOW; ++r) col[r] = e[r][k];
-    transform_bt16(col, w);
-    for (int i = 0; i < WINDOW; ++i) vstore16(w[i], 0, out + (size_t)(WINDOW * i + k) * element_floats);
   }
 }

@@ -2,10 +2,11 @@
 // The 36 products of Winograd F(4×4, 3×3) and its output transform in one kernel
 // (src/ops/winograd.cpp; the transforms are those of kernels_cl/winograd.cl). One work-item takes
 // MR output channels and 32 tiles: for each element e it runs the packed GEMM's register tile
-// (packed_tile.cl) over the ci input channels, U_e's A panel against V_e's B panel, and parks the
-// MR×32 product in local memory (36·MR·32 floats: 36 KiB at MR = 8, reused by every work-group
-// a thread runs, so it stays in the core's cache); then Y = Aᵀ m A, bias and activation go from
-// there straight into the output. The 36 products never reach global memory.
+// (packed_tile.cl) over the ci input channels, U_e's A panel against V_e's B panel (its low 16
+// columns alone where the other 16 are padding), and parks the MR×32 product in local memory
+// (36·MR·32 floats: 36 KiB at MR = 8, reused by every work-group a thread runs, so it stays in the
+// core's cache); then Y = Aᵀ m A, bias and activation go from there straight into the output.
+// The 36 products never reach global memory.
 //
 // U: the 36 matrices [co_pad × ci] (co_pad = co rounded up to MR) packed as one matrix of
 // 36·co_pad rows in MR-row panels: element e's panel p is panel e·(co_pad / MR) + p.
@@ -32,6 +33,24 @@ inline void transform_at16(const float16* m, float16* y) {
 #define PARK(r)                                                  \
   vstore16(lo##r, 0, scratch + (e * MR + r) * 32);               \
   vstore16(hi##r, 0, scratch + (e * MR + r) * 32 + 16);
+#define PARK_LOW(r) vstore16(lo##r, 0, scratch + (e * MR + r) * 32);
+
+// TILE_PRODUCT (packed_tile.cl) for a B panel whose tiles past the first 16 are padding: only the
+// low 16 columns, one B vector per k instead of two (24×32 outputs: 48 tiles, the second panel of
+// 32 half empty, a quarter of the products padding otherwise).
+#define ACCUMULATE_LOW(r)                   \
+  {                                         \
+    const float16 a = (float16)(ap[r]);     \
+    lo##r = fma(a, b_lo, lo##r);            \
+  }
+#define TILE_PRODUCT_LOW(ap, bp, k)            \
+  EACH_ROW(DECLARE)                            \
+  for (int q_ = 0; q_ < (k); ++q_) {           \
+    const float16 b_lo = vload16(0, bp);       \
+    EACH_ROW(ACCUMULATE_LOW)                   \
+    ap += MR;                                  \
+    bp += 32;                                  \
+  }
 
 __kernel void winograd_gemm(__global const float* restrict u, const int u_offset, __global const float* restrict v,
                             const int v_offset, const int v_element_floats, __global float* restrict out,
@@ -42,11 +61,17 @@ __kernel void winograd_gemm(__global const float* restrict u, const int u_offset
   const int panel = get_global_id(0), column_panel = get_global_id(1);
   const int panels = get_global_size(0);  // A panels per element
   const int row0 = panel * MR, col0 = column_panel * 32;
+  const bool low_half = count - col0 <= 16;  // the output loop below never reads the high half then
   for (int e = 0; e < ELEMENTS; ++e) {
     __global const float* ap = u + u_offset + (size_t)(e * panels + panel) * channels * MR;
     __global const float* bp = v + v_offset + (size_t)e * v_element_floats + (size_t)column_panel * channels * 32;
-    TILE_PRODUCT(ap, bp, channels)
-    EACH_ROW(PARK)
+    if (low_half) {
+      TILE_PRODUCT_LOW(ap, bp, channels)
+      EACH_ROW(PARK_LOW)
+    } else {
+      TILE_PRODUCT(ap, bp, channels)
+      EACH_ROW(PARK)
+    }
   }
   for (int part = 0; part < 2; ++part) {
     const int lane0 = col0 + 16 * part;  // the first of these 16 tiles in the range

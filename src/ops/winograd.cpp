@@ -15,6 +15,10 @@ namespace {
 constexpr std::size_t kElements = kWinogradElements;  // a 6×6 transform: one GEMM per element
 constexpr std::size_t kTile = 4;                      // output pixels per tile side
 constexpr std::size_t kTileWidth = kPackedColumns;
+// Input channels per work-item of the input transform (kernels_cl/winograd.cl): enough work per
+// work-group that starting one costs little beside it, few enough blocks of channels that the
+// deep layers' single panel of tiles still gives both cores work (ci = 512: 64 work-items).
+constexpr std::size_t kInputChannelBlock = 8;
 
 int checked_int(std::size_t value, const char* what) {
   if (value > static_cast<std::size_t>(INT32_MAX)) {
@@ -36,6 +40,11 @@ bool winograd_preferred(const Shape& input, const Shape& weight, int stride) {
   return ((input[2] + 3) / 4) * ((input[3] + 3) / 4) >= kWinogradMinTiles;
 }
 
+int winograd_tile_rows(std::int64_t co, std::int64_t ci, int device_rows) {
+  if (ci >= kWinogradDeepChannels && device_rows >= 8) return kWinogradDeepTileRows;
+  return packed_gemm_tile_rows(static_cast<std::size_t>(co), 0, device_rows);
+}
+
 std::vector<PackedPanels> winograd_weights(Queue& queue, const Tensor& weight, Device* long_lived) {
   if (!winograd_eligible(weight.shape(), 1) || !weight.contiguous()) {
     throw invalid_input("winograd: the weights must be a contiguous [co ≥ 16, ci ≥ 32, 3, 3] tensor, got " +
@@ -44,7 +53,8 @@ std::vector<PackedPanels> winograd_weights(Queue& queue, const Tensor& weight, D
   const auto co = static_cast<std::size_t>(weight.dim(0)), ci = static_cast<std::size_t>(weight.dim(1));
   // Each element's matrix is padded to whole MR-row panels, so that the 36 of them pack as one
   // matrix of 36·padded rows whose panels never straddle two elements.
-  const auto rows = static_cast<std::size_t>(packed_gemm_tile_rows(co, 0, packed_gemm_setting(queue.device(), "MR")));
+  const auto rows = static_cast<std::size_t>(winograd_tile_rows(weight.dim(0), weight.dim(1),
+                                                                 packed_gemm_setting(queue.device(), "MR")));
   const std::size_t padded = (co + rows - 1) / rows * rows;
   const std::size_t pairs = padded * ci;
   const Tensor u = Tensor::empty(queue, {static_cast<std::int64_t>(kElements * pairs)});
@@ -93,9 +103,11 @@ void conv2d_winograd(Queue& queue, const Tensor& input, const std::vector<Packed
       const std::size_t count_floats = PackedPanels::floats(count, channels, static_cast<int>(kTileWidth));
       forward.set_args(in_n, v, checked_int(channels, "channels"), static_cast<int>(input.h()),
                        static_cast<int>(input.w()), checked_int(tiles_w, "tiles"), checked_int(first, "tile"),
-                       checked_int(count, "tiles"), checked_int(count_floats, "panels"));
-      // 16 tiles per work-item, one per vector lane (kernels_cl/winograd.cl).
-      queue.launch(forward, Range(padded / 16, channels), Range(1, 1));
+                       checked_int(count, "tiles"), checked_int(count_floats, "panels"),
+                       static_cast<int>(kInputChannelBlock));
+      // A panel of 32 tiles in a block of channels per work-item (kernels_cl/winograd.cl).
+      queue.launch(forward, Range(padded / kTileWidth, (channels + kInputChannelBlock - 1) / kInputChannelBlock),
+                   Range(1, 1));
       // Without a bias the kernel never reads its bias argument; any valid buffer will do.
       product.set_args(u.data, v, checked_int(count_floats, "panels"), out_n, has_bias ? bias : v,
                        checked_int(out_channels, "channels"), checked_int(channels, "channels"),

@@ -45,6 +45,21 @@ inline constexpr std::int64_t kWinogradMinTiles = 32;
 // least kWinogradMinTiles tiles. An empty `input` (size unknown) counts as large enough.
 bool winograd_preferred(const Shape& input, const Shape& weight, int stride);
 
+// Input channels from which the products run on the widest register tile, kWinogradDeepTileRows
+// rows of U per 32 tiles instead of the device's MR: a work-item's 36 B panels (36·32·ci floats,
+// 1.7 MiB at ci = 384) no longer stay in the core's cache between work-items, and more rows per
+// B vector load need fewer of them per FMA (docs/performance.md, "Issue 24, fifth pass
+// (Winograd)": the 512×384 layers of ci ≥ 386 ran their products 11–30 % faster with 14 rows
+// than with 8, those of ci ≤ 256 no faster or slower, the padding of small co included).
+inline constexpr std::int64_t kWinogradDeepChannels = 384;
+inline constexpr int kWinogradDeepTileRows = 14;
+
+// Rows per A panel of U for a layer of `co` output and `ci` input channels on a device whose
+// packed GEMM tile has `device_rows` rows: kWinogradDeepTileRows for deep layers where the
+// device's tile is the standard 8 rows or more (the 32 vector registers of AVX-512 that 2·14
+// float16 accumulators need; a device tuned to fewer rows keeps its own), else as the packed GEMM.
+int winograd_tile_rows(std::int64_t co, std::int64_t ci, int device_rows);
+
 // The 36 transformed weight matrices U_e [co × ci], packed as A panels (long-lived on `long_lived`
 // when given, else temporaries of `queue`).
 std::vector<PackedPanels> winograd_weights(Queue& queue, const Tensor& weight, Device* long_lived);

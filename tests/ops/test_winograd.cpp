@@ -159,6 +159,43 @@ TEST(Winograd, SmallOutputsStayOnThePackedGemm) {
   expect_winograd_matches({"conv6_1_like", 64, 32, 6, 8, 1, 1, true, leaky}, {1}, false, true);
 }
 
+TEST(Winograd, InputTransformChannelBlocksAndEdgeVectors) {
+  // The input transform takes a 32-tile panel in blocks of 8 channels (kernels_cl/winograd.cl):
+  // 45 and 33 channels end in partial blocks. Widths 70 and 69 (18 tiles a row) put a group of
+  // 16 side-by-side tiles against each edge, where one window-row vector crosses the plane's
+  // left (padding 1) or right edge mid-vector; 132 with padding 0 has a group whose vectors all
+  // lie inside. Batches and a tile range that starts mid-row, as in the network.
+  const auto leaky = ActivationSpec::leaky_relu(0.1f);
+  expect_winograd_matches({"w70_ci45", 45, 16, 13, 70, 1, 1, true, leaky}, {2});
+  expect_winograd_matches({"w69_pad0", 33, 20, 10, 69, 1, 0, false, ActivationSpec::relu()}, {1});
+  expect_winograd_matches({"w132_pad0", 40, 16, 9, 132, 1, 0, true, ActivationSpec::none()}, {2});
+  expect_winograd_matches({"w70_ranges", 45, 16, 21, 70, 1, 1, true, leaky}, {1, 0, 0, 0, 0, 36 * 45 * 40});
+}
+
+TEST(Winograd, DeepLayersUseTheWidestRegisterTile) {
+  // From kWinogradDeepChannels inputs U is packed in 14-row panels where the device's packed
+  // tile has 8 rows or more; shallower layers, and devices tuned to fewer rows, keep the
+  // device's tile (small co: the short tiles of the packed GEMM).
+  EXPECT_EQ(detail::winograd_tile_rows(256, 384, 8), detail::kWinogradDeepTileRows);
+  EXPECT_EQ(detail::winograd_tile_rows(512, 1026, 12), detail::kWinogradDeepTileRows);
+  EXPECT_EQ(detail::winograd_tile_rows(256, 383, 8), 8);
+  EXPECT_EQ(detail::winograd_tile_rows(256, 512, 4), 4);
+  EXPECT_EQ(detail::winograd_tile_rows(16, 82, 8), 8);
+  // co = 20 fills one 14-row panel and 6 rows of a second (the rest padding); ci = 390 ends in a
+  // partial block of input channels.
+  const auto leaky = ActivationSpec::leaky_relu(0.1f);
+  expect_winograd_matches({"deep_co20", 390, 20, 11, 9, 1, 1, true, leaky}, {2});
+  expect_winograd_matches({"deep_co30_tiles", 384, 30, 16, 40, 1, 1, false, ActivationSpec::none()}, {1}, true, true);
+  // 24×32 outputs as FlowNet2's conv4_1: 48 tiles, the second 32-tile panel half padding, whose
+  // products run on its low 16 columns alone (kernels_cl/winograd_gemm.cl); batch 2.
+  expect_winograd_matches({"conv4_1_like", 384, 16, 24, 32, 1, 1, true, leaky}, {2}, true, true);
+  Queue& queue = testing::test_queue();
+  const Tensor w = Tensor::from_host(queue, {30, 384, 3, 3}, testing::random_vector(30 * 384 * 9, 7));
+  const GemmWeights prepared = prepare_conv2d_weights(queue, w, GemmBackend::Winograd, 1, Shape{});
+  ASSERT_EQ(prepared.winograd.size(), 1u);
+  EXPECT_EQ(prepared.winograd[0].width, detail::winograd_tile_rows(30, 384, packed_gemm_setting(queue.device(), "MR")));
+}
+
 TEST(Winograd, PlanName) {
   DeviceInfo cpu;
   cpu.type = DeviceType::CPU;
