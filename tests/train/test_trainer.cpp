@@ -16,6 +16,7 @@
 #include <iterator>
 #include <limits>
 #include <memory>
+#include <optional>
 
 #include <sys/stat.h>
 
@@ -228,6 +229,19 @@ TEST(TrainingSet, FlowsComeFromTheCacheOnASecondLoadAndTargetsAreTheBodyFrameGyr
   EXPECT_LT(peak, 1.3);
 }
 
+// The sequence's true camera-frame rate over the frame interval that ends at `t_ns` (its exact
+// mean, SynthReport::interval_rates); nothing, and a test failure, when `t_ns` is not a frame time
+// after the first.
+std::optional<Vec3> interval_rate(const SynthReport& truth, std::int64_t t_ns) {
+  const auto& t = truth.camera_t_ns;
+  const auto k = static_cast<std::size_t>(std::find(t.begin(), t.end(), t_ns) - t.begin());
+  if (k == 0 || k >= t.size()) {
+    ADD_FAILURE() << "no frame interval of the sequence ends at " << t_ns << " ns";
+    return std::nullopt;
+  }
+  return truth.interval_rates[k - 1];
+}
+
 // Frames whose stamps run 40 ms early against the IMU: given the offset, each pair's target is the
 // gyro over the interval the frames show, so its size is that of the true rate of the pair (|ω| is
 // the same in the body and the camera frame); without it, the target is 40 ms off.
@@ -252,11 +266,9 @@ TEST(TrainingSet, ATimeOffsetPutsTheTargetsOnTheImuClock) {
     EXPECT_GT(set.size(), 30u);
     double sum = 0;
     for (std::size_t i = 0; i < set.size(); ++i) {
-      const auto k = static_cast<std::size_t>(
-          std::find(truth.camera_t_ns.begin(), truth.camera_t_ns.end(), set.timestamp_ns(i)) - truth.camera_t_ns.begin());
-      EXPECT_TRUE(k > 0 && k < truth.camera_t_ns.size()) << "pair " << i;
-      if (k == 0 || k >= truth.camera_t_ns.size()) continue;
-      const Vec3& w = truth.interval_rates[k - 1];
+      const std::optional<Vec3> rate = interval_rate(truth, set.timestamp_ns(i));
+      if (!rate) continue;
+      const Vec3& w = *rate;
       const Vec3& t = set.targets()[i];
       const double d = std::hypot(t[0], t[1], t[2]) - std::hypot(w[0], w[1], w[2]);
       sum += d * d;
@@ -296,11 +308,9 @@ TEST(TrainingSet, TargetsAreCameraFrameForANormalizedHeadAndBodyFrameForAPaperHe
     EXPECT_GT(set.size(), 15u);
     double sum = 0;
     for (std::size_t i = 0; i < set.size(); ++i) {
-      const auto k = static_cast<std::size_t>(
-          std::find(truth.camera_t_ns.begin(), truth.camera_t_ns.end(), set.timestamp_ns(i)) - truth.camera_t_ns.begin());
-      EXPECT_TRUE(k > 0 && k < truth.camera_t_ns.size()) << "pair " << i;
-      if (k == 0 || k >= truth.camera_t_ns.size()) continue;
-      const Vec3 w = body ? mul(camera_to_body, truth.interval_rates[k - 1]) : truth.interval_rates[k - 1];
+      const std::optional<Vec3> rate = interval_rate(truth, set.timestamp_ns(i));
+      if (!rate) continue;
+      const Vec3 w = body ? mul(camera_to_body, *rate) : *rate;
       for (int a = 0; a < 3; ++a) {
         const double d = set.targets()[i][static_cast<std::size_t>(a)] - w[static_cast<std::size_t>(a)];
         sum += d * d;
