@@ -25,8 +25,8 @@
 #include "inertialnet/pipeline/rate_fusion.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/synth/synthetic_sequence.hpp"
-#include "inertialnet/train/trainer.hpp"
 #include "inertialnet/train/training_set.hpp"
+#include "support/small_heads.hpp"
 #include "support/testing.hpp"
 
 namespace inertialnet {
@@ -55,26 +55,10 @@ const Fixture& fixture() {
     s.motion = SynthOptions::General;
     s.seed = 31;
     write_synthetic_sequence(out.sequence, s);
-    TrainingSetOptions o;
-    o.width = kHeadWidth;
-    o.height = kHeadHeight;
-    o.flow = FlowMethod::DIS;
-    o.input = HeadInput::Normalized;
-    TrainingSet set(o);
-    set.add_sequence(out.sequence);
+    const TrainingSet set = testing::head_training_set(out.sequence, kHeadWidth, kHeadHeight);
     for (std::uint64_t seed = 1; seed <= 3; ++seed) {
-      TrainerOptions t;
-      t.head.input_width = kHeadWidth;
-      t.head.input_height = kHeadHeight;
-      t.optimizer = OptimizerKind::Adam;
-      t.lr = 1e-3f;
-      t.epochs = 1;
-      t.batch = 2;
-      t.seed = seed;
-      Trainer trainer(testing::test_device(), t);
-      EXPECT_TRUE(trainer.train(set, set, {}));
       const fs::path head = out.root / ("head" + std::to_string(seed) + ".safetensors");
-      trainer.save_head(head, {{kMetadataHeadInput, head_input_to_json({HeadInput::Normalized, "dis"})}});
+      testing::train_small_head(set, seed, {{head, {HeadInput::Normalized, "dis"}}});
       out.heads.push_back(head.string());
     }
     return out;
