@@ -57,18 +57,21 @@ TrainingSetOptions set_options(const fs::path& cache) {
   return o;
 }
 
+// A general-motion sequence of `frames` frames at the suite's size from `seed`, rates up to 60 deg/s.
+SynthOptions general_motion(int frames, std::uint64_t seed) {
+  SynthOptions s;
+  s.frames = frames;
+  s.width = kWidth;
+  s.height = kHeight;
+  s.motion = SynthOptions::General;
+  s.seed = seed;
+  s.max_rate_deg_s = 60;
+  return s;
+}
+
 fs::path sequence(const fs::path& root, std::uint64_t seed) {
   const fs::path dir = root / ("general_" + std::to_string(seed));
-  if (!fs::exists(dir / "mav0")) {
-    SynthOptions s;
-    s.frames = kFrames;
-    s.width = kWidth;
-    s.height = kHeight;
-    s.motion = SynthOptions::General;
-    s.seed = seed;
-    s.max_rate_deg_s = 60;
-    write_synthetic_sequence(dir, s);
-  }
+  if (!fs::exists(dir / "mav0")) write_synthetic_sequence(dir, general_motion(kFrames, seed));
   return dir;
 }
 
@@ -247,13 +250,7 @@ std::optional<Vec3> interval_rate(const SynthReport& truth, std::int64_t t_ns) {
 // the same in the body and the camera frame); without it, the target is 40 ms off.
 TEST(TrainingSet, ATimeOffsetPutsTheTargetsOnTheImuClock) {
   const fs::path dir = fs::path(testing::temporary_directory("trainer_offset")) / "offset";
-  SynthOptions so;
-  so.frames = 41;
-  so.width = kWidth;
-  so.height = kHeight;
-  so.motion = SynthOptions::General;
-  so.seed = 31;
-  so.max_rate_deg_s = 60;
+  SynthOptions so = general_motion(41, 31);
   so.noise = false;
   so.time_offset_s = 0.04;
   const SynthReport truth = write_synthetic_sequence(dir, so);
@@ -288,13 +285,7 @@ TEST(TrainingSet, ATimeOffsetPutsTheTargetsOnTheImuClock) {
 // rendered with, per component, turned by EuRoC's rotation for the paper head.
 TEST(TrainingSet, TargetsAreCameraFrameForANormalizedHeadAndBodyFrameForAPaperHead) {
   const fs::path dir = fs::path(testing::temporary_directory("trainer_frames")) / "frames";
-  SynthOptions so;
-  so.frames = 21;
-  so.width = kWidth;
-  so.height = kHeight;
-  so.motion = SynthOptions::General;
-  so.seed = 33;
-  so.max_rate_deg_s = 60;
+  SynthOptions so = general_motion(21, 33);
   so.noise = false;
   const SynthReport truth = write_synthetic_sequence(dir, so);
   const Mat3 camera_to_body = read_euroc(dir).camera->rotation_BS();
