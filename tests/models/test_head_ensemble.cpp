@@ -6,7 +6,6 @@
 #include <array>
 #include <cmath>
 #include <filesystem>
-#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -23,16 +22,17 @@
 #include "inertialnet/models/weights.hpp"
 #include "inertialnet/pipeline/predict.hpp"
 #include "inertialnet/pipeline/rate_fusion.hpp"
-#include "inertialnet/runtime/error.hpp"
 #include "inertialnet/synth/synthetic_sequence.hpp"
-#include "inertialnet/train/trainer.hpp"
 #include "inertialnet/train/training_set.hpp"
+#include "support/small_heads.hpp"
 #include "support/testing.hpp"
 
 namespace inertialnet {
 namespace {
 
 namespace fs = std::filesystem;
+
+using testing::invalid_input_message;
 
 constexpr int kHeadWidth = 32, kHeadHeight = 20;
 
@@ -55,26 +55,10 @@ const Fixture& fixture() {
     s.motion = SynthOptions::General;
     s.seed = 31;
     write_synthetic_sequence(out.sequence, s);
-    TrainingSetOptions o;
-    o.width = kHeadWidth;
-    o.height = kHeadHeight;
-    o.flow = FlowMethod::DIS;
-    o.input = HeadInput::Normalized;
-    TrainingSet set(o);
-    set.add_sequence(out.sequence);
+    const TrainingSet set = testing::head_training_set(out.sequence, kHeadWidth, kHeadHeight);
     for (std::uint64_t seed = 1; seed <= 3; ++seed) {
-      TrainerOptions t;
-      t.head.input_width = kHeadWidth;
-      t.head.input_height = kHeadHeight;
-      t.optimizer = OptimizerKind::Adam;
-      t.lr = 1e-3f;
-      t.epochs = 1;
-      t.batch = 2;
-      t.seed = seed;
-      Trainer trainer(testing::test_device(), t);
-      EXPECT_TRUE(trainer.train(set, set, {}));
       const fs::path head = out.root / ("head" + std::to_string(seed) + ".safetensors");
-      trainer.save_head(head, {{kMetadataHeadInput, head_input_to_json({HeadInput::Normalized, "dis"})}});
+      testing::train_small_head(set, seed, {{head, {HeadInput::Normalized, "dis"}}});
       out.heads.push_back(head.string());
     }
     return out;
@@ -93,15 +77,21 @@ std::map<std::string, std::vector<float>> tensors_of(const std::string& path, co
   return out;
 }
 
-std::string invalid_input_message(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    EXPECT_EQ(e.kind(), ErrorKind::InvalidInput) << e.what();
-    return e.what();
+// Writes `to` with every tensor of `from` and its metadata, `key` set to `value` (`to` may be `from`).
+void copy_with_metadata(const std::string& from, const std::string& to, const std::string& key,
+                        const std::string& value) {
+  const SafetensorsFile file(from);
+  std::vector<HostTensor> tensors;
+  for (const auto& name : file.names()) {
+    HostTensor t;
+    t.name = name;
+    t.shape = Shape(file.shape(name).begin(), file.shape(name).end());
+    t.data = file.to_float32(name);
+    tensors.push_back(t);
   }
-  ADD_FAILURE() << "no error";
-  return "";
+  auto meta = file.metadata();
+  meta[key] = value;
+  write_safetensors(to, tensors, meta);
 }
 
 TEST(HeadEnsemble, CombineGivesTheMeanAndTheSampleSpreadPerAxis) {
@@ -184,20 +174,7 @@ TEST(HeadEnsemble, WritingRefusesHeadsThatDoNotBelongTogetherNamingTheFile) {
   const Fixture& f = fixture();
   // The second head with another input convention in its metadata.
   const std::string other = (f.root / "paper.safetensors").string();
-  {
-    const SafetensorsFile file(f.heads[1]);
-    std::vector<HostTensor> tensors;
-    for (const auto& name : file.names()) {
-      HostTensor t;
-      t.name = name;
-      t.shape = Shape(file.shape(name).begin(), file.shape(name).end());
-      t.data = file.to_float32(name);
-      tensors.push_back(t);
-    }
-    auto meta = file.metadata();
-    meta[kMetadataHeadInput] = head_input_to_json({HeadInput::Paper, "dis"});
-    write_safetensors(other, tensors, meta);
-  }
+  copy_with_metadata(f.heads[1], other, kMetadataHeadInput, head_input_to_json({HeadInput::Paper, "dis"}));
   std::string message =
       invalid_input_message([&] { write_head_ensemble((f.root / "x.safetensors").string(), {f.heads[0], other}); });
   EXPECT_NE(message.find(other + ": metadata inertialnet.head_input"), std::string::npos) << message;
@@ -276,52 +253,32 @@ TEST(HeadEnsemble, PredictReportsTheMembersMeanAndTakesTheLearnedSigmaFromTheirS
   }
 }
 
-TEST(HeadEnsemble, PredictRefusesABadEnsembleRecordNamingFileKeyAndValue) {
+// Each case: a file of the fixture's first `heads` heads whose ensemble record is `record`, and a
+// part of predict's message.
+TEST(HeadEnsemble, PredictRefusesABadEnsembleFileNamingWhatIsWrong) {
   const Fixture& f = fixture();
-  const std::string path = (f.root / "bad.safetensors").string();
-  write_head_ensemble(path, f.heads);
-  {
-    const SafetensorsFile file(path);
-    std::vector<HostTensor> tensors;
-    for (const auto& name : file.names()) {
-      HostTensor t;
-      t.name = name;
-      t.shape = Shape(file.shape(name).begin(), file.shape(name).end());
-      t.data = file.to_float32(name);
-      tensors.push_back(t);
-    }
-    auto meta = file.metadata();
-    meta[kMetadataEnsemble] = "{\"members\":70,\"version\":1}";
-    write_safetensors(path, tensors, meta);
+  const auto path_of = [&](const std::string& file) { return (f.root / (file + ".safetensors")).string(); };
+  struct Case {
+    std::string file;
+    std::size_t heads;
+    std::string record;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      // A bad record: file, key and value named.
+      {"bad", 3, "{\"members\":70,\"version\":1}",
+       path_of("bad") + ": metadata inertialnet.ensemble '{\"members\":70,\"version\":1}' is not a head ensemble "
+                        "description: \"members\" is 70"},
+      // Two heads' tensors, a record of three: the member without its tensors named.
+      {"short", 2, head_ensemble_to_json(3), "short.safetensors (ensemble member 2)"},
+  };
+  for (const Case& c : cases) {
+    const std::string path = path_of(c.file);
+    write_head_ensemble(path, {f.heads.begin(), f.heads.begin() + static_cast<std::ptrdiff_t>(c.heads)});
+    copy_with_metadata(path, path, kMetadataEnsemble, c.record);
+    const std::string message = invalid_input_message([&] { predict({path}, false); });
+    EXPECT_NE(message.find(c.message), std::string::npos) << c.file << ": " << message;
   }
-  const std::string message = invalid_input_message([&] { predict({path}, false); });
-  EXPECT_NE(message.find(path + ": metadata inertialnet.ensemble '{\"members\":70,\"version\":1}' is not a head "
-                                "ensemble description: \"members\" is 70"),
-            std::string::npos)
-      << message;
-}
-
-TEST(HeadEnsemble, AMemberWithoutItsTensorsIsNamed) {
-  const Fixture& f = fixture();
-  // Two heads' tensors, a record of three.
-  const std::string path = (f.root / "short.safetensors").string();
-  write_head_ensemble(path, {f.heads[0], f.heads[1]});
-  {
-    const SafetensorsFile file(path);
-    std::vector<HostTensor> tensors;
-    for (const auto& name : file.names()) {
-      HostTensor t;
-      t.name = name;
-      t.shape = Shape(file.shape(name).begin(), file.shape(name).end());
-      t.data = file.to_float32(name);
-      tensors.push_back(t);
-    }
-    auto meta = file.metadata();
-    meta[kMetadataEnsemble] = head_ensemble_to_json(3);
-    write_safetensors(path, tensors, meta);
-  }
-  const std::string message = invalid_input_message([&] { predict({path}, false); });
-  EXPECT_NE(message.find("short.safetensors (ensemble member 2)"), std::string::npos) << message;
 }
 
 }  // namespace

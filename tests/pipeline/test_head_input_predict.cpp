@@ -19,8 +19,8 @@
 #include "inertialnet/pipeline/predict.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/synth/synthetic_sequence.hpp"
-#include "inertialnet/train/trainer.hpp"
 #include "inertialnet/train/training_set.hpp"
+#include "support/small_heads.hpp"
 #include "support/testing.hpp"
 
 namespace inertialnet {
@@ -35,7 +35,7 @@ struct Fixture {
 };
 
 // A 1280×720 sequence of 5 frames and a head trained on it for one epoch at 320×180 (normalized
-// input, DIS flow), saved with the metadata train writes.
+// input, DIS flow, seed 1), saved with the metadata train writes.
 const Fixture& fixture() {
   static const Fixture f = [] {
     Fixture out;
@@ -48,31 +48,17 @@ const Fixture& fixture() {
     s.motion = SynthOptions::General;
     s.seed = 23;
     write_synthetic_sequence(out.sequence, s);
-    TrainingSetOptions o;
-    o.width = kHeadWidth;
-    o.height = kHeadHeight;
-    o.flow = FlowMethod::DIS;
-    o.input = HeadInput::Normalized;
-    TrainingSet set(o);
-    set.add_sequence(out.sequence);
-    TrainerOptions t;
-    t.head.input_width = kHeadWidth;
-    t.head.input_height = kHeadHeight;
-    t.optimizer = OptimizerKind::Adam;
-    t.lr = 1e-3f;
-    t.epochs = 1;
-    t.batch = 2;
-    Trainer trainer(testing::test_device(), t);
-    EXPECT_TRUE(trainer.train(set, set, {}));
     out.head = out.root / "head.safetensors";
-    trainer.save_head(out.head, {{kMetadataHeadInput, head_input_to_json({HeadInput::Normalized, "dis", true})}});
-    // The same weights as a head written before the frame was recorded (body frame of its rig).
     out.body_head = out.root / "body_head.safetensors";
-    trainer.save_head(out.body_head, {{kMetadataHeadInput, head_input_to_json({HeadInput::Normalized, "dis", false})}});
-    // The same weights as a head of the fine DIS (the weights do not matter to which flow it gets).
     out.fine_head = out.root / "fine_head.safetensors";
-    trainer.save_head(out.fine_head,
-                      {{kMetadataHeadInput, head_input_to_json({HeadInput::Normalized, "dis-fine", true})}});
+    testing::train_small_head(testing::head_training_set(out.sequence, kHeadWidth, kHeadHeight), 1,
+                              {{out.head, {HeadInput::Normalized, "dis", true}},
+                               // The same weights as a head written before the frame was recorded
+                               // (body frame of its rig).
+                               {out.body_head, {HeadInput::Normalized, "dis", false}},
+                               // The same weights as a head of the fine DIS (the weights do not
+                               // matter to which flow it gets).
+                               {out.fine_head, {HeadInput::Normalized, "dis-fine", true}}});
     return out;
   }();
   return f;
@@ -109,13 +95,7 @@ TEST(HeadInputPredict, AHeadOf320x180GivesOn1280x720FramesTheRatesOfTheTrainingS
   }
 
   // The training set's flows of the same frames, through the same head.
-  TrainingSetOptions o;
-  o.width = kHeadWidth;
-  o.height = kHeadHeight;
-  o.flow = FlowMethod::DIS;
-  o.input = HeadInput::Normalized;
-  TrainingSet set(o);
-  set.add_sequence(f.sequence);
+  const TrainingSet set = testing::head_training_set(f.sequence, kHeadWidth, kHeadHeight);
   const WeightSet weights = WeightSet::load(testing::test_device(), {f.head.string()});
   InertialNetHead head(testing::test_device(), weights);
   Queue& queue = testing::test_queue();
@@ -175,13 +155,7 @@ TEST(HeadInputPredict, AnotherFlowThanTheHeadWasTrainedOnIsRefusedNamingIt) {
 
 // The head's rates on the flows of a training set of `flow` (the same frames, sizes and input).
 std::vector<Vec3> rates_on_training_flows(const Fixture& f, FlowMethod flow, const Mat3& camera_to_body) {
-  TrainingSetOptions o;
-  o.width = kHeadWidth;
-  o.height = kHeadHeight;
-  o.flow = flow;
-  o.input = HeadInput::Normalized;
-  TrainingSet set(o);
-  set.add_sequence(f.sequence);
+  const TrainingSet set = testing::head_training_set(f.sequence, kHeadWidth, kHeadHeight, flow);
   const WeightSet weights = WeightSet::load(testing::test_device(), {f.fine_head.string()});
   InertialNetHead head(testing::test_device(), weights);
   Queue& queue = testing::test_queue();

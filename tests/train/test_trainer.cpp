@@ -16,6 +16,7 @@
 #include <iterator>
 #include <limits>
 #include <memory>
+#include <optional>
 
 #include <sys/stat.h>
 
@@ -56,18 +57,21 @@ TrainingSetOptions set_options(const fs::path& cache) {
   return o;
 }
 
+// A general-motion sequence of `frames` frames at the suite's size from `seed`, rates up to 60 deg/s.
+SynthOptions general_motion(int frames, std::uint64_t seed) {
+  SynthOptions s;
+  s.frames = frames;
+  s.width = kWidth;
+  s.height = kHeight;
+  s.motion = SynthOptions::General;
+  s.seed = seed;
+  s.max_rate_deg_s = 60;
+  return s;
+}
+
 fs::path sequence(const fs::path& root, std::uint64_t seed) {
   const fs::path dir = root / ("general_" + std::to_string(seed));
-  if (!fs::exists(dir / "mav0")) {
-    SynthOptions s;
-    s.frames = kFrames;
-    s.width = kWidth;
-    s.height = kHeight;
-    s.motion = SynthOptions::General;
-    s.seed = seed;
-    s.max_rate_deg_s = 60;
-    write_synthetic_sequence(dir, s);
-  }
+  if (!fs::exists(dir / "mav0")) write_synthetic_sequence(dir, general_motion(kFrames, seed));
   return dir;
 }
 
@@ -228,18 +232,25 @@ TEST(TrainingSet, FlowsComeFromTheCacheOnASecondLoadAndTargetsAreTheBodyFrameGyr
   EXPECT_LT(peak, 1.3);
 }
 
+// The sequence's true camera-frame rate over the frame interval that ends at `t_ns` (its exact
+// mean, SynthReport::interval_rates); nothing, and a test failure, when `t_ns` is not a frame time
+// after the first.
+std::optional<Vec3> interval_rate(const SynthReport& truth, std::int64_t t_ns) {
+  const auto& t = truth.camera_t_ns;
+  const auto k = static_cast<std::size_t>(std::find(t.begin(), t.end(), t_ns) - t.begin());
+  if (k == 0 || k >= t.size()) {
+    ADD_FAILURE() << "no frame interval of the sequence ends at " << t_ns << " ns";
+    return std::nullopt;
+  }
+  return truth.interval_rates[k - 1];
+}
+
 // Frames whose stamps run 40 ms early against the IMU: given the offset, each pair's target is the
 // gyro over the interval the frames show, so its size is that of the true rate of the pair (|ω| is
 // the same in the body and the camera frame); without it, the target is 40 ms off.
 TEST(TrainingSet, ATimeOffsetPutsTheTargetsOnTheImuClock) {
   const fs::path dir = fs::path(testing::temporary_directory("trainer_offset")) / "offset";
-  SynthOptions so;
-  so.frames = 41;
-  so.width = kWidth;
-  so.height = kHeight;
-  so.motion = SynthOptions::General;
-  so.seed = 31;
-  so.max_rate_deg_s = 60;
+  SynthOptions so = general_motion(41, 31);
   so.noise = false;
   so.time_offset_s = 0.04;
   const SynthReport truth = write_synthetic_sequence(dir, so);
@@ -252,11 +263,9 @@ TEST(TrainingSet, ATimeOffsetPutsTheTargetsOnTheImuClock) {
     EXPECT_GT(set.size(), 30u);
     double sum = 0;
     for (std::size_t i = 0; i < set.size(); ++i) {
-      const auto k = static_cast<std::size_t>(
-          std::find(truth.camera_t_ns.begin(), truth.camera_t_ns.end(), set.timestamp_ns(i)) - truth.camera_t_ns.begin());
-      EXPECT_TRUE(k > 0 && k < truth.camera_t_ns.size()) << "pair " << i;
-      if (k == 0 || k >= truth.camera_t_ns.size()) continue;
-      const Vec3& w = truth.interval_rates[k - 1];
+      const std::optional<Vec3> rate = interval_rate(truth, set.timestamp_ns(i));
+      if (!rate) continue;
+      const Vec3& w = *rate;
       const Vec3& t = set.targets()[i];
       const double d = std::hypot(t[0], t[1], t[2]) - std::hypot(w[0], w[1], w[2]);
       sum += d * d;
@@ -276,13 +285,7 @@ TEST(TrainingSet, ATimeOffsetPutsTheTargetsOnTheImuClock) {
 // rendered with, per component, turned by EuRoC's rotation for the paper head.
 TEST(TrainingSet, TargetsAreCameraFrameForANormalizedHeadAndBodyFrameForAPaperHead) {
   const fs::path dir = fs::path(testing::temporary_directory("trainer_frames")) / "frames";
-  SynthOptions so;
-  so.frames = 21;
-  so.width = kWidth;
-  so.height = kHeight;
-  so.motion = SynthOptions::General;
-  so.seed = 33;
-  so.max_rate_deg_s = 60;
+  SynthOptions so = general_motion(21, 33);
   so.noise = false;
   const SynthReport truth = write_synthetic_sequence(dir, so);
   const Mat3 camera_to_body = read_euroc(dir).camera->rotation_BS();
@@ -296,11 +299,9 @@ TEST(TrainingSet, TargetsAreCameraFrameForANormalizedHeadAndBodyFrameForAPaperHe
     EXPECT_GT(set.size(), 15u);
     double sum = 0;
     for (std::size_t i = 0; i < set.size(); ++i) {
-      const auto k = static_cast<std::size_t>(
-          std::find(truth.camera_t_ns.begin(), truth.camera_t_ns.end(), set.timestamp_ns(i)) - truth.camera_t_ns.begin());
-      EXPECT_TRUE(k > 0 && k < truth.camera_t_ns.size()) << "pair " << i;
-      if (k == 0 || k >= truth.camera_t_ns.size()) continue;
-      const Vec3 w = body ? mul(camera_to_body, truth.interval_rates[k - 1]) : truth.interval_rates[k - 1];
+      const std::optional<Vec3> rate = interval_rate(truth, set.timestamp_ns(i));
+      if (!rate) continue;
+      const Vec3 w = body ? mul(camera_to_body, *rate) : *rate;
       for (int a = 0; a < 3; ++a) {
         const double d = set.targets()[i][static_cast<std::size_t>(a)] - w[static_cast<std::size_t>(a)];
         sum += d * d;
