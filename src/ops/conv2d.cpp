@@ -60,13 +60,9 @@ void conv2d_direct(Queue& queue, const Tensor& input, const Tensor& weight, cons
   // most 16 of AVX-512's 32 registers.
   const std::int64_t rows = weight.dim(0) <= 2 ? 4 : 2;
   Kernel& kernel = queue.kernel("conv2d_direct", "conv2d_direct",
-                                KernelDefines()
+                                detail::conv_window_defines(weight.dim(2), weight.dim(3), options.stride, options.padding)
                                     .add("COUT", weight.dim(0))
                                     .add("ROWS", rows)
-                                    .add("KH", weight.dim(2))
-                                    .add("KW", weight.dim(3))
-                                    .add("STRIDE", options.stride)
-                                    .add("PAD", options.padding)
                                     .add("HAS_BIAS", has_bias)
                                     .add(activation_defines(options.activation)));
   const auto out_h = static_cast<std::size_t>(output.h()), out_w = static_cast<std::size_t>(output.w());
@@ -177,7 +173,7 @@ void conv2d(Queue& queue, const Tensor& input, const Tensor& weight, const Tenso
     const Tensor columns = Tensor::empty(queue, {static_cast<std::int64_t>(reduction), static_cast<std::int64_t>(chunk)});
     Kernel& unfold = queue.kernel(
         "im2col", "im2col",
-        KernelDefines().add("KH", kh).add("KW", kw).add("STRIDE", options.stride).add("PAD", options.padding));
+        detail::conv_window_defines(weight.dim(2), weight.dim(3), options.stride, options.padding));
     const Range local(detail::work_group_size(device, 64), 1);
     for (std::int64_t n = 0; n < batch; ++n) {
       const Tensor in_n = input.sample(n);

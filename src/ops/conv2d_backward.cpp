@@ -40,10 +40,6 @@ ConvGeometry check_shapes(const std::string& op, const Shape& input, const Tenso
   return g;
 }
 
-KernelDefines window_defines(const ConvGeometry& g, const Conv2dBackwardOptions& options) {
-  return KernelDefines().add("KH", g.kh).add("KW", g.kw).add("STRIDE", options.stride).add("PAD", options.padding);
-}
-
 }  // namespace
 
 void conv2d_backward_data(Queue& queue, const Tensor& grad_output, const Tensor& weight, const Tensor& grad_input,
@@ -70,7 +66,7 @@ void conv2d_backward_data(Queue& queue, const Tensor& grad_output, const Tensor&
   const Tensor columns =
       Tensor::empty(queue, {static_cast<std::int64_t>(g.reduction), static_cast<std::int64_t>(g.pixels)});
   // The forward pass's col2im (conv_transpose2d's gather) is exactly the adjoint of im2col.
-  Kernel& gather = queue.kernel("col2im", "col2im", window_defines(g, options).add("HAS_BIAS", false));
+  Kernel& gather = queue.kernel("col2im", "col2im", detail::conv_window_defines(g.kh, g.kw, options.stride, options.padding).add("HAS_BIAS", false));
   const Range local(detail::work_group_size(queue.device(), 64), 1);
   for (std::int64_t n = 0; n < grad_input.n(); ++n) {
     const Tensor grad_in_n = grad_input.sample(n);
@@ -106,7 +102,7 @@ void conv2d_backward_weight(Queue& queue, const Tensor& input, const Tensor& gra
   Kernel* unfold = nullptr;
   if (!g.identity_columns) {
     columns = Tensor::empty(queue, {static_cast<std::int64_t>(g.reduction), static_cast<std::int64_t>(g.pixels)});
-    unfold = &queue.kernel("im2col", "im2col", window_defines(g, options));
+    unfold = &queue.kernel("im2col", "im2col", detail::conv_window_defines(g.kh, g.kw, options.stride, options.padding));
   }
   const Range local(detail::work_group_size(queue.device(), 64), 1);
   for (std::int64_t n = 0; n < input.n(); ++n) {

@@ -56,7 +56,7 @@ void conv2d_slices(Queue& queue, const Tensor& input, const Tensor& weight, cons
   const Tensor partial =
       Tensor::empty(queue, {static_cast<std::int64_t>(slices * out_channels), static_cast<std::int64_t>(chunk)});
   Kernel& unfold = queue.kernel(
-      "im2col", "im2col", KernelDefines().add("KH", kh).add("KW", kw).add("STRIDE", options.stride).add("PAD", options.padding));
+      "im2col", "im2col", conv_window_defines(weight.dim(2), weight.dim(3), options.stride, options.padding));
   const bool has_bias = bias.defined();
   Kernel& sum = queue.kernel("conv2d_slices", "conv2d_slices_sum",
                              KernelDefines()

@@ -45,14 +45,10 @@ void conv2d_splitk_group(Queue& queue, const Tensor& input, const Tensor& weight
   // A power of two no larger than the device allows (the tree sum halves it).
   const std::size_t group = work_group_size(queue.device(), kGroupSize);
   Kernel& kernel = queue.kernel("conv2d_splitk", "conv2d_splitk",
-                                KernelDefines()
+                                conv_window_defines(weight.dim(2), weight.dim(3), options.stride, options.padding)
                                     .add("COUT", weight.dim(0))
                                     .add("PIXELS", kPixelsPerGroup)
                                     .add("GROUP", group)
-                                    .add("KH", weight.dim(2))
-                                    .add("KW", weight.dim(3))
-                                    .add("STRIDE", options.stride)
-                                    .add("PAD", options.padding)
                                     .add("HAS_BIAS", has_bias)
                                     .add(activation_defines(options.activation)));
   const auto out_h = static_cast<std::size_t>(output.h()), out_w = static_cast<std::size_t>(output.w());

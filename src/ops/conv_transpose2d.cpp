@@ -118,11 +118,7 @@ void conv_transpose2d(Queue& queue, const Tensor& input, const Tensor& weight, c
   // col2im addresses the bias of a channel block through a [1, co] view of it.
   const Tensor bias_row = has_bias ? bias.reshaped({1, static_cast<std::int64_t>(out_channels)}) : Tensor();
   Kernel& gather = queue.kernel("col2im", "col2im",
-                                KernelDefines()
-                                    .add("KH", kh)
-                                    .add("KW", kw)
-                                    .add("STRIDE", options.stride)
-                                    .add("PAD", options.padding)
+                                detail::conv_window_defines(weight.dim(2), weight.dim(3), options.stride, options.padding)
                                     .add("HAS_BIAS", has_bias)
                                     .add(activation_defines(options.activation)));
   const Range local(detail::work_group_size(device, 64), 1);

@@ -50,6 +50,12 @@ inline std::size_t packed_column_budget(const Device& device, std::size_t reques
   return column_budget(device, requested ? requested : kPackedFloats);
 }
 
+// The window parameters of every kernel that reads a convolution's input windows itself
+// (im2col, col2im, the direct and split-K convolutions): kernel size, stride, padding.
+inline KernelDefines conv_window_defines(std::int64_t kh, std::int64_t kw, int stride, int padding) {
+  return KernelDefines().add("KH", kh).add("KW", kw).add("STRIDE", stride).add("PAD", padding);
+}
+
 // The same elements in the same order: the one kind of aliasing an elementwise kernel tolerates.
 inline bool same_view(const Tensor& a, const Tensor& b) {
   return a.buffer() == b.buffer() && a.offset() == b.offset() && a.shape() == b.shape() &&
