@@ -505,7 +505,7 @@ py::array_t<float> dis_flow(const py::array& first, const py::array& second, con
   require_flow_check_setting(flow_check, "flow_check");
   std::vector<FlowField> flows;
   run_interruptibly([&](const std::atomic<bool>& stop) {
-    DisFlow dis(method == "dis-fine" ? DisVariant::Fine : DisVariant::Medium);
+    DisFlow dis(dis_variant(parse_flow_method(method)));
     for (std::size_t i = 0; i < a.size() && !stop; ++i) {
       flows.push_back(dis.compute(a[i], b[i]));
       dis.check(flows.back(), a[i], b[i], flow_check);

@@ -84,8 +84,9 @@ def test_cli_flow_dis_fine_matches_dis_flow_method_dis_fine(cli, sequence, tmp_p
     fine = inertialnet.dis_flow(a, b, method="dis-fine")
     np.testing.assert_array_equal(fine.view(np.uint32), from_cli.view(np.uint32))
     assert not np.array_equal(fine, inertialnet.dis_flow(a, b))
-    with pytest.raises(ValueError, match="method 'farneback': expected dis or dis-fine"):
-        inertialnet.dis_flow(a, b, method="farneback")
+    for method in ("farneback", "", "lk", "flownet2"):
+        with pytest.raises(ValueError, match=f"method '{method}': expected dis or dis-fine"):
+            inertialnet.dis_flow(a, b, method=method)
 
 
 def test_save_flow_matches_keep_flow(cli, sequence, tmp_path):

@@ -65,7 +65,7 @@ std::vector<KindGemmReference> packed_gemm_references(Queue& queue, ModelKind mo
       if (found == seconds.end()) {
         found = seconds.emplace(key, packed_gemm_seconds(queue, s->m, s->n, s->k, kReferenceRuns)).first;
       }
-      flops += 2.0 * static_cast<double>(s->m) * static_cast<double>(s->n) * static_cast<double>(s->k);
+      flops += s->flops();
       total += found->second;
     }
     r.products = products_of_kind[i].size();
