@@ -70,7 +70,9 @@ Command register_flow(CLI::App& app, const GlobalOptions& global) {
   app.add_option("image1", o->image1, "first frame")->required()->check(CLI::ExistingFile);
   app.add_option("image2", o->image2, "second frame (same size)")->required()->check(CLI::ExistingFile);
   app.add_option("-w,--weights", o->weights, "FlowNet2-family weights (safetensors); repeatable");
-  app.add_option("--flow", o->flow, "flownet2 (default with weights) or dis (OpenCV DIS; default without weights)")
+  app.add_option("--flow", o->flow,
+                 "flownet2 (default with weights), dis (OpenCV DIS; default without weights) or dis-fine (DIS "
+                 "refined down to the full resolution)")
       ->transform(choice("flow method", {"flownet2", "dis", "dis-fine"}));
   app.add_option("--model", o->model, "flow network (default: from the weights)")
       ->transform(choice("model", flow_model_names()));

@@ -446,8 +446,9 @@ Command register_predict(CLI::App& app, const GlobalOptions& global) {
   app.add_option("--model", o->model, "flow network (default FlowNet2)")->transform(choice("model", flow_model_names()));
   app.add_option("--flow", o->flow,
                  "flownet2 (default with weights), dis (OpenCV DIS; default without weights when --readout-time is "
-                 "given) or lk (sparse Lucas-Kanade at the geometric head's sample points; geometric head only; "
-                 "default without weights otherwise)")
+                 "given), dis-fine (DIS refined down to the full resolution: a recipe head's since v3) or lk "
+                 "(sparse Lucas-Kanade at the geometric head's sample points; geometric head only; default without "
+                 "weights otherwise)")
       ->transform(choice("flow method", {"flownet2", "dis", "dis-fine", "lk"}));
   app.add_option("--head", o->head, "inertialnet (default with weights), geometric (default without), or both")
       ->transform(choice("head", {"inertialnet", "geometric", "both"}));
