@@ -342,13 +342,36 @@ std::vector<float> SafetensorsFile::to_float32(const std::string& name) const {
   return out;
 }
 
+namespace {
+
+std::optional<MetadataEntry> metadata_entry(const SafetensorsFile& file, const std::string& key) {
+  const auto& meta = file.metadata();
+  if (const auto found = meta.find(key); found != meta.end()) return MetadataEntry{file.path(), found->second};
+  return std::nullopt;
+}
+
+}  // namespace
+
 std::optional<MetadataEntry> find_metadata(const std::vector<std::string>& paths, const std::string& key) {
+  // One file open at a time, and none after the one that answers.
   for (const auto& path : paths) {
-    const SafetensorsFile file(path);
-    const auto& meta = file.metadata();
-    if (const auto found = meta.find(key); found != meta.end()) return MetadataEntry{path, found->second};
+    if (auto entry = metadata_entry(SafetensorsFile(path), key)) return entry;
   }
   return std::nullopt;
+}
+
+std::optional<MetadataEntry> find_metadata_in(const std::vector<SafetensorsFile>& files, const std::string& key) {
+  for (const auto& file : files) {
+    if (auto entry = metadata_entry(file, key)) return entry;
+  }
+  return std::nullopt;
+}
+
+std::vector<SafetensorsFile> open_safetensors(const std::vector<std::string>& paths) {
+  std::vector<SafetensorsFile> files;
+  files.reserve(paths.size());
+  for (const auto& path : paths) files.emplace_back(path);
+  return files;
 }
 
 }  // namespace inertialnet

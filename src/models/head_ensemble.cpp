@@ -50,8 +50,10 @@ int head_ensemble_from_json(const std::string& text) {
   return members;
 }
 
-int read_head_ensemble(const std::vector<std::string>& paths) {
-  const auto entry = find_metadata(paths, kMetadataEnsemble);
+namespace {
+
+// The member count a file's metadata records (1 when none does).
+int head_ensemble_of(const std::optional<MetadataEntry>& entry) {
   if (!entry) return 1;
   try {
     return head_ensemble_from_json(entry->value);
@@ -60,6 +62,16 @@ int read_head_ensemble(const std::vector<std::string>& paths) {
     throw invalid_input(entry->path + ": metadata " + kMetadataEnsemble + " '" + entry->value.substr(0, 80) +
                         "' is not a head ensemble description: " + e.what());
   }
+}
+
+}  // namespace
+
+int read_head_ensemble(const std::vector<std::string>& paths) {
+  return head_ensemble_of(find_metadata(paths, kMetadataEnsemble));
+}
+
+int read_head_ensemble(const std::vector<SafetensorsFile>& files) {
+  return head_ensemble_of(find_metadata_in(files, kMetadataEnsemble));
 }
 
 EnsembleRates combine_ensemble(const std::vector<std::array<double, 3>>& members) {

@@ -54,8 +54,10 @@ HeadInputInfo head_input_from_json(const std::string& text) {
   return info;
 }
 
-HeadInputInfo read_head_input(const std::vector<std::string>& paths) {
-  const auto entry = find_metadata(paths, kMetadataHeadInput);
+namespace {
+
+// The head input a file's metadata records (the paper's when none does).
+HeadInputInfo head_input_of(const std::optional<MetadataEntry>& entry) {
   if (!entry) return {};
   try {
     return head_input_from_json(entry->value);
@@ -64,6 +66,16 @@ HeadInputInfo read_head_input(const std::vector<std::string>& paths) {
     throw invalid_input(entry->path + ": metadata " + kMetadataHeadInput + " '" + entry->value.substr(0, 80) +
                         "' is not a head input description: " + e.what());
   }
+}
+
+}  // namespace
+
+HeadInputInfo read_head_input(const std::vector<std::string>& paths) {
+  return head_input_of(find_metadata(paths, kMetadataHeadInput));
+}
+
+HeadInputInfo read_head_input(const std::vector<SafetensorsFile>& files) {
+  return head_input_of(find_metadata_in(files, kMetadataHeadInput));
 }
 
 std::vector<float> resize_flow(const float* flow, int w, int h, int out_w, int out_h) {

@@ -111,8 +111,10 @@ SigmaCalibration sigma_calibration_from_json(const std::string& text) {
   return c;
 }
 
-std::optional<SigmaCalibration> read_sigma_calibration(const std::vector<std::string>& paths) {
-  const auto entry = find_metadata(paths, kMetadataSigmaCalibration);
+namespace {
+
+// The calibration a file's metadata records (nullopt when none does).
+std::optional<SigmaCalibration> sigma_calibration_of(const std::optional<MetadataEntry>& entry) {
   if (!entry) return std::nullopt;
   try {
     return sigma_calibration_from_json(entry->value);
@@ -121,6 +123,16 @@ std::optional<SigmaCalibration> read_sigma_calibration(const std::vector<std::st
     throw invalid_input(entry->path + ": metadata " + kMetadataSigmaCalibration + " '" + entry->value.substr(0, 160) +
                         "' is not a valid σ calibration: " + e.what());
   }
+}
+
+}  // namespace
+
+std::optional<SigmaCalibration> read_sigma_calibration(const std::vector<std::string>& paths) {
+  return sigma_calibration_of(find_metadata(paths, kMetadataSigmaCalibration));
+}
+
+std::optional<SigmaCalibration> read_sigma_calibration(const std::vector<SafetensorsFile>& files) {
+  return sigma_calibration_of(find_metadata_in(files, kMetadataSigmaCalibration));
 }
 
 SigmaCalibration fit_sigma_calibration(const std::vector<SigmaFitSample>& samples) {

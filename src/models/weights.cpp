@@ -31,47 +31,58 @@ void WeightSet::add(Device& device, const std::string& name, const Shape& shape,
   source_of_.emplace(name, source);
 }
 
+void WeightSet::add_file(Device& device, const SafetensorsFile& file) {
+  const std::string& path = file.path();
+  const std::string source = std::filesystem::path(path).filename().string();
+  source_names_.push_back(source);
+  const auto& meta = file.metadata();
+  if (auto synthetic = meta.find(kMetadataSynthetic); synthetic != meta.end() && synthetic->second == "true") {
+    const auto model = meta.count(kMetadataModel) ? meta.at(kMetadataModel) : std::string("model");
+    const auto seed = meta.count(kMetadataSeed) ? meta.at(kMetadataSeed) : std::string("?");
+    synthetic_sources_.push_back(source + " (synthetic " + model + ", seed " + seed + ")");
+  }
+  if (auto model = meta.find(kMetadataModel); model != meta.end()) {
+    try {
+      models_.push_back(model_kind_from_string(model->second));
+    } catch (const Error& e) {
+      throw invalid_input(path + ": metadata " + kMetadataModel + ": " + e.what());
+    }
+  }
+  if (auto head = meta.find(kMetadataHead); head != meta.end()) {
+    try {
+      head_config_ = head_config_from_json(head->second);
+    } catch (const Error& e) {
+      throw invalid_input(path + ": metadata " + kMetadataHead + " is not a valid head configuration: " + e.what());
+    }
+    has_head_config_ = true;
+  }
+  for (const auto& name : file.names()) {
+    const std::vector<float> values = file.to_float32(name);
+    // A NaN or infinite weight poisons every output it reaches; refuse it where it enters.
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      if (!std::isfinite(values[i])) {
+        const std::string text = std::isnan(values[i]) ? "nan" : values[i] > 0 ? "inf" : "-inf";
+        throw invalid_input(path + ": tensor '" + name + "' holds " + text + " at element " + std::to_string(i) +
+                            "; weights must be finite numbers.");
+      }
+    }
+    add(device, name, file.shape(name), values, source);
+  }
+}
+
 WeightSet WeightSet::load(Device& device, const std::vector<std::string>& paths) {
   if (paths.empty()) throw invalid_input("no weight file given");
   WeightSet set;
-  for (const auto& path : paths) {
-    const SafetensorsFile file(path);
-    const std::string source = std::filesystem::path(path).filename().string();
-    set.source_names_.push_back(source);
-    const auto& meta = file.metadata();
-    if (auto synthetic = meta.find(kMetadataSynthetic); synthetic != meta.end() && synthetic->second == "true") {
-      const auto model = meta.count(kMetadataModel) ? meta.at(kMetadataModel) : std::string("model");
-      const auto seed = meta.count(kMetadataSeed) ? meta.at(kMetadataSeed) : std::string("?");
-      set.synthetic_sources_.push_back(source + " (synthetic " + model + ", seed " + seed + ")");
-    }
-    if (auto model = meta.find(kMetadataModel); model != meta.end()) {
-      try {
-        set.models_.push_back(model_kind_from_string(model->second));
-      } catch (const Error& e) {
-        throw invalid_input(path + ": metadata " + kMetadataModel + ": " + e.what());
-      }
-    }
-    if (auto head = meta.find(kMetadataHead); head != meta.end()) {
-      try {
-        set.head_config_ = head_config_from_json(head->second);
-      } catch (const Error& e) {
-        throw invalid_input(path + ": metadata " + kMetadataHead + " is not a valid head configuration: " + e.what());
-      }
-      set.has_head_config_ = true;
-    }
-    for (const auto& name : file.names()) {
-      const std::vector<float> values = file.to_float32(name);
-      // A NaN or infinite weight poisons every output it reaches; refuse it where it enters.
-      for (std::size_t i = 0; i < values.size(); ++i) {
-        if (!std::isfinite(values[i])) {
-          const std::string text = std::isnan(values[i]) ? "nan" : values[i] > 0 ? "inf" : "-inf";
-          throw invalid_input(path + ": tensor '" + name + "' holds " + text + " at element " +
-                              std::to_string(i) + "; weights must be finite numbers.");
-        }
-      }
-      set.add(device, name, file.shape(name), values, source);
-    }
-  }
+  // One file open at a time: each is read whole before the next is opened.
+  for (const auto& path : paths) set.add_file(device, SafetensorsFile(path));
+  device.queue().finish();
+  return set;
+}
+
+WeightSet WeightSet::load(Device& device, const std::vector<SafetensorsFile>& files) {
+  if (files.empty()) throw invalid_input("no weight file given");
+  WeightSet set;
+  for (const auto& file : files) set.add_file(device, file);
   device.queue().finish();
   return set;
 }

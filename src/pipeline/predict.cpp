@@ -13,6 +13,7 @@
 #include "inertialnet/io/bag.hpp"
 #include "inertialnet/io/calibration_file.hpp"
 #include "inertialnet/io/camera.hpp"
+#include "inertialnet/io/safetensors.hpp"
 #include "inertialnet/models/flow_consistency.hpp"
 #include "inertialnet/models/head_ensemble.hpp"
 #include "inertialnet/models/head_input.hpp"
@@ -219,14 +220,19 @@ Prediction::Prediction(const PredictSettings& s) : settings_(s) {
                                     "FlowNet2 and InertialNet head tensors (safetensors). ") + kNoWeightsHelp +
                         ". Without weights, predict runs Lucas-Kanade (or DIS) flow + the geometric head.");
   }
+  // The weight files, each opened and its header read and validated once: the questions asked of
+  // their metadata below and every device's weights come from these (opened here for the
+  // InertialNet head, else where the first device loads them).
+  std::vector<SafetensorsFile> weight_files;
   // A trained head says which flow it learned from and how its input is scaled (its metadata
   // "inertialnet.head_input"; none: the paper's convention): that flow is the default, another one
   // asked for explicitly is refused, since the head has never seen it.
   if (processor_.inertialnet_head) {
-    const HeadInputInfo trained = read_head_input(s.weights);
+    weight_files = open_safetensors(s.weights);
+    const HeadInputInfo trained = read_head_input(weight_files);
     processor_.head_input = trained.convention;
     processor_.head_camera_frame = trained.camera_frame;
-    processor_.ensemble_members = read_head_ensemble(s.weights);  // 1: a single head
+    processor_.ensemble_members = read_head_ensemble(weight_files);  // 1: a single head
     if (!trained.flow.empty()) {
       const FlowMethod learned = parse_flow_method(trained.flow);
       if (s.flow.empty()) {
@@ -273,7 +279,7 @@ Prediction::Prediction(const PredictSettings& s) : settings_(s) {
   if (processor_.fuse && processor_.inertialnet_head) {
     // The head's own σ calibration (models/sigma_calibration.hpp; invalid_input naming the file and
     // the key when malformed); a head without one keeps the built-in σ model and plain weights.
-    if (const auto calibration = read_sigma_calibration(s.weights)) {
+    if (const auto calibration = read_sigma_calibration(weight_files)) {
       processor_.head_sigma.calibration = calibration;
       processor_.fusion.geometric_scale = calibration->geometric_scale;
       processor_.fusion.correlation = calibration->correlation;
@@ -292,7 +298,8 @@ Prediction::Prediction(const PredictSettings& s) : settings_(s) {
     options.profiler = s.profiler;
     devices_.push_back(std::make_unique<Device>(info, options));
     if (have_weights) {
-      weight_sets_.push_back(std::make_unique<WeightSet>(WeightSet::load(*devices_.back(), s.weights)));
+      if (weight_files.empty()) weight_files = open_safetensors(s.weights);
+      weight_sets_.push_back(std::make_unique<WeightSet>(WeightSet::load(*devices_.back(), weight_files)));
       weights_of_[devices_.back().get()] = weight_sets_.back().get();
     }
   }

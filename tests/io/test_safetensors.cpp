@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "inertialnet/runtime/error.hpp"
+#include "support/testing.hpp"
 
 namespace inertialnet {
 namespace {
@@ -149,6 +150,32 @@ TEST_F(SafetensorsTest, FindMetadataSearchesTheFilesInOrder) {
   EXPECT_EQ(find_metadata({c, b}, "key")->value, "from c");
   EXPECT_FALSE(find_metadata({a}, "key").has_value());
   EXPECT_FALSE(find_metadata({}, "key").has_value());
+}
+
+// The same files opened once (predict asks their metadata several questions): open_safetensors
+// keeps the order given, find_metadata_in answers as find_metadata does by path, and a file that
+// does not open is refused as it is by path.
+TEST_F(SafetensorsTest, FindMetadataInOpenFilesAnswersAsByPath) {
+  const std::string a = path("a.safetensors"), b = path("b.safetensors"), c = path("c.safetensors");
+  write_safetensors(a, std::vector<HostTensor>{{"x", {1}, {1.0f}}});
+  write_safetensors(b, std::vector<HostTensor>{{"y", {1}, {2.0f}}}, {{"key", "from b"}});
+  write_safetensors(c, std::vector<HostTensor>{{"z", {1}, {3.0f}}}, {{"key", "from c"}});
+  const std::vector<SafetensorsFile> files = open_safetensors({a, b, c});
+  ASSERT_EQ(files.size(), 3u);
+  EXPECT_EQ(files[0].path(), a);
+  EXPECT_EQ(files[2].path(), c);
+  const auto found = find_metadata_in(files, "key");
+  ASSERT_TRUE(found.has_value());
+  EXPECT_EQ(found->path, b);
+  EXPECT_EQ(found->value, "from b");
+  EXPECT_EQ(find_metadata_in(open_safetensors({c, b}), "key")->value, "from c");
+  EXPECT_FALSE(find_metadata_in(open_safetensors({a}), "key").has_value());
+  EXPECT_FALSE(find_metadata_in(std::vector<SafetensorsFile>{}, "key").has_value());
+  EXPECT_TRUE(open_safetensors({}).empty());
+  const std::string missing = path("missing.safetensors");
+  const std::string refused = testing::invalid_input_message([&] { open_safetensors({a, missing}); });
+  EXPECT_TRUE(testing::contains(refused, missing)) << refused;
+  EXPECT_EQ(refused, testing::invalid_input_message([&] { SafetensorsFile{missing}; }));
 }
 
 TEST_F(SafetensorsTest, WriterPadsHeaderWithSpacesToAMultipleOfEight) {

@@ -156,6 +156,39 @@ TEST(HeadEnsemble, TheFileKeepsEveryMembersTensorsExactly) {
   EXPECT_EQ(wa, wb);
 }
 
+// The ensemble read from its files opened once, as predict reads them: the same member count, and
+// the same weight set (tensors, head configuration, sources) as loaded by path.
+TEST(HeadEnsemble, ReadFromOpenFilesAnswersAsByPath) {
+  const Fixture& f = fixture();
+  const std::string path = (f.root / "ensemble_open.safetensors").string();
+  write_head_ensemble(path, f.heads);
+  const std::vector<SafetensorsFile> files = open_safetensors({f.heads[0], path});
+  EXPECT_EQ(read_head_ensemble(files), 3);
+  EXPECT_EQ(read_head_ensemble(open_safetensors({f.heads[0]})), 1);  // a plain head
+  const std::string bad = (f.root / "ensemble_bad.safetensors").string();
+  write_safetensors(bad, std::vector<HostTensor>{{"head.fc2.bias", {3}, {0.0f, 0.0f, 0.0f}}},
+                    {{kMetadataEnsemble, "{\"members\":1,\"version\":1}"}});
+  const std::string message = invalid_input_message([&] { read_head_ensemble(open_safetensors({bad})); });
+  EXPECT_NE(message.find(bad), std::string::npos) << message;
+  EXPECT_EQ(message, invalid_input_message([&] { read_head_ensemble({bad}); }));
+
+  const std::vector<SafetensorsFile> ensemble = open_safetensors({path});
+  const WeightSet opened = WeightSet::load(testing::test_device(), ensemble);
+  const WeightSet by_path = WeightSet::load(testing::test_device(), {path});
+  EXPECT_EQ(opened.shapes(), by_path.shapes());
+  EXPECT_EQ(opened.sources(), by_path.sources());
+  EXPECT_TRUE(opened.has_head_config());
+  EXPECT_EQ(head_config_to_json(opened.head_config()), head_config_to_json(by_path.head_config()));
+  Queue& queue = testing::test_queue();
+  for (const auto& [name, tensor] : by_path.tensors()) {
+    EXPECT_EQ(opened.get(name).to_host(queue), tensor.to_host(queue)) << name;
+  }
+  // The files stay open and readable: a second device's load reads the same headers again.
+  EXPECT_EQ(WeightSet::load(testing::test_device(), ensemble).shapes(), by_path.shapes());
+  testing::expect_invalid_input([] { WeightSet::load(testing::test_device(), std::vector<SafetensorsFile>{}); },
+                                "no weight file given");
+}
+
 TEST(HeadEnsemble, AFlowModelBesideTheEnsembleDoesNotClaimTheMembersTensors) {
   // predict -w flownet2.safetensors -w ensemble.safetensors: the flow model owns every name but the
   // head's, and the members' ensemble.* names are the head's too.

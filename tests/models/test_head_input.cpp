@@ -5,10 +5,14 @@
 // paper's does not), the paper convention is the resize train always did, the added rotation
 // flow is the rotational motion field of docs/data_conventions.md, and the metadata round trip.
 #include <cmath>
+#include <filesystem>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "inertialnet/io/safetensors.hpp"
+#include "inertialnet/io/safetensors_writer.hpp"
 #include "inertialnet/models/head_input.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/train/rotation_augmentation.hpp"
@@ -127,6 +131,27 @@ TEST(HeadInput, MetadataRoundTripAndRefusals) {
   }
   EXPECT_EQ(parse_head_input("normalized"), HeadInput::Normalized);
   EXPECT_THROW(parse_head_input("Normalised"), Error);
+}
+
+// read_head_input from the weight files opened once (as predict reads them) answers as it does
+// by path: the first file with the metadata, the paper's convention when none has it, and a
+// malformed record refused with the same message naming the file and the key.
+TEST(HeadInput, ReadFromOpenFilesAnswersAsByPath) {
+  const std::filesystem::path root = testing::temporary_directory("head_input_files");
+  const std::string plain = (root / "plain.safetensors").string(), head = (root / "head.safetensors").string();
+  const std::string bad = (root / "bad.safetensors").string();
+  const std::vector<HostTensor> tensors{{"head.fc2.bias", {3}, {0.0f, 0.0f, 0.0f}}};
+  write_safetensors(plain, tensors);
+  write_safetensors(head, tensors, {{kMetadataHeadInput, head_input_to_json({HeadInput::Normalized, "dis", true})}});
+  write_safetensors(bad, tensors, {{kMetadataHeadInput, "{\"convention\":\"pixels\"}"}});
+  const HeadInputInfo found = read_head_input(open_safetensors({plain, head}));
+  EXPECT_EQ(found.convention, HeadInput::Normalized);
+  EXPECT_EQ(found.flow, "dis");
+  EXPECT_TRUE(found.camera_frame);
+  EXPECT_EQ(read_head_input(open_safetensors({plain})).convention, HeadInput::Paper);
+  const std::string message = testing::invalid_input_message([&] { read_head_input(open_safetensors({bad, head})); });
+  EXPECT_TRUE(testing::contains(message, bad) && testing::contains(message, kMetadataHeadInput)) << message;
+  EXPECT_EQ(message, testing::invalid_input_message([&] { read_head_input({bad, head}); }));
 }
 
 TEST(RotationAugmentation, AddsTheRotationalMotionFieldInEitherConvention) {

@@ -5,6 +5,7 @@
 // naming the file, the key and the value (exit 2 in the CLI); the head's σ applies the
 // calibration; and on correlated synthetic errors the generalised least-squares fusion beats both
 // heads on every axis where the independent inverse-variance rule does not.
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -14,11 +15,13 @@
 
 #include <gtest/gtest.h>
 
+#include "inertialnet/io/safetensors.hpp"
 #include "inertialnet/io/safetensors_writer.hpp"
 #include "inertialnet/models/head_uncertainty.hpp"
 #include "inertialnet/models/sigma_calibration.hpp"
 #include "inertialnet/pipeline/rate_fusion.hpp"
 #include "inertialnet/runtime/error.hpp"
+#include "support/testing.hpp"
 
 namespace inertialnet {
 namespace {
@@ -128,6 +131,30 @@ TEST(SigmaCalibration, BadMetadataInAHeadFileIsInvalidInputNamingFileKeyAndValue
   write_safetensors(path, tensors, std::map<std::string, std::string>{});
   EXPECT_FALSE(read_sigma_calibration({path}).has_value());
   std::filesystem::remove(path);
+}
+
+// read_sigma_calibration from the weight files opened once (as predict --fuse reads them) answers
+// as it does by path: the first file's calibration, none without one, and a malformed one refused
+// with the same message naming the file and the key.
+TEST(SigmaCalibration, ReadFromOpenFilesAnswersAsByPath) {
+  const std::filesystem::path root = testing::temporary_directory("sigma_calibration_files");
+  const std::string plain = (root / "plain.safetensors").string(), head = (root / "head.safetensors").string();
+  const std::string bad = (root / "bad.safetensors").string();
+  const std::vector<HostTensor> tensors{{"head.fc2.bias", {3}, {0.0f, 0.0f, 0.0f}}};
+  write_safetensors(plain, tensors, std::map<std::string, std::string>{});
+  write_safetensors(head, tensors,
+                    {{kMetadataSigmaCalibration, R"({"floor_rad_s":[0.1,0.2,0.3],"pairs":5,"scale":[1,2,3],"version":1})"}});
+  write_safetensors(bad, tensors,
+                    {{kMetadataSigmaCalibration, R"({"floor_rad_s":[0.1,-0.5,0.1],"pairs":5,"scale":[1,1,1],"version":1})"}});
+  const auto found = read_sigma_calibration(open_safetensors({plain, head}));
+  ASSERT_TRUE(found.has_value());
+  EXPECT_EQ(found->scale, (std::array<double, 3>{1, 2, 3}));
+  EXPECT_EQ(found->floor_rad_s, (std::array<double, 3>{0.1, 0.2, 0.3}));
+  EXPECT_EQ(found->pairs, 5u);
+  EXPECT_FALSE(read_sigma_calibration(open_safetensors({plain})).has_value());
+  const std::string message = testing::invalid_input_message([&] { read_sigma_calibration(open_safetensors({bad})); });
+  EXPECT_TRUE(testing::contains(message, bad) && testing::contains(message, kMetadataSigmaCalibration)) << message;
+  EXPECT_EQ(message, testing::invalid_input_message([&] { read_sigma_calibration({bad}); }));
 }
 
 TEST(SigmaCalibration, HeadSigmaOptionsRefuseAnInvalidCalibration) {

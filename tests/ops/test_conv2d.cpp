@@ -5,87 +5,33 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
-#include <ostream>
 #include <string>
 #include <vector>
 
 #include "inertialnet/ops/conv2d.hpp"
-#include "inertialnet/ops/gemm/backend.hpp"
 #include "inertialnet/ops/gemm/plan.hpp"
 #include "reference/conv.hpp"
-#include "ops/op_testing.hpp"
-#include "ops/winograd.hpp"
+#include "support/conv_matches.hpp"
 #include "support/flownet_layers.hpp"
 #include "support/testing.hpp"
 
 namespace inertialnet {
 namespace {
 
-struct ConvCase {
-  std::string name;
-  int ci, co, h, w, k, stride, padding;
-  bool bias;
-  ActivationSpec activation;
-};
-void PrintTo(const ConvCase& c, std::ostream* os) { *os << c.name; }
-
-// Where the op's tensors sit inside wider tensors: `*_before` / `*_after` extra channels around
-// the input and the output (0 everywhere: plain contiguous tensors).
-struct Placement {
-  int batch = 1;
-  int in_before = 0, in_after = 0;
-  int out_before = 0, out_after = 0;
-  std::size_t max_column_floats = 0;
-};
-
-// A FlowNet2 layer of the shared table as a test case.
-ConvCase from_layer(const flownet_layers::LayerShape& l) {
-  return {l.identifier(), l.ci, l.co, l.h, l.w, l.k, l.stride, l.padding, l.bias, l.activation};
-}
-
-void expect_conv_matches(const ConvCase& c, const Placement& p) {
-  SCOPED_TRACE(c.name);
-  Queue& queue = testing::test_queue();
-  reference::ConvShape s{p.batch, c.ci, c.h, c.w, c.co, c.k, c.k, c.stride, c.padding};
-  const int oh = s.conv_out_h(), ow = s.conv_out_w();
-  const std::size_t in_plane = static_cast<std::size_t>(c.h) * c.w;
-
-  const auto input = testing::random_vector(static_cast<std::size_t>(p.batch) * c.ci * in_plane, 101);
-  const auto weight = testing::random_vector(static_cast<std::size_t>(c.co) * c.ci * c.k * c.k, 102);
-  const auto bias = c.bias ? testing::random_vector(static_cast<std::size_t>(c.co), 103) : std::vector<float>{};
-  const auto expected = reference::conv2d(s, input, weight, bias, c.activation);
-
-  // The input and the output as channel slices of wider tensors whose other channels must survive.
-  const testing::Sliced in =
-      testing::embed_sliced(queue, input, {p.batch, c.ci, c.h, c.w}, p.in_before, p.in_before + p.in_after, 104);
-  const testing::Sliced out =
-      testing::make_sliced(queue, {p.batch, c.co, oh, ow}, p.out_before, p.out_before + p.out_after, 105);
-  Tensor w = Tensor::from_host(queue, {c.co, c.ci, c.k, c.k}, weight);
-  Tensor b = c.bias ? Tensor::from_host(queue, {c.co}, bias) : Tensor();
-  Conv2dOptions options{c.stride, c.padding, c.activation, p.max_column_floats};
-  conv2d(queue, in.view, w, b, out.view, options);
-  EXPECT_TRUE(testing::untouched_outside(queue, out)) << "elements outside the output slice were written";
-  const auto got = testing::view_values(queue, out);
-  // float32 accumulation of K = ci·k·k products of magnitude ≲ 1 against a double reference:
-  // the error grows with the reduction length, so the absolute floor is sqrt(K) (the typical
-  // output magnitude) and 1e-5 relative to that leaves ~10× margin over K·eps at K ≈ 10^4.
-  // The winograd plan's F(4×4, 3×3) layers have a measured bound of their own (op_testing.hpp).
-  const double floor = std::sqrt(static_cast<double>(c.ci) * c.k * c.k);
-  const bool winograd = gemm_backend(queue.device().info()) == GemmBackend::Winograd &&
-                        detail::winograd_preferred(in.view.shape(), w.shape(), c.stride);
-  EXPECT_TRUE(testing::all_close(got, expected, winograd ? testing::kWinogradRelativeTolerance : 1e-5, floor));
-}
+using testing::ConvCase;
+using testing::expect_conv_matches;
+using testing::ConvPlacement;
 
 class FlowNetConvShapes : public ::testing::TestWithParam<ConvCase> {};
 
-TEST_P(FlowNetConvShapes, MatchTheReference) { expect_conv_matches(GetParam(), Placement{}); }
+TEST_P(FlowNetConvShapes, MatchTheReference) { expect_conv_matches(GetParam(), ConvPlacement{}); }
 
 // Every FlowNet2 convolution at a 64×64 network input (FlowNetC/S/SD at 1/2…1/64 resolution,
 // FlowNetFusion at full, 1/2 and 1/4 resolution).
 std::vector<ConvCase> flownet2_conv_cases() {
   std::vector<ConvCase> cases;
   for (const auto& layer : flownet_layers::flownet2_layers(64, 64, flownet_layers::LayerKind::Conv)) {
-    cases.push_back(from_layer(layer));
+    cases.push_back(testing::conv_case_of(layer));
   }
   return cases;
 }
@@ -105,7 +51,7 @@ TEST(Conv2d, OddSizesBatchThree) {
 }
 
 TEST(Conv2d, WritesIntoAChannelSliceAndReadsFromOne) {
-  const Placement p{3, 2, 3, 5, 4, 0};
+  const ConvPlacement p{3, 2, 3, 5, 4, 0};
   // im2col path, 1×1 direct path, and an output at the very start / end of the wide tensor.
   expect_conv_matches({"slice_k3", 6, 10, 37, 23, 3, 1, 1, true, ActivationSpec::leaky_relu(0.1f)}, p);
   expect_conv_matches({"slice_k1", 6, 10, 37, 23, 1, 1, 0, true, ActivationSpec::leaky_relu(0.1f)}, p);
@@ -116,7 +62,7 @@ TEST(Conv2d, WritesIntoAChannelSliceAndReadsFromOne) {
 
 TEST(Conv2d, SmallColumnBudgetProcessesPixelRanges) {
   // A budget of 100 columns splits 37×23 outputs into 9 ranges, the last one partial.
-  Placement p{3, 1, 1, 2, 2, 5 * 3 * 3 * 100};
+  ConvPlacement p{3, 1, 1, 2, 2, 5 * 3 * 3 * 100};
   expect_conv_matches({"chunked", 5, 7, 37, 23, 3, 1, 1, true, ActivationSpec::leaky_relu(0.1f)}, p);
   p.max_column_floats = 1;  // one pixel at a time
   expect_conv_matches({"one_pixel", 2, 3, 5, 4, 3, 2, 1, true, ActivationSpec::relu()}, p);
@@ -148,7 +94,7 @@ TEST(Conv2d, FewOutputChannelsDirectKernelAtOddSizes) {
 TEST(Conv2d, PredictFlowAtFlowNet2sRealSize) {
   for (const auto& layer : flownet_layers::flownet2_layers(384, 512, flownet_layers::LayerKind::Conv)) {
     if (layer.co > kDirectConvMaxChannels) continue;
-    expect_conv_matches(from_layer(layer), Placement{});
+    expect_conv_matches(testing::conv_case_of(layer), ConvPlacement{});
   }
 }
 

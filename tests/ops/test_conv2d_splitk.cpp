@@ -4,7 +4,6 @@
 // tests/reference/conv.cpp with the bounds of test_conv2d: odd sizes, a single pixel, channel
 // slices, batches, FlowNet2's real layer shapes; and the selection rules (GPU devices only).
 // The sliced form runs its products on the plan's backend: the suite runs under every plan.
-#include <cmath>
 #include <string>
 #include <vector>
 
@@ -13,52 +12,20 @@
 #include "ops/conv2d_slices.hpp"
 #include "ops/conv2d_splitk.hpp"
 #include "ops/op_testing.hpp"
-#include "reference/conv.hpp"
+#include "support/conv_matches.hpp"
 #include "support/flownet_layers.hpp"
 #include "support/testing.hpp"
 
 namespace inertialnet {
 namespace {
 
-struct SplitCase {
-  std::string name;
-  int ci, co, h, w, k, stride, padding;
-  bool bias;
-  ActivationSpec activation;
-  int batch = 1;
-  // Extra channels around the input and the output view (0: plain contiguous tensors).
-  int in_before = 0, in_after = 0, out_before = 0, out_after = 0;
-  std::size_t max_column_floats = 0;
-};
+using testing::ConvCase;
+using testing::ConvPlacement;
 
-SplitCase from_layer(const flownet_layers::LayerShape& l) {
-  return {l.identifier(), l.ci, l.co, l.h, l.w, l.k, l.stride, l.padding, l.bias, l.activation};
-}
-
-void expect_form_matches(const SplitCase& c, Conv2dAlgorithm algorithm) {
-  SCOPED_TRACE(c.name);
-  Queue& queue = testing::test_queue();
-  const reference::ConvShape s{c.batch, c.ci, c.h, c.w, c.co, c.k, c.k, c.stride, c.padding};
-  const int oh = s.conv_out_h(), ow = s.conv_out_w();
-  const auto input = testing::random_vector(static_cast<std::size_t>(c.batch) * c.ci * c.h * c.w, 201);
-  const auto weight = testing::random_vector(static_cast<std::size_t>(c.co) * c.ci * c.k * c.k, 202);
-  const auto bias = c.bias ? testing::random_vector(static_cast<std::size_t>(c.co), 203) : std::vector<float>{};
-  const auto expected = reference::conv2d(s, input, weight, bias, c.activation);
-  const testing::Sliced in =
-      testing::embed_sliced(queue, input, {c.batch, c.ci, c.h, c.w}, c.in_before, c.in_before + c.in_after, 204);
-  const testing::Sliced out =
-      testing::make_sliced(queue, {c.batch, c.co, oh, ow}, c.out_before, c.out_before + c.out_after, 205);
-  const Tensor w = Tensor::from_host(queue, {c.co, c.ci, c.k, c.k}, weight);
-  const Tensor b = c.bias ? Tensor::from_host(queue, {c.co}, bias) : Tensor();
-  Conv2dOptions options{c.stride, c.padding, c.activation, c.max_column_floats};
-  options.algorithm = algorithm;
-  conv2d(queue, in.view, w, b, out.view, options);
-  EXPECT_TRUE(testing::untouched_outside(queue, out)) << "elements outside the output slice were written";
-  // test_conv2d's bound: float32 sums of K = ci·k·k products of magnitude ≲ 1 against a double
-  // reference, 1e-5 relative to the floor sqrt(K). The split-K forms add the same products in
-  // another order, which changes the rounding by a few K·eps at most.
-  const double floor = std::sqrt(static_cast<double>(c.ci) * c.k * c.k);
-  EXPECT_TRUE(testing::all_close(testing::view_values(queue, out), expected, 1e-5, floor));
+// The conv2d suites' one check (support/conv_matches.hpp: test_conv2d's bound) with `form`
+// forced, on data from seeds of this suite's own.
+void expect_form_matches(const ConvCase& c, Conv2dAlgorithm form, const ConvPlacement& p = {}) {
+  testing::expect_conv_matches(c, p, {form, 201});
 }
 
 // --- split-K across a work-group (predict_flow) ---------------------------------------------------
@@ -85,9 +52,9 @@ TEST(Conv2dSplitKGroup, OddSizes) {
 TEST(Conv2dSplitKGroup, BatchesAndChannelSlices) {
   const auto leaky = ActivationSpec::leaky_relu(0.1f);
   const auto form = Conv2dAlgorithm::SplitKGroup;
-  expect_form_matches({"batch3", 5, 2, 13, 17, 3, 1, 1, true, leaky, 3}, form);
-  expect_form_matches({"slices", 6, 2, 13, 40, 3, 1, 1, true, leaky, 3, 2, 3, 1, 4}, form);
-  expect_form_matches({"slice_last", 3, 2, 7, 9, 3, 1, 1, true, ActivationSpec::none(), 2, 1, 0, 7, 0}, form);
+  expect_form_matches({"batch3", 5, 2, 13, 17, 3, 1, 1, true, leaky}, form, {3});
+  expect_form_matches({"slices", 6, 2, 13, 40, 3, 1, 1, true, leaky}, form, {3, 2, 3, 1, 4});
+  expect_form_matches({"slice_last", 3, 2, 7, 9, 3, 1, 1, true, ActivationSpec::none()}, form, {2, 1, 0, 7, 0});
 }
 
 // FlowNet2's predict_flow layers (2 outputs, 3×3, 16…1,026 inputs) at a 192×256 network input
@@ -97,7 +64,7 @@ TEST(Conv2dSplitKGroup, FlowNet2PredictFlowShapes) {
   int layers = 0;
   for (const auto& layer : flownet_layers::flownet2_layers(192, 256, flownet_layers::LayerKind::Conv)) {
     if (layer.co > kDirectConvMaxChannels) continue;
-    expect_form_matches(from_layer(layer), Conv2dAlgorithm::SplitKGroup);
+    expect_form_matches(testing::conv_case_of(layer), Conv2dAlgorithm::SplitKGroup);
     ++layers;
   }
   EXPECT_GE(layers, 12);
@@ -159,18 +126,18 @@ TEST(Conv2dSplitKSlices, OddSizes) {
   expect_form_matches({"one_pixel", 11, 4, 1, 1, 3, 1, 1, true, leaky}, form);
   expect_form_matches({"k5s2", 3, 7, 17, 9, 5, 2, 2, true, ActivationSpec::relu()}, form);
   expect_form_matches({"deep_odd", 515, 9, 5, 3, 3, 1, 1, true, leaky}, form);
-  SplitCase ranges{"pixel_ranges", 7, 9, 13, 11, 3, 1, 1, true, leaky, 2};
+  ConvPlacement ranges{2};
   ranges.max_column_floats = 7 * 9 * 20;  // 20 pixels per range: 8 ranges, the last partial
-  expect_form_matches(ranges, form);
+  expect_form_matches({"pixel_ranges", 7, 9, 13, 11, 3, 1, 1, true, leaky}, form, ranges);
   // More partial rows (7 slices × 30 channels) than K (63): they set the range, 3 pixels.
-  SplitCase wide{"partials_set_the_range", 7, 30, 13, 11, 3, 1, 1, true, leaky};
+  ConvPlacement wide;
   wide.max_column_floats = 7 * 30 * 3;
-  expect_form_matches(wide, form);
+  expect_form_matches({"partials_set_the_range", 7, 30, 13, 11, 3, 1, 1, true, leaky}, form, wide);
 }
 
 TEST(Conv2dSplitKSlices, BatchesAndChannelSlices) {
   const auto leaky = ActivationSpec::leaky_relu(0.1f);
-  expect_form_matches({"slices", 6, 10, 7, 9, 3, 1, 1, true, leaky, 3, 2, 3, 1, 4}, Conv2dAlgorithm::SplitKSlices);
+  expect_form_matches({"slices", 6, 10, 7, 9, 3, 1, 1, true, leaky}, Conv2dAlgorithm::SplitKSlices, {3, 2, 3, 1, 4});
 }
 
 // FlowNet2's deep layers on small images (K ≥ 9·512 and ≤ 192 output pixels: conv4_1…conv6_1
@@ -184,7 +151,7 @@ TEST(Conv2dSplitKSlices, FlowNet2DeepLayerShapes) {
     if (layer.co <= kDirectConvMaxChannels || depth < detail::kSlicedMinDepth || pixels > detail::kSlicedMaxPixels) {
       continue;
     }
-    expect_form_matches(from_layer(layer), Conv2dAlgorithm::SplitKSlices);
+    expect_form_matches(testing::conv_case_of(layer), Conv2dAlgorithm::SplitKSlices);
     ++layers;
   }
   EXPECT_GE(layers, 6);

@@ -87,5 +87,12 @@ struct MetadataEntry {
 // The first of `paths` (weight files given together, searched in order) whose metadata holds
 // `key`; nullopt when none does. Each file is opened and validated like SafetensorsFile.
 std::optional<MetadataEntry> find_metadata(const std::vector<std::string>& paths, const std::string& key);
+// find_metadata over files already open, for a reader that asks several questions of the same
+// files (predict: the head's input, its ensemble, its σ calibration, then the tensors) and reads
+// and validates each header once. (Another name than find_metadata: `{}` would fit either.)
+std::optional<MetadataEntry> find_metadata_in(const std::vector<SafetensorsFile>& files, const std::string& key);
+
+// Each of `paths` opened as a SafetensorsFile, in order (the first that fails throws).
+std::vector<SafetensorsFile> open_safetensors(const std::vector<std::string>& paths);
 
 }  // namespace inertialnet

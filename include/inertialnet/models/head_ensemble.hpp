@@ -19,6 +19,8 @@
 
 namespace inertialnet {
 
+class SafetensorsFile;
+
 inline constexpr const char* kMetadataEnsemble = "inertialnet.ensemble";
 inline constexpr int kMaxEnsembleMembers = 64;
 
@@ -32,6 +34,8 @@ int head_ensemble_from_json(const std::string& text);
 // The member count recorded in the first of `paths` whose metadata has inertialnet.ensemble; 1 when
 // none has it. A bad record is invalid_input naming the file, the key and the value.
 int read_head_ensemble(const std::vector<std::string>& paths);
+// The same from files already open (io/safetensors.hpp), their headers read once.
+int read_head_ensemble(const std::vector<SafetensorsFile>& files);
 
 // The ensemble's answer for one pair from its members' rates: their mean, and their spread (the
 // sample standard deviation per axis, 0 when they agree; with one member, 0).

@@ -20,6 +20,8 @@
 
 namespace inertialnet {
 
+class SafetensorsFile;
+
 enum class HeadInput { Paper, Normalized };
 std::string to_string(HeadInput input);              // "paper", "normalized"
 HeadInput parse_head_input(const std::string& text);  // invalid_input listing the choices
@@ -49,6 +51,8 @@ HeadInputInfo head_input_from_json(const std::string& json);
 // The head-input metadata of the first of `paths` that has it (the paper's, flow unknown, when
 // none does); a malformed one is invalid_input naming the file and the key. Reads the headers only.
 HeadInputInfo read_head_input(const std::vector<std::string>& paths);
+// The same from files already open (io/safetensors.hpp), their headers read once.
+HeadInputInfo read_head_input(const std::vector<SafetensorsFile>& files);
 
 // A planar [2, h, w] flow in pixels resized to out_w × out_h: area averaging when shrinking (no
 // aliasing of fine flow detail), bilinear otherwise, u and v scaled by the size ratio.

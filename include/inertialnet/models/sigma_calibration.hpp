@@ -26,6 +26,8 @@
 
 namespace inertialnet {
 
+class SafetensorsFile;
+
 inline constexpr const char* kMetadataSigmaCalibration = "inertialnet.sigma_calibration";
 inline constexpr int kSigmaCalibrationVersion = 1;
 
@@ -55,6 +57,8 @@ SigmaCalibration sigma_calibration_from_json(const std::string& json);
 // a malformed or invalid one is invalid_input naming the file, the key and the value. Reads the
 // headers only.
 std::optional<SigmaCalibration> read_sigma_calibration(const std::vector<std::string>& paths);
+// The same from files already open (io/safetensors.hpp), their headers read once.
+std::optional<SigmaCalibration> read_sigma_calibration(const std::vector<SafetensorsFile>& files);
 
 // One validation pair for the fit, rad/s per axis: the learned head's error (prediction − truth)
 // and the raw spread of its passes; when the geometric head answered too, its error and its σ.

@@ -20,6 +20,8 @@
 
 namespace inertialnet {
 
+class SafetensorsFile;
+
 class WeightSet {
  public:
   WeightSet() = default;
@@ -27,6 +29,9 @@ class WeightSet {
   // Every tensor of every file, converted to float32 and uploaded. Duplicate names across files
   // are refused. The files' metadata is kept (model kind, synthetic flag, head configuration).
   static WeightSet load(Device& device, const std::vector<std::string>& paths);
+  // The same from files already open (io/safetensors.hpp), their headers read once: predict asks
+  // their metadata its questions and loads them on every device without reading them again.
+  static WeightSet load(Device& device, const std::vector<SafetensorsFile>& files);
   // The synthetic weights of `kind` (docs/model_spec.md), generated on the host and uploaded.
   static WeightSet synthetic(Device& device, ModelKind kind, std::uint64_t seed, const HeadConfig& head = {});
 
@@ -65,6 +70,8 @@ class WeightSet {
  private:
   void add(Device& device, const std::string& name, const Shape& shape, const std::vector<float>& data,
            const std::string& source);
+  // Every tensor and the metadata of one file (load's body, for either of its forms).
+  void add_file(Device& device, const SafetensorsFile& file);
 
   std::map<std::string, Tensor> tensors_;
   std::map<std::string, Shape> shapes_;

@@ -1,0 +1,93 @@
+// SPDX-License-Identifier: Apache-2.0
+// The one convolution check of the conv2d suites (test_conv2d: the plan's choice; test_conv2d_splitk:
+// the split-K forms forced): a case's random input, weights and bias, conv2d run with its input
+// and output as channel slices of wider tensors, and the output against the float64 direct
+// convolution of tests/reference/conv.cpp with the bound of every GEMM and direct convolution.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "inertialnet/ops/conv2d.hpp"
+#include "inertialnet/ops/gemm/backend.hpp"
+#include "ops/op_testing.hpp"
+#include "ops/winograd.hpp"
+#include "reference/conv.hpp"
+#include "support/flownet_layers.hpp"
+#include "support/testing.hpp"
+
+namespace inertialnet::testing {
+
+// One convolution: ci → co channels on an h×w input, a k×k window.
+struct ConvCase {
+  std::string name;
+  int ci, co, h, w, k, stride, padding;
+  bool bias;
+  ActivationSpec activation;
+};
+inline void PrintTo(const ConvCase& c, std::ostream* os) { *os << c.name; }
+
+// A FlowNet2 layer of the shared table as a case.
+inline ConvCase conv_case_of(const flownet_layers::LayerShape& l) {
+  return {l.identifier(), l.ci, l.co, l.h, l.w, l.k, l.stride, l.padding, l.bias, l.activation};
+}
+
+// Where the op's tensors sit inside wider tensors: `*_before` / `*_after` extra channels around
+// the input and the output (0 everywhere: plain contiguous tensors); the column budget of
+// Conv2dOptions (0: the op's own).
+struct ConvPlacement {
+  int batch = 1;
+  int in_before = 0, in_after = 0;
+  int out_before = 0, out_after = 0;
+  std::size_t max_column_floats = 0;
+};
+
+// How a suite runs its cases: the form it forces (Default: the plan's choice) and the first of
+// the five seeds of a case's random data (input, weights, bias, the wider input and output), so
+// that each suite keeps data of its own.
+struct ConvRun {
+  Conv2dAlgorithm algorithm = Conv2dAlgorithm::Default;
+  std::uint32_t first_seed = 101;
+};
+
+inline void expect_conv_matches(const ConvCase& c, const ConvPlacement& p, const ConvRun& run = {}) {
+  SCOPED_TRACE(c.name);
+  Queue& queue = test_queue();
+  const reference::ConvShape s{p.batch, c.ci, c.h, c.w, c.co, c.k, c.k, c.stride, c.padding};
+  const int oh = s.conv_out_h(), ow = s.conv_out_w();
+  const std::uint32_t seed = run.first_seed;
+
+  const auto input = random_vector(static_cast<std::size_t>(p.batch) * c.ci * c.h * c.w, seed);
+  const auto weight = random_vector(static_cast<std::size_t>(c.co) * c.ci * c.k * c.k, seed + 1);
+  const auto bias = c.bias ? random_vector(static_cast<std::size_t>(c.co), seed + 2) : std::vector<float>{};
+  const auto expected = reference::conv2d(s, input, weight, bias, c.activation);
+
+  // The input and the output as channel slices of wider tensors whose other channels must survive.
+  const Sliced in = embed_sliced(queue, input, {p.batch, c.ci, c.h, c.w}, p.in_before, p.in_before + p.in_after, seed + 3);
+  const Sliced out = make_sliced(queue, {p.batch, c.co, oh, ow}, p.out_before, p.out_before + p.out_after, seed + 4);
+  const Tensor w = Tensor::from_host(queue, {c.co, c.ci, c.k, c.k}, weight);
+  const Tensor b = c.bias ? Tensor::from_host(queue, {c.co}, bias) : Tensor();
+  Conv2dOptions options{c.stride, c.padding, c.activation, p.max_column_floats};
+  options.algorithm = run.algorithm;
+  conv2d(queue, in.view, w, b, out.view, options);
+  EXPECT_TRUE(untouched_outside(queue, out)) << "elements outside the output slice were written";
+  // float32 accumulation of K = ci·k·k products of magnitude ≲ 1 against a double reference:
+  // the error grows with the reduction length, so the absolute floor is sqrt(K) (the typical
+  // output magnitude) and 1e-5 relative to that leaves ~10× margin over K·eps at K ≈ 10^4. The
+  // split-K forms add the same products in another order, which changes the rounding by a few
+  // K·eps at most. The winograd plan's F(4×4, 3×3) layers, where the plan chooses, have a
+  // measured bound of their own (op_testing.hpp).
+  const double floor = std::sqrt(static_cast<double>(c.ci) * c.k * c.k);
+  const bool winograd = run.algorithm == Conv2dAlgorithm::Default &&
+                        gemm_backend(queue.device().info()) == GemmBackend::Winograd &&
+                        detail::winograd_preferred(in.view.shape(), w.shape(), c.stride);
+  EXPECT_TRUE(all_close(view_values(queue, out), expected, winograd ? kWinogradRelativeTolerance : 1e-5, floor));
+}
+
+}  // namespace inertialnet::testing
