@@ -18,10 +18,11 @@
 
 namespace inertialnet::detail {
 
-// Deep and small: K from 9·512 (FlowNet's conv5), at most 192 output pixels per sample
-// (conv5/conv6 at 512×384 have 48–192).
+// Deep and small: K from 9·512 (FlowNet's conv4_1), at most 768 output pixels per sample
+// (conv4_1…conv6_1 at 512×384 have 48–768). On an H100 the 768 (conv4_1 joining) took the 3×3
+// stride-1 kind from 7.98 to 7.68 ms (docs/performance.md, "Split-K forms for GPUs").
 inline constexpr std::size_t kSlicedMinDepth = 9 * 512;
-inline constexpr std::size_t kSlicedMaxPixels = 192;
+inline constexpr std::size_t kSlicedMaxPixels = 768;
 
 // Whether a convolution with weights [co, ci, kh, kw] and `output_pixels` outputs per channel
 // and sample runs the sliced form by default: on a non-CPU device, on the CLBlast backend (the

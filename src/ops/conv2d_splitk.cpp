@@ -14,12 +14,13 @@ namespace inertialnet::detail {
 namespace {
 
 // Output pixels per work-group (PIXELS of conv2d_splitk.cl) and work-items splitting their
-// reduction (GROUP). Starting values, not yet measured on a GPU: 64 work-items are two warps,
-// and 4 pixels × 2 channels give FlowNet2's smallest predict_flow (6×8 pixels, K = 9,216) 12
-// work-groups of 144 loop steps each and its largest (predict_flow0, 384×512, K = 144) 49,152
-// of 2–3. docs/performance.md says how to measure them on a lent GPU.
-constexpr int kPixelsPerGroup = 4;
-constexpr std::size_t kGroupSize = 64;
+// reduction (GROUP), measured on an NVIDIA H100 (docs/performance.md, "Split-K forms for GPUs"):
+// FlowNet2's 23 predict_flow layers at 512×384 took 1.42 ms with 64 × 4, 1.00 with 128 × 4,
+// 0.76–0.84 with 128 × 2, 0.81 with 256 × 2, 1.21–1.40 with 256 × 1 (CLBlast's two-row GEMM
+// before: 5.66). 128 work-items are four warps; 2 pixels × 2 channels give predict_flow6 (6×8
+// pixels, K = 9,216) 24 work-groups of 72 loop steps each.
+constexpr int kPixelsPerGroup = 2;
+constexpr std::size_t kGroupSize = 128;
 
 }  // namespace
 

@@ -140,7 +140,7 @@ TEST(Conv2dSplitKSlices, BatchesAndChannelSlices) {
   expect_form_matches({"slices", 6, 10, 7, 9, 3, 1, 1, true, leaky}, Conv2dAlgorithm::SplitKSlices, {3, 2, 3, 1, 4});
 }
 
-// FlowNet2's deep layers on small images (K ≥ 9·512 and ≤ 192 output pixels: conv4_1…conv6_1
+// FlowNet2's deep layers on small images (K ≥ 9·512 and ≤ 768 output pixels: conv4_1…conv6_1
 // and FlowNetSD's deep ones) at a 192×256 network input, half the real size so that the
 // float64 reference stays quick; the reduction lengths and channel counts are the real ones.
 TEST(Conv2dSplitKSlices, FlowNet2DeepLayerShapes) {
@@ -163,7 +163,8 @@ TEST(Conv2dSplitKSlices, ChosenOnGpusOnlyForDeepSmallLayers) {
   const Shape conv6_1{1024, 1024, 3, 3}, conv5{512, 512, 3, 3};
   EXPECT_TRUE(detail::splitk_slices_preferred(gpu, GemmBackend::CLBlast, conv6_1, 48));
   EXPECT_TRUE(detail::splitk_slices_preferred(gpu, GemmBackend::CLBlast, conv5, 192));
-  EXPECT_FALSE(detail::splitk_slices_preferred(gpu, GemmBackend::CLBlast, conv5, 193));  // a larger image
+  EXPECT_TRUE(detail::splitk_slices_preferred(gpu, GemmBackend::CLBlast, conv5, 768));   // conv4_1 at 512×384
+  EXPECT_FALSE(detail::splitk_slices_preferred(gpu, GemmBackend::CLBlast, conv5, 769));  // a larger image
   EXPECT_FALSE(detail::splitk_slices_preferred(gpu, GemmBackend::CLBlast, {512, 256, 3, 3}, 48));  // K 2,304
   EXPECT_FALSE(detail::splitk_slices_preferred(gpu, GemmBackend::CLBlast, {2, 1024, 3, 3}, 48));   // predict_flow
   EXPECT_FALSE(detail::splitk_slices_preferred(gpu, GemmBackend::Packed, conv6_1, 48));  // a forced packed plan
