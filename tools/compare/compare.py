@@ -11,7 +11,7 @@ environment (see README.md here for how to create it).
 
     tools/compare/compare.py [--venv DIR] [--inertialnet build/inertialnet] \
         [--models FlowNet2,FlowNet2-C] [--size 512x384] [--threads 2] [--pairs 3] [--rounds 2] [--json] \
-        [--device gpu --torch-device cuda] [--plan packed,winograd]
+        [--device gpu --torch-device cuda [--tf32]] [--plan packed,winograd]
 
 With several `--plan`s, each round runs ours once per plan before PyTorch, and each plan gets its
 own row and ratio. Every round line carries the 1-minute load average read before it, and a
@@ -69,6 +69,9 @@ def main() -> int:
     parser.add_argument("--device", default="", help="--device for inertialnet (default: its default)")
     parser.add_argument("--torch-device", default="cpu",
                         help="PyTorch's device (cpu, cuda): compare an OpenCL GPU run with PyTorch on the same GPU")
+    parser.add_argument("--tf32", action="store_true",
+                        help="PyTorch's float32 convolutions on TF32 tensor cores (its GPU default); without it, float32 "
+                             "on both sides")
     parser.add_argument("--correlation", choices=("bmm", "shift"), default="bmm", help="PyTorch's correlation")
     parser.add_argument("--plan", default="",
                         help="inertialnet's GEMM plan(s), comma-separated, each timed in every round (default: its default)")
@@ -90,7 +93,7 @@ def main() -> int:
         ours_command += ["--device", args.device]
     torch_command = [python, os.path.join(HERE, "torch_bench.py"), "--size", args.size, "--threads", str(args.threads),
                      "--pairs", str(args.pairs), "--correlation", args.correlation,
-                     "--torch-device", args.torch_device]
+                     "--torch-device", args.torch_device] + (["--tf32"] if args.tf32 else [])
 
     models = [m for m in args.models.split(",") if m]
     runs = {(m, p): {"ours": [], "ours_total": [], "torch": [], "load": []} for m in models for p in plans}
@@ -127,10 +130,11 @@ def main() -> int:
                         "torch_seconds_per_pair": theirs, "ratio": ours / theirs, "runs": run})
     if args.json:
         print(json.dumps({"device": device, "torch": torch_version, "torch_device": torch_device,
-                          "correlation": args.correlation,
+                          "correlation": args.correlation, "torch_tf32": args.tf32,
                           "results": summary}, indent=2))
         return 0
-    print(f"{args.size}, {args.threads} threads, float32; ours on {device}, PyTorch {torch_version} "
+    precision = "float32 (PyTorch: TF32 allowed)" if args.tf32 else "float32"
+    print(f"{args.size}, {args.threads} threads, {precision}; ours on {device}, PyTorch {torch_version} "
           f"on {torch_device} (correlation: {args.correlation}); medians of {args.rounds} interleaved rounds of {args.pairs} pairs")
     print(f"{'model':<14} {'plan':<9} {'ours s/pair':>12} {'PyTorch s/pair':>15} {'ours/PyTorch':>13}")
     for s in summary:

@@ -25,25 +25,26 @@ print(json.dumps({"results": [{"device": "stand-in", "stages": {"flow": flow}, "
 '''
 
 FAKE_PYTHON = r'''#!/usr/bin/env python3
-import json
-print(json.dumps({"torch": "stand-in", "torch_device": "cpu", "seconds_per_pair": 1.285}))
+import json, sys
+print(json.dumps({"torch": "stand-in", "torch_device": "cpu", "seconds_per_pair": 1.285 if "--tf32" not in sys.argv else 0.9,
+                  "tf32": "--tf32" in sys.argv}))
 '''
 
 
-def run_compare(tmp_path, extra_env=None):
+def run_compare(tmp_path, extra_env=None, extra_args=(), json_output=True):
     binary = tmp_path / "inertialnet"
     binary.write_text(FAKE_INERTIALNET)
     binary.chmod(0o755)
-    (tmp_path / "venv" / "bin").mkdir(parents=True)
+    (tmp_path / "venv" / "bin").mkdir(parents=True, exist_ok=True)
     python = tmp_path / "venv" / "bin" / "python"
     python.write_text(FAKE_PYTHON)
     python.chmod(0o755)
     env = dict(os.environ, **(extra_env or {}))
     done = subprocess.run([sys.executable, os.path.join(HERE, "compare.py"), "--venv", str(tmp_path / "venv"),
                            "--inertialnet", str(binary), "--models", "FlowNet2", "--rounds", "2",
-                           "--plan", "packed,winograd", "--json"],
+                           "--plan", "packed,winograd", *extra_args] + (["--json"] if json_output else []),
                           env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, check=True)
-    return json.loads(done.stdout), done.stderr
+    return (json.loads(done.stdout) if json_output else done.stdout), done.stderr
 
 
 def test_each_plan_gets_its_own_figures(tmp_path):
@@ -64,3 +65,16 @@ def test_a_run_that_cannot_be_its_plan_is_flagged(tmp_path):
     by_plan = {r["plan"]: r for r in result["results"]}
     assert all(by_plan["winograd"]["runs"]["notes"])
     assert not any(by_plan["packed"]["runs"]["notes"])
+
+
+def test_pytorch_computes_in_float32_unless_tf32_is_asked_for(tmp_path):
+    # PyTorch's GPU default runs float32 convolutions on TF32 tensor cores; ours are float32, so
+    # --tf32 is passed on only when asked, and the result says which comparison it is.
+    result, _ = run_compare(tmp_path)
+    assert result["torch_tf32"] is False
+    assert all(r["torch_seconds_per_pair"] == 1.285 for r in result["results"])
+    result, _ = run_compare(tmp_path, extra_args=["--tf32"])
+    assert result["torch_tf32"] is True
+    assert all(r["torch_seconds_per_pair"] == 0.9 for r in result["results"])
+    table, _ = run_compare(tmp_path, extra_args=["--tf32"], json_output=False)
+    assert "float32 (PyTorch: TF32 allowed)" in table.splitlines()[0]

@@ -51,10 +51,17 @@ def main() -> int:
     parser.add_argument("--pairs", type=int, default=3)
     parser.add_argument("--correlation", choices=("bmm", "shift"), default="bmm")
     parser.add_argument("--torch-device", default="cpu", help="PyTorch's device: cpu, cuda, cuda:1 ...")
+    parser.add_argument("--tf32", action="store_true",
+                        help="let cuDNN and cuBLAS run float32 work on TF32 tensor cores (PyTorch's default for "
+                             "convolutions; 10-bit mantissa). Without it both sides compute in float32.")
     args = parser.parse_args()
     width, height = (int(v) for v in args.size.lower().split("x"))
 
     torch.set_num_threads(args.threads)
+    # PyTorch runs float32 convolutions on TF32 tensor cores by default on GPUs that have them;
+    # ours are float32 throughout, so the comparison is float32 unless asked otherwise.
+    torch.backends.cudnn.allow_tf32 = args.tf32
+    torch.backends.cuda.matmul.allow_tf32 = args.tf32
     error = check_correlation()
     if error > 1e-12:
         print(f"correlation_bmm differs from the reference's correlation by {error}", file=sys.stderr)
@@ -88,7 +95,7 @@ def main() -> int:
     print(json.dumps({
         "model": args.model, "width": width, "height": height, "threads": torch.get_num_threads(),
         "torch_device": str(device) + (f" ({torch.cuda.get_device_name(device)})" if device.type == "cuda" else ""),
-        "correlation": args.correlation, "torch": torch.__version__, "pairs": args.pairs,
+        "correlation": args.correlation, "torch": torch.__version__, "pairs": args.pairs, "tf32": args.tf32,
         "warmup_seconds": warmup, "seconds": times, "seconds_per_pair": sum(times) / len(times),
     }))
     return 0
