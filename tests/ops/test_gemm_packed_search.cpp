@@ -65,5 +65,32 @@ TEST(PackedGemmSearch, ATunedDeviceUsesItsParametersWithTheSameResult) {
   EXPECT_EQ(packed_gemm_setting(device, "MR"), packed_gemm_parameters().front().default_value);
 }
 
+// A product whose whole packed B is small next to A walks B panels first (A read once), whatever
+// the device's setting; every other product keeps the setting (deconv5 at 512×384 measured
+// faster this way: docs/performance.md, "deconv5: A read once").
+TEST(PackedGemmPanelsFirst, SmallBAgainstALargeAWalksBPanelsFirst) {
+  DeviceOptions options;
+  options.program_cache = DiskCacheMode::Off;
+  Device device(testing::test_device().info(), options);
+  for (const int setting : {1, 0}) {
+    DeviceTuning tuning;
+    tuning.packed = {{"PANELS_FIRST", setting}};
+    device.set_tuning(tuning);
+    EXPECT_EQ(packed_gemm_panels_first(device, 8192, 48, 1024), 0);       // deconv5: B 256 KiB, A 33 MB
+    EXPECT_EQ(packed_gemm_panels_first(device, 1024, 1024, 1024), setting);  // B 4 MiB
+    EXPECT_EQ(packed_gemm_panels_first(device, 1024, 48, 9216), setting);    // conv6_1: B 2.3 MiB
+    EXPECT_EQ(packed_gemm_panels_first(device, 8192, 32, 1024), setting);    // one B panel: nothing to walk
+    EXPECT_EQ(packed_gemm_panels_first(device, 16, 48, 1024), setting);      // A no larger than B
+  }
+  // At the threshold (setting 1): 2 panels × 32 columns × 2,048 deep × 4 bytes = 512 KiB is
+  // small, one deeper is not.
+  DeviceTuning tuning;
+  tuning.packed = {{"PANELS_FIRST", 1}};
+  device.set_tuning(tuning);
+  const std::size_t deepest = kPackedSmallOperandBytes / (64 * sizeof(float));
+  EXPECT_EQ(packed_gemm_panels_first(device, 8192, 64, deepest), 0);
+  EXPECT_EQ(packed_gemm_panels_first(device, 8192, 64, deepest + 1), 1);
+}
+
 }  // namespace
 }  // namespace inertialnet

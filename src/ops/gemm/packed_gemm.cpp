@@ -82,6 +82,14 @@ int packed_gemm_setting(const Device& device, const char* name) {
   return parameter_default(name);
 }
 
+int packed_gemm_panels_first(const Device& device, std::size_t m, std::size_t n, std::size_t k) {
+  const std::size_t column_panels = (n + kPackedColumns - 1) / kPackedColumns;
+  const std::size_t b_bytes = column_panels * kPackedColumns * k * sizeof(float);
+  const std::size_t a_bytes = m * k * sizeof(float);
+  if (column_panels > 1 && b_bytes <= kPackedSmallOperandBytes && a_bytes > b_bytes) return 0;
+  return packed_gemm_setting(device, "PANELS_FIRST");
+}
+
 int packed_gemm_tile_rows(std::size_t m, int requested, int standard) {
   if (requested > 0) {
     if (!is_candidate("MR", requested)) throw invalid_input("packed GEMM: MR=" + std::to_string(requested) + " is not supported");
@@ -174,7 +182,7 @@ void gemm_packed(Queue& queue, const PackedPanels& a, const PackedPanels& b, con
                         std::to_string(m) + " rows");
   }
   const bool has_beta = epilogue.beta != 0.0f;
-  if (panels_first != 0 && panels_first != 1) panels_first = packed_gemm_setting(queue.device(), "PANELS_FIRST");
+  if (panels_first != 0 && panels_first != 1) panels_first = packed_gemm_panels_first(queue.device(), m, n, k);
   Kernel& kernel = queue.kernel("gemm_packed", "gemm_packed",
                                 KernelDefines()
                                     .add("MR", a.width)

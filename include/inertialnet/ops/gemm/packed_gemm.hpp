@@ -42,6 +42,13 @@ const std::vector<PackedGemmParameter>& packed_gemm_parameters();
 // (Device::tuning()) when that is one of the candidates, else the default.
 int packed_gemm_setting(const Device& device, const char* name);
 
+// PANELS_FIRST for an m×n×k product: 0 (B panels first: each A panel is read once, against all
+// of B) where the whole packed B fits in kPackedSmallOperandBytes and A is larger, since then B
+// stays in cache and A, streamed once per B panel the other way, is the cost (deconv5 at 512×384:
+// A 33 MB, B two panels of 128 KiB); else the device's setting (packed_gemm_setting).
+inline constexpr std::size_t kPackedSmallOperandBytes = 512 * 1024;
+int packed_gemm_panels_first(const Device& device, std::size_t m, std::size_t n, std::size_t k);
+
 // The tile rows for an m-row product: the standard MR (`standard`, 0: the default), or a smaller
 // one that wastes fewer padded rows when m is small (m = 2 → 2, m = 4 → 4); `requested` > 0
 // forces a candidate.
@@ -92,7 +99,7 @@ struct GemmEpilogue {
 };
 
 // C (m×n view, m = a.lines, n = b.lines) from packed operands of equal depth. `panels_first`
-// (0 or 1) forces that build option; −1 takes the device's setting.
+// (0 or 1) forces that build option; −1 takes packed_gemm_panels_first().
 void gemm_packed(Queue& queue, const PackedPanels& a, const PackedPanels& b, const MatrixView& c,
                  const GemmEpilogue& epilogue = {}, int panels_first = -1);
 
