@@ -641,11 +641,13 @@ class PyInertialNetHead {
   PyInertialNetHead(const py::object& weights, const py::object& device) : device_(device_of(device)) {
     const auto paths = paths_of(weights);
     py::gil_scoped_release release;
-    weights_ = std::make_unique<WeightSet>(WeightSet::load(*device_, paths));
+    // Each file opened and its header read once, for the tensors and the two metadata questions.
+    const std::vector<SafetensorsFile> files = open_safetensors(paths);
+    weights_ = std::make_unique<WeightSet>(WeightSet::load(*device_, files));
     head_ = std::make_unique<InertialNetHead>(*device_, *weights_);
-    input_ = read_head_input(paths);
+    input_ = read_head_input(files);
     // A head ensemble (models/head_ensemble.hpp): rates() is its members' mean, as in predict.
-    for (int k = 1; k < read_head_ensemble(paths); ++k) {
+    for (int k = 1; k < read_head_ensemble(files); ++k) {
       member_weights_.push_back(std::make_unique<WeightSet>(weights_->ensemble_member(k)));
       members_.push_back(std::make_unique<InertialNetHead>(*device_, *member_weights_.back()));
     }
