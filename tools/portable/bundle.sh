@@ -20,17 +20,36 @@ mkdir -p "$work/bin" "$work/lib"
 cp "$build/inertialnet" "$work/bin/"
 for t in "$@"; do cp "$build/tests/$t" "$work/bin/"; done
 strip "$work"/bin/*
-libdir=/lib/x86_64-linux-gnu
-keep="libopencv_core.so.406 libopencv_imgproc.so.406 libopencv_imgcodecs.so.406 libopencv_videoio.so.406
-      libopencv_video.so.406 libopencv_calib3d.so.406 libopencv_features2d.so.406 libopencv_flann.so.406
-      libopengv.so.1.0 libclblast.so.1 libOpenCL.so.1 libsqlite3.so.0 libtbb.so.12 libz.so.1 libjpeg.so.62
-      libpng16.so.16 libzstd.so.1 liblz4.so.1 libbz2.so.1.0"
+# Kept as they are (by name, any version); the system's own libraries stay the other machine's;
+# every other library one of these needs becomes a stand-in.
+keep='^lib(opencv_(core|imgproc|imgcodecs|videoio|video|calib3d|features2d|flann)|opengv|clblast|OpenCL|sqlite3|tbb|z|jpeg|png16|zstd|lz4|bz2)\.so'
 system=" libstdc++.so.6 libm.so.6 libgcc_s.so.1 libc.so.6 ld-linux-x86-64.so.2 libpthread.so.0 libdl.so.2 librt.so.1 "
-for l in $keep; do cp -L "$libdir/$l" "$work/lib/"; done
-needed=$( (for b in "$work"/bin/* "$work"/lib/*; do readelf -d "$b"; done) | sed -n 's/.*(NEEDED).*\[\(.*\)\]/\1/p' | sort -u)
-for n in $needed; do
-  case " $keep $system " in *" $n "*) continue ;; esac
-  python3 "$here/stub_library.py" "$libdir/$n" "$work/lib"
+# Where each library the binaries load lives here (soname → path), from the dynamic loader.
+declare -A path_of
+for b in "$work"/bin/*; do
+  while read -r name arrow path _; do
+    [ "$arrow" = "=>" ] && [ "${path:0:1}" = "/" ] && path_of[$name]=$path
+  done < <(ldd "$b")
+done
+needed_by() { readelf -d "$1" | sed -n 's/.*(NEEDED).*\[\(.*\)\]/\1/p'; }
+declare -A done_
+queue=$(for b in "$work"/bin/*; do needed_by "$b"; done | sort -u)
+while [ -n "$queue" ]; do
+  next=""
+  for n in $queue; do
+    [ -n "${done_[$n]:-}" ] && continue
+    done_[$n]=1
+    case "$system" in *" $n "*) continue ;; esac
+    real=${path_of[$n]:-}
+    [ -n "$real" ] || { echo "bundle: cannot find $n" >&2; exit 1; }
+    if [[ $n =~ $keep ]]; then
+      cp -L "$real" "$work/lib/$n"
+      next="$next $(needed_by "$work/lib/$n")"
+    else
+      python3 "$here/stub_library.py" "$real" "$work/lib"
+    fi
+  done
+  queue=$next
 done
 # Every library the binaries load must now come from the bundle or the system list above.
 for b in "$work"/bin/*; do
