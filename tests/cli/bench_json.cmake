@@ -1,9 +1,13 @@
 # SPDX-License-Identifier: Apache-2.0
 # `inertialnet bench --json` at a tiny size: the document parses and holds every field of the
 # schema documented in tools/cli/bench_report.hpp ("inertialnet.bench/1").
-#   cmake -DCLI=<inertialnet> -P bench_json.cmake
+#   cmake -DCLI=<inertialnet> [-DPLAN=clblast] -P bench_json.cmake
 cmake_minimum_required(VERSION 3.19)  # string(JSON) and if(IN_LIST)
-execute_process(COMMAND ${CLI} bench --model FlowNet2 --size 64x64 --pairs 1 --json
+set(plan_option "")
+if(PLAN)
+  set(plan_option --plan ${PLAN})
+endif()
+execute_process(COMMAND ${CLI} bench --model FlowNet2 --size 64x64 --pairs 1 --json ${plan_option}
                 RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 600)
 message("$ inertialnet bench --model FlowNet2 --size 64x64 --pairs 1 --json\n${out}${err}(exit ${code})")
 if(NOT code EQUAL 0)
@@ -106,6 +110,23 @@ foreach(i RANGE ${last})
     endif()
     expect_field(results 0 profile kinds ${i} of_packed_gemm)
     expect_finite("${value}" "kinds[${i}].of_packed_gemm")
+    # CLBlast's rate on the same products where the layers ran on CLBlast (PLAN=clblast here, a
+    # GPU's default), null where they ran on the packed kernels.
+    string(JSON clblast_type TYPE "${out}" results 0 profile kinds ${i} clblast_gemm)
+    if(PLAN STREQUAL "clblast")
+      if(NOT clblast_type STREQUAL "OBJECT")
+        message(FATAL_ERROR "kind '${kind}' ran on CLBlast but has clblast_gemm of type ${clblast_type}")
+      endif()
+      expect_field(results 0 profile kinds ${i} clblast_gemm gflops)
+      expect_finite("${value}" "kinds[${i}].clblast_gemm.gflops")
+      if(NOT value GREATER 0)
+        message(FATAL_ERROR "kinds[${i}].clblast_gemm.gflops is ${value}")
+      endif()
+      expect_field(results 0 profile kinds ${i} of_clblast_gemm)
+      expect_finite("${value}" "kinds[${i}].of_clblast_gemm")
+    elseif(NOT clblast_type STREQUAL "NULL")
+      message(FATAL_ERROR "kind '${kind}' ran on the packed kernels but has clblast_gemm of type ${clblast_type}")
+    endif()
   elseif(NOT kind STREQUAL "linear" AND NOT reference_type STREQUAL "NULL")
     message(FATAL_ERROR "kind '${kind}' has no GEMM but packed_gemm of type ${reference_type}")
   endif()

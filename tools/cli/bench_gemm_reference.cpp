@@ -6,7 +6,9 @@
 #include <tuple>
 
 #include "inertialnet/models/gemm_shapes.hpp"
+#include "inertialnet/ops/gemm/backend.hpp"
 #include "inertialnet/ops/gemm/packed_gemm_rate.hpp"
+#include "inertialnet/runtime/device.hpp"
 
 namespace inertialnet::cli {
 
@@ -51,25 +53,31 @@ std::vector<KindGemmReference> packed_gemm_references(Queue& queue, ModelKind mo
       r.k = s.k;
     }
   }
-  // The kind's rate is its layers' work over the time the packed GEMM takes for their products,
+  // The kind's rate is its layers' work over the time the GEMM takes for their products,
   // each layer counted once (FlowNet2 runs several layers of one size): the GEMM's own rate on
   // the kind's shapes, as the kind's own rate is over all of its layers. Products timed once
   // each, however many layers and kinds share one.
-  std::map<std::tuple<std::size_t, std::size_t, std::size_t>, double> seconds;
-  for (std::size_t i = 0; i < references.size(); ++i) {
-    KindGemmReference& r = references[i];
+  using Product = std::tuple<std::size_t, std::size_t, std::size_t>;
+  using Timer = double (*)(Queue&, std::size_t, std::size_t, std::size_t, int);
+  // The rate of `timer` over kind i's products: their work over its summed time.
+  auto rate = [&](std::map<Product, double>& seconds, Timer timer, std::size_t i) {
     double flops = 0, total = 0;
     for (const GemmShape* s : products_of_kind[i]) {
-      const auto key = std::make_tuple(s->m, s->n, s->k);
+      const Product key{s->m, s->n, s->k};
       auto found = seconds.find(key);
-      if (found == seconds.end()) {
-        found = seconds.emplace(key, packed_gemm_seconds(queue, s->m, s->n, s->k, kReferenceRuns)).first;
-      }
+      if (found == seconds.end()) found = seconds.emplace(key, timer(queue, s->m, s->n, s->k, kReferenceRuns)).first;
       flops += s->flops();
       total += found->second;
     }
+    return total > 0 ? flops * 1e-9 / total : 0.0;
+  };
+  const bool runs_clblast = !uses_packed_kernels(gemm_backend(queue.device().info()));
+  std::map<Product, double> packed_seconds, clblast_seconds;
+  for (std::size_t i = 0; i < references.size(); ++i) {
+    KindGemmReference& r = references[i];
     r.products = products_of_kind[i].size();
-    r.gflops = total > 0 ? flops * 1e-9 / total : 0;
+    r.gflops = rate(packed_seconds, &packed_gemm_seconds, i);
+    if (runs_clblast) r.clblast_gflops = rate(clblast_seconds, &clblast_gemm_seconds, i);
   }
   return references;
 }

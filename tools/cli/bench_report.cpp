@@ -61,19 +61,29 @@ std::string format_bench_text(const BenchResult& r, bool layers) {
   out += "per layer kind (one profiled pair, device time " + fixed(profiled_seconds(r.layers), 3) + " s):\n";
   out += format_kind_table(group_by_kind(r.layers));
   if (!r.gemm_references.empty()) {
-    out += "\nthe packed GEMM alone on each kind's products (operands packed beforehand; heaviest named):\n";
-    const TextTable table({{"kind", 22, true, 0}, {"GFLOP/s", 9, false, 1}, {"of GEMM", 9, false, 1},
-                           {"M×N×K", 24, true, 2}, {"layer", 0, true, 1}});
+    // Where the layers ran on CLBlast (GPUs), its rate on the same products comes first: the
+    // packed kernels are written for CPUs and are not that machine's GEMM.
+    const bool clblast = r.gemm_references.front().clblast_gflops > 0;
+    out += clblast ? "\nCLBlast's GEMM and the packed GEMM alone on each kind's products (heaviest named):\n"
+                   : "\nthe packed GEMM alone on each kind's products (operands packed beforehand; heaviest named):\n";
+    std::vector<TextColumn> columns{{"kind", 22, true, 0}};
+    if (clblast) columns.insert(columns.end(), {{"CLBlast", 9, false, 1}, {"of it", 7, false, 1}});
+    columns.insert(columns.end(), {{"GFLOP/s", 9, false, 1}, {"of GEMM", 9, false, 1}, {"M×N×K", 24, true, 2},
+                                   {"layer", 0, true, 1}});
+    const TextTable table(columns);
     out += table.header();
+    auto share = [](double gflops, double of) { return text_cell("%.0f%%", of > 0 ? 100 * gflops / of : 0); };
     for (const auto& k : group_by_kind(r.layers)) {
       const KindGemmReference* reference = reference_of(r, k.kind);
       if (!reference) continue;
       const double gflops = k.seconds > 0 ? k.flops * 1e-9 / k.seconds : 0;
       const std::string product =
           std::to_string(reference->m) + "×" + std::to_string(reference->n) + "×" + std::to_string(reference->k);
-      out += table.row({k.kind, text_cell("%.1f", reference->gflops),
-                        text_cell("%.0f%%", reference->gflops > 0 ? 100 * gflops / reference->gflops : 0), product,
-                        reference->layer});
+      std::vector<std::string> cells{k.kind};
+      if (clblast) cells.insert(cells.end(), {text_cell("%.1f", reference->clblast_gflops), share(gflops, reference->clblast_gflops)});
+      cells.insert(cells.end(), {text_cell("%.1f", reference->gflops), share(gflops, reference->gflops), product,
+                                 reference->layer});
+      out += table.row(cells);
     }
   }
   if (layers) out += "\nper layer:\n" + format_layer_table(r.layers);
@@ -120,7 +130,9 @@ std::string format_bench_json(const std::vector<BenchResult>& results) {
                              {"backends", k.backends},
                              {"gflop", k.flops * 1e-9},
                              {"packed_gemm", nullptr},
-                             {"of_packed_gemm", nullptr}};
+                             {"of_packed_gemm", nullptr},
+                             {"clblast_gemm", nullptr},
+                             {"of_clblast_gemm", nullptr}};
       if (const KindGemmReference* reference = reference_of(r, k.kind)) {
         kind["packed_gemm"] = {{"layer", reference->layer},
                                {"m", reference->m},
@@ -129,6 +141,10 @@ std::string format_bench_json(const std::vector<BenchResult>& results) {
                                {"products", reference->products},
                                {"gflops", reference->gflops}};
         kind["of_packed_gemm"] = reference->gflops > 0 ? gflops / reference->gflops : 0;
+        if (reference->clblast_gflops > 0) {
+          kind["clblast_gemm"] = {{"products", reference->products}, {"gflops", reference->clblast_gflops}};
+          kind["of_clblast_gemm"] = gflops / reference->clblast_gflops;
+        }
       }
       kinds.push_back(std::move(kind));
     }

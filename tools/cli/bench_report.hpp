@@ -37,7 +37,12 @@
 //                                            over their summed time); layer, m, n, k name the
 //                                            heaviest; null for kinds without a GEMM
 //                                            (bench_gemm_reference.hpp)
-//                      "of_packed_gemm": number | null   gflops / packed_gemm.gflops } ]
+//                      "of_packed_gemm": number | null   gflops / packed_gemm.gflops
+//                      "clblast_gemm": { "products", "gflops" } | null
+//                                            CLBlast's GEMM on the same products, where the run's
+//                                            layers use CLBlast (a GPU's default, --plan clblast);
+//                                            null where they use the packed kernels (CPUs)
+//                      "of_clblast_gemm": number | null  gflops / clblast_gemm.gflops } ]
 //         "layers": [ { "name", "kind", "seconds", "flops", "gflops", "backend" } ]
 //       } } ] }
 // "backend" is the GEMM backend a layer ran on ("clblast", …; "" for layers without a GEMM).
