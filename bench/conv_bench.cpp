@@ -40,7 +40,8 @@ void run_layer(benchmark::State& state, const LayerShape& layer, DeconvAlgorithm
   std::function<void()> run;
   if (layer.kind == LayerKind::Conv) {
     weight = random_tensor(queue, {layer.co, layer.ci, layer.k, layer.k}, 2);
-    prepared = prepare_conv2d_weights(queue, weight, gemm_backend(device.info()), layer.stride, input.shape());
+    prepared = prepare_conv2d_weights(queue, weight, gemm_backend(device.info()), layer.stride, layer.padding,
+                                      input.shape());
     Conv2dOptions options{layer.stride, layer.padding, layer.activation};
     options.prepared = &prepared;
     output = Tensor::empty(device, {1, layer.co, layer.out_h(), layer.out_w()});

@@ -9,9 +9,14 @@
 //   Aᵀ = [1 1 1 1 1 0; 0 1 −1 2 −2 0; 0 1 1 4 4 0; 0 1 −1 8 −8 1]
 // Element e = 6·row + column of a 6×6 transform is GEMM number e.
 //
-// Build option: -DPAD (zeros on every side).
+// Build options: -DPAD (zeros on every side); -DPHASES=1: the input is read as its four stride-2
+// phase images (a 5×5 stride-2 padding-2 convolution as a 3×3 stride-1 one, below).
 
 #include "common.cl"
+
+#ifndef PHASES
+#define PHASES 0
+#endif
 
 #define ELEMENTS 36
 #define TILE 4    // output pixels per tile side
@@ -85,6 +90,12 @@ inline float16 every_fourth(const float16 a, const float16 b, const float16 c, c
 // element only in a vector that crosses the plane's left or right edge: at the 48×64 and 96×128
 // layers every group of 16 tiles touches an edge) and split into the 6 columns by shuffles;
 // otherwise every lane reads its own window.
+//
+// PHASES = 1 (a 5×5 stride-2 padding-2 convolution, src/ops/winograd.hpp): `channels` counts the
+// phase images of the height × width input, channel 4·c + 2·ry + rx holding
+// x[c, 2j + ry, 2i + rx] at (j, i) (zero where 2j + ry ≥ height or 2i + rx ≥ width), so the 3×3
+// stride-1 transform with PAD 1 reads them without their ever being written out; a whole
+// 16-column vector of a phase row is two input vectors split into even or odd lanes.
 // Launch (ceil(count / 32), ceil(channels / channel_block)) work-items in work-groups of one.
 __kernel void winograd_input(__global const float* restrict in, const int in_offset, __global float* restrict v,
                              const int v_offset, const int channels, const int height, const int width,
@@ -99,22 +110,41 @@ __kernel void winograd_input(__global const float* restrict in, const int in_off
       const int tile0 = first + lane0;
       const int ty = tile0 / tiles_w, tx = tile0 - ty * tiles_w;
       const bool whole = lanes == 16 && tx + 16 <= tiles_w;
+#if PHASES
+      // Phase (ry, rx) of input channel c / 4: its pixel (j, i) is the input's (2j + ry, 2i + rx);
+      // `rows` × `cols` of them lie inside the input.
+      const int ry = (c >> 1) & 1, rx = c & 1;
+      __global const float* plane = in + in_offset + (size_t)(c >> 2) * height * width;
+      const int rows = (height - ry + 1) / 2, cols = (width - rx + 1) / 2;
+#define AT(y, x) ((size_t)(2 * (y) + ry) * width + 2 * (x) + rx)
+#define STEP 2  // input columns per phase column
+#else
       __global const float* plane = in + in_offset + (size_t)c * height * width;
+      const int rx = 0, rows = height, cols = width;
+#define AT(y, x) ((size_t)(y) * width + (x))
+#define STEP 1
+#endif
       float16 e[WINDOW][WINDOW];  // d B: row r of every window
       for (int r = 0; r < WINDOW; ++r) {
         float16 d[WINDOW];  // column q of window row r, per lane
         if (whole) {
           const int y = TILE * ty + r - PAD, x0 = TILE * tx - PAD;
           float16 row[5];  // input columns x0 … x0 + 79 of row y (68 used), zeros outside the plane
-          if (y >= 0 && y < height) {
-            __global const float* src = plane + (size_t)y * width;
+          if (y >= 0 && y < rows) {
+            __global const float* src = plane + AT(y, 0);
             for (int k = 0; k < 5; ++k) {
               const int x = x0 + 16 * k;
-              if (x >= 0 && x + 16 <= width) {
+              if (x >= 0 && STEP * x + rx + 16 * STEP <= width) {
+#if PHASES
+                // Input columns 2x + rx … 2x + rx + 31, the even lanes of which are this phase's.
+                const uint16 even = (uint16)(0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 20, 22, 24, 26, 28, 30);
+                row[k] = shuffle2(vload16(0, src + 2 * x), vload16(0, src + 2 * x + 16), even);
+#else
                 row[k] = vload16(0, src + x);
+#endif
               } else {
                 float piece[16];
-                for (int j = 0; j < 16; ++j) piece[j] = x + j >= 0 && x + j < width ? src[x + j] : 0.0f;
+                for (int j = 0; j < 16; ++j) piece[j] = x + j >= 0 && x + j < cols ? src[STEP * (x + j)] : 0.0f;
                 row[k] = vload16(0, piece);
               }
             }
@@ -136,16 +166,18 @@ __kernel void winograd_input(__global const float* restrict in, const int in_off
           for (int j = 0; j < 16; ++j) {
             const int tile = tile0 + j;
             const int y = TILE * (tile / tiles_w) + r - PAD, x0 = TILE * (tile % tiles_w) - PAD;
-            const bool row_in = j < lanes && y >= 0 && y < height;
+            const bool row_in = j < lanes && y >= 0 && y < rows;
             for (int q = 0; q < WINDOW; ++q) {
               const int x = x0 + q;
-              window[q][j] = row_in && x >= 0 && x < width ? plane[(size_t)y * width + x] : 0.0f;
+              window[q][j] = row_in && x >= 0 && x < cols ? plane[AT(y, x)] : 0.0f;
             }
           }
           for (int q = 0; q < WINDOW; ++q) d[q] = vload16(0, window[q]);
         }
         transform_bt16(d, e[r]);
       }
+#undef AT
+#undef STEP
       __global float* out = v + v_offset + (size_t)p * channels * 32 + (size_t)c * 32 + 16 * part;
       for (int k = 0; k < WINDOW; ++k) {
         float16 col[WINDOW], w[WINDOW];  // Bᵀ (d B): column k

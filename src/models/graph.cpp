@@ -332,7 +332,7 @@ void Executor::run(Queue& queue, const std::map<std::string, Tensor>& inputs, co
           layer = planned_layer(conv2d_plan_key(scratch_in.shape(), weight.shape(), base.stride, base.padding), base,
                                 [&](const Conv2dOptions& o) { conv2d(queue, scratch_in, weight, bias, scratch_out, o); });
         }
-        gemm_weights_[i] = &prepared->conv2d(queue, node.weight, weight, base.stride, timed ? &layer : nullptr,
+        gemm_weights_[i] = &prepared->conv2d(queue, node.weight, weight, base.stride, base.padding, timed ? &layer : nullptr,
                                              graph_.value(node.inputs[0]).shape);
       } else {
         const auto base = node.options_as<ConvTranspose2dOptions>();

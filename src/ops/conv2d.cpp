@@ -26,7 +26,7 @@ void conv2d_packed(Queue& queue, const Tensor& input, const Tensor& weight, cons
                    const Conv2dOptions& options) {
   const bool prepared = options.prepared && options.prepared->packed.data.defined();
   const PackedPanels weights = prepared ? options.prepared->packed
-                                        : prepare_conv2d_weights(queue, weight, GemmBackend::Packed, options.stride).packed;
+                                        : prepare_conv2d_weights(queue, weight, GemmBackend::Packed, options.stride, options.padding).packed;
   const std::size_t reduction = weights.depth;
   const auto out_h = static_cast<int>(output.h()), out_w = static_cast<int>(output.w());
   const std::size_t pixels = static_cast<std::size_t>(out_h) * static_cast<std::size_t>(out_w);
@@ -134,11 +134,22 @@ void conv2d(Queue& queue, const Tensor& input, const Tensor& weight, const Tenso
   // rule); without them the rule decides here.
   const bool winograd = backend == GemmBackend::Winograd &&
                         (options.prepared ? !options.prepared->winograd.empty()
-                                          : detail::winograd_preferred(input.shape(), weight.shape(), options.stride));
+                                          : detail::winograd_preferred(input.shape(), weight.shape(), options.stride,
+                                                                       options.padding));
   if (winograd) {
+    // 5×5 stride-2 padding-2 layers run as 3×3 Winograd over their input's phase images.
+    const bool phases = detail::winograd_phase_eligible(weight.shape(), options.stride, options.padding);
+    if (!phases && !detail::winograd_eligible(weight.shape(), options.stride)) {
+      throw invalid_input("conv2d: weights prepared for Winograd, but a layer of weight " + to_string(weight.shape()) +
+                          ", stride " + std::to_string(options.stride) + " and padding " +
+                          std::to_string(options.padding) + " does not run it");
+    }
     detail::report_backend(queue, to_string(backend));
-    detail::conv2d_winograd(queue, input, options.prepared ? options.prepared->winograd : detail::winograd_weights(queue, weight, nullptr),
-                            bias, output, options);
+    detail::conv2d_winograd(queue, input,
+                            options.prepared ? options.prepared->winograd
+                            : phases         ? detail::winograd_phase_weights(queue, weight, nullptr)
+                                             : detail::winograd_weights(queue, weight, nullptr),
+                            bias, output, options, phases);
     return;
   }
   if (uses_packed_kernels(backend)) {

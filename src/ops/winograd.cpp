@@ -34,10 +34,19 @@ bool winograd_eligible(const Shape& weight, int stride) {
          weight[2] == 3 && weight[3] == 3 && stride == 1;
 }
 
-bool winograd_preferred(const Shape& input, const Shape& weight, int stride) {
-  if (!winograd_eligible(weight, stride)) return false;
+bool winograd_phase_eligible(const Shape& weight, int stride, int padding) {
+  return weight.size() == 4 && weight[2] == kWinogradPhaseKernel && weight[3] == kWinogradPhaseKernel &&
+         stride == kWinogradPhaseStride && padding == kWinogradPhasePadding &&
+         winograd_eligible({weight[0], 4 * weight[1], 3, 3}, 1);
+}
+
+bool winograd_preferred(const Shape& input, const Shape& weight, int stride, int padding) {
+  const bool phases = winograd_phase_eligible(weight, stride, padding);
+  if (!phases && !winograd_eligible(weight, stride)) return false;
   if (input.size() != 4) return true;
-  return ((input[2] + 3) / 4) * ((input[3] + 3) / 4) >= kWinogradMinTiles;
+  // The phase form's output (and phase images) are ceil(H/2) × ceil(W/2).
+  const std::int64_t h = phases ? (input[2] + 1) / 2 : input[2], w = phases ? (input[3] + 1) / 2 : input[3];
+  return ((h + 3) / 4) * ((w + 3) / 4) >= kWinogradMinTiles;
 }
 
 int winograd_tile_rows(std::int64_t co, std::int64_t ci, int device_rows) {
@@ -67,12 +76,43 @@ std::vector<PackedPanels> winograd_weights(Queue& queue, const Tensor& weight, D
   return packed;
 }
 
+std::vector<PackedPanels> winograd_phase_weights(Queue& queue, const Tensor& weight, Device* long_lived) {
+  if (!winograd_phase_eligible(weight.shape(), kWinogradPhaseStride, kWinogradPhasePadding) || !weight.contiguous()) {
+    throw invalid_input("winograd: the weights of a phase-form layer must be a contiguous [co ≥ 16, ci ≥ 8, 5, 5] "
+                        "tensor, got " + to_string(weight.shape()));
+  }
+  const auto co = static_cast<std::size_t>(weight.dim(0)), ci = static_cast<std::size_t>(weight.dim(1));
+  const std::vector<float> w = weight.to_host(queue);
+  std::vector<float> phased(co * 4 * ci * 9, 0.0f);  // [co, 4·ci, 3, 3]; taps past the 5×5 window stay zero
+  constexpr std::size_t k = kWinogradPhaseKernel;
+  for (std::size_t o = 0; o < co; ++o) {
+    for (std::size_t c = 0; c < ci; ++c) {
+      for (std::size_t ky = 0; ky < k; ++ky) {
+        for (std::size_t kx = 0; kx < k; ++kx) {
+          // Tap (ky, kx) = (2·ty + ry, 2·tx + rx) of phase channel 4·c + 2·ry + rx.
+          const std::size_t phase = 4 * c + 2 * (ky % 2) + kx % 2;
+          phased[((o * 4 * ci + phase) * 3 + ky / 2) * 3 + kx / 2] = w[((o * ci + c) * k + ky) * k + kx];
+        }
+      }
+    }
+  }
+  const Tensor as_3x3 = Tensor::from_host(queue, {weight.dim(0), 4 * weight.dim(1), 3, 3}, phased);
+  return winograd_weights(queue, as_3x3, long_lived);
+}
+
 void conv2d_winograd(Queue& queue, const Tensor& input, const std::vector<PackedPanels>& weights, const Tensor& bias,
-                     const Tensor& output, const Conv2dOptions& options) {
+                     const Tensor& output, const Conv2dOptions& options, bool phases) {
   if (weights.size() != 1 || weights[0].lines % (kElements * static_cast<std::size_t>(weights[0].width)) != 0) {
     throw invalid_input("winograd: expected the 36 transformed weight matrices packed as one");
   }
   const PackedPanels& u = weights[0];
+  // A phase-form layer reads its input's 4·ci phase images with padding 1 (winograd_phase_eligible).
+  const std::size_t input_channels = static_cast<std::size_t>(input.c()) * (phases ? 4 : 1);
+  if (u.depth != input_channels) {
+    throw invalid_input("winograd: the prepared weights take " + std::to_string(u.depth) + " input channels, the " +
+                        (phases ? "phase images have " : "input has ") + std::to_string(input_channels));
+  }
+  const int padding = phases ? 1 : options.padding;
   const std::size_t channels = u.depth, out_channels = static_cast<std::size_t>(output.c());
   const std::size_t row_panels = u.panels() / kElements;
   const auto out_h = static_cast<std::size_t>(output.h()), out_w = static_cast<std::size_t>(output.w());
@@ -88,7 +128,7 @@ void conv2d_winograd(Queue& queue, const Tensor& input, const std::vector<Packed
   const Tensor v = Tensor::empty(queue, {static_cast<std::int64_t>(kElements * element_floats)});
 
   const bool has_bias = bias.defined();
-  Kernel& forward = queue.kernel("winograd", "winograd_input", KernelDefines().add("PAD", options.padding));
+  Kernel& forward = queue.kernel("winograd", "winograd_input", KernelDefines().add("PAD", padding).add("PHASES", phases));
   Kernel& product = queue.kernel("winograd_gemm", "winograd_gemm",
                                  KernelDefines()
                                      .add("MR", u.width)

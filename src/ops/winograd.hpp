@@ -2,7 +2,8 @@
 // Winograd F(4×4, 3×3) convolution for the winograd plan on CPU devices: 3×3 stride-1 layers
 // of at least kWinogradMinChannels output and kWinogradMinInputChannels input channels do 36
 // GEMMs of [co × ci]·[ci × tiles] (36 multiplies per 16 output pixels and channel pair instead of
-// 144) plus two transforms (kernels_cl/winograd.cl).
+// 144) plus two transforms (kernels_cl/winograd.cl); 5×5 stride-2 padding-2 layers run as such a
+// layer over their input's four stride-2 phases (winograd_phase_eligible).
 //
 // The weights are transformed (U = G g Gᵀ) and packed into 36 sets of A panels once per layer
 // (ops/gemm/plan.hpp). Per call, the input transform writes V = Bᵀ d B of a range of 4×4 output
@@ -41,9 +42,28 @@ bool winograd_eligible(const Shape& weight, int stride);
 // slower than the packed GEMM, conv5_1, 12×16 in 12 tiles, 0.7–1.0×; conv4_1, 48 tiles, 0.5×).
 inline constexpr std::int64_t kWinogradMinTiles = 32;
 
-// Eligible, and on an NCHW `input` (3×3, stride 1: the output is about the input's size) with at
-// least kWinogradMinTiles tiles. An empty `input` (size unknown) counts as large enough.
-bool winograd_preferred(const Shape& input, const Shape& weight, int stride);
+// 5×5 stride-2 padding-2 convolutions (FlowNetC/S conv2 and conv3) as one 3×3 stride-1 padding-1
+// Winograd convolution over the input's four stride-2 phase images (space-to-depth): with
+// k − 2 = 2a + r, y[o] = Σₖ x[2o + k − 2]·w[k] = Σ_r Σ_{a=−1..1} x_r[o + a]·w_r[a], where
+// x_r[j] = x[2j + r], w_0 = (w[0], w[2], w[4]) and w_1 = (w[1], w[3], 0); in 2-D the phase images
+// x_{ry,rx} are 4·ci input channels (channel 4·c + 2·ry + rx) and the weights
+// w'[o, 4·c + 2·ry + rx, ty, tx] = w[o, c, 2·ty + ry, 2·tx + rx] (zero past 4). The output,
+// ceil(H/2) × ceil(W/2), is the phase images' size. 4 × 36/16 = 9 products per output and input
+// channel instead of 25. Only this shape qualifies: a 3×3 stride-2 layer's phases need 4 × 4 taps
+// of which 9 are used (no gain), a 7×7 one's need 4-tap phases (not F(4×4, 3×3)). The phase
+// images are never written: kernels_cl/winograd.cl reads them from the input (PHASES).
+inline constexpr int kWinogradPhaseKernel = 5;
+inline constexpr int kWinogradPhaseStride = 2;
+inline constexpr int kWinogradPhasePadding = 2;
+
+// Whether a convolution with weights [co, ci, kh, kw], `stride` and `padding` runs as that phase
+// form on the winograd plan: 5×5, stride 2, padding 2, and as a 3×3 layer of 4·ci inputs eligible.
+bool winograd_phase_eligible(const Shape& weight, int stride, int padding);
+
+// Eligible (either form), and on an NCHW `input` whose output has at least kWinogradMinTiles
+// tiles (3×3 stride 1: about the input's size; the phase form: ceil(H/2) × ceil(W/2)). An empty
+// `input` (size unknown) counts as large enough.
+bool winograd_preferred(const Shape& input, const Shape& weight, int stride, int padding);
 
 // Input channels from which the products run on the widest register tile, kWinogradDeepTileRows
 // rows of U per 32 tiles instead of the device's MR: a work-item's 36 B panels (36·32·ci floats,
@@ -64,9 +84,13 @@ int winograd_tile_rows(std::int64_t co, std::int64_t ci, int device_rows);
 // when given, else temporaries of `queue`).
 std::vector<PackedPanels> winograd_weights(Queue& queue, const Tensor& weight, Device* long_lived);
 
+// The same for a phase-form layer's 5×5 weights [co, ci, 5, 5]: rearranged on the host into the
+// 3×3 weights [co, 4·ci, 3, 3] of the phase images, then transformed and packed as above.
+std::vector<PackedPanels> winograd_phase_weights(Queue& queue, const Tensor& weight, Device* long_lived);
+
 // output = activation(conv(input, weight) + bias) from the prepared U panels; shapes checked by
-// the caller (conv2d).
+// the caller (conv2d). `phases`: the layer is a phase-form one (winograd_phase_weights' panels).
 void conv2d_winograd(Queue& queue, const Tensor& input, const std::vector<PackedPanels>& weights, const Tensor& bias,
-                     const Tensor& output, const Conv2dOptions& options);
+                     const Tensor& output, const Conv2dOptions& options, bool phases = false);
 
 }  // namespace inertialnet::detail

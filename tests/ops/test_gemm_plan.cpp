@@ -123,7 +123,7 @@ GemmBackend run_planned_conv(PreparedWeights& prepared, const std::string& name)
     conv2d(queue, in, w, b, out, timed);
     ++runs;
   };
-  const GemmWeights& chosen = prepared.conv2d(queue, name, w, options.stride, &layer);
+  const GemmWeights& chosen = prepared.conv2d(queue, name, w, options.stride, options.padding, &layer);
   options.prepared = &chosen;
   conv2d(queue, in, w, b, out, options);
   // The bound of test_conv2d: 1e-5 relative to sqrt(K), the typical output magnitude.

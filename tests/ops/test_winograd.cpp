@@ -32,6 +32,7 @@ struct Case {
   int ci, co, h, w, stride, padding;
   bool bias;
   ActivationSpec activation;
+  int k = 3;  // 5: a 5×5 stride-2 padding-2 layer, the phase form (ops/winograd.hpp)
 };
 
 struct Placement {
@@ -48,10 +49,10 @@ void expect_winograd_matches(const Case& c, const Placement& p, bool expect_wino
                              bool with_input_shape = false) {
   SCOPED_TRACE(c.name);
   Queue& queue = testing::test_queue();
-  const reference::ConvShape s{p.batch, c.ci, c.h, c.w, c.co, 3, 3, c.stride, c.padding};
+  const reference::ConvShape s{p.batch, c.ci, c.h, c.w, c.co, c.k, c.k, c.stride, c.padding};
   const int oh = s.conv_out_h(), ow = s.conv_out_w();
   const auto input = testing::random_vector(static_cast<std::size_t>(p.batch) * c.ci * c.h * c.w, 201);
-  const auto weight = testing::random_vector(static_cast<std::size_t>(c.co) * c.ci * 9, 202);
+  const auto weight = testing::random_vector(static_cast<std::size_t>(c.co) * c.ci * c.k * c.k, 202);
   const auto bias = c.bias ? testing::random_vector(static_cast<std::size_t>(c.co), 203) : std::vector<float>{};
   const auto expected = reference::conv2d(s, input, weight, bias, c.activation);
 
@@ -59,10 +60,10 @@ void expect_winograd_matches(const Case& c, const Placement& p, bool expect_wino
       testing::embed_sliced(queue, input, {p.batch, c.ci, c.h, c.w}, p.in_before, p.in_before + p.in_after, 204);
   const testing::Sliced out =
       testing::make_sliced(queue, {p.batch, c.co, oh, ow}, p.out_before, p.out_before + p.out_after, 205);
-  const Tensor w = Tensor::from_host(queue, {c.co, c.ci, 3, 3}, weight);
+  const Tensor w = Tensor::from_host(queue, {c.co, c.ci, c.k, c.k}, weight);
   const Tensor b = c.bias ? Tensor::from_host(queue, {c.co}, bias) : Tensor();
-  const GemmWeights prepared =
-      prepare_conv2d_weights(queue, w, GemmBackend::Winograd, c.stride, with_input_shape ? in.view.shape() : Shape{});
+  const GemmWeights prepared = prepare_conv2d_weights(queue, w, GemmBackend::Winograd, c.stride, c.padding,
+                                                      with_input_shape ? in.view.shape() : Shape{});
   // The 36 transformed matrices packed as one (ops/winograd.hpp), else the plain packed panels.
   ASSERT_EQ(prepared.winograd.size(), expect_winograd ? 1u : 0u);
   if (expect_winograd) {
@@ -71,7 +72,7 @@ void expect_winograd_matches(const Case& c, const Placement& p, bool expect_wino
   Conv2dOptions options{c.stride, c.padding, c.activation, p.max_column_floats, &prepared};
   conv2d(queue, in.view, w, b, out.view, options);
   EXPECT_TRUE(testing::untouched_outside(queue, out)) << "elements outside the output slice were written";
-  const double floor = std::sqrt(static_cast<double>(c.ci) * 9);
+  const double floor = std::sqrt(static_cast<double>(c.ci) * c.k * c.k);
   EXPECT_TRUE(testing::all_close(testing::view_values(queue, out), expected,
                                   expect_winograd ? testing::kWinogradRelativeTolerance : 1e-5, floor));
 }
@@ -148,11 +149,11 @@ TEST(Winograd, IneligibleLayersRunPacked) {
 TEST(Winograd, SmallOutputsStayOnThePackedGemm) {
   // Fewer than kWinogradMinTiles 4×4 tiles (one 32-tile B panel): FlowNetC/S/SD conv6_1 (6×8)
   // and conv5_1 (12×16) at 512×384 run the packed GEMM; conv4_1 (24×32, 48 tiles) Winograd.
-  EXPECT_FALSE(detail::winograd_preferred({1, 1024, 6, 8}, {1024, 1024, 3, 3}, 1));
-  EXPECT_FALSE(detail::winograd_preferred({1, 512, 12, 16}, {512, 512, 3, 3}, 1));
-  EXPECT_TRUE(detail::winograd_preferred({1, 512, 24, 32}, {512, 512, 3, 3}, 1));
-  EXPECT_TRUE(detail::winograd_preferred({}, {512, 512, 3, 3}, 1));  // size unknown
-  EXPECT_FALSE(detail::winograd_preferred({1, 512, 24, 32}, {512, 512, 3, 3}, 2));
+  EXPECT_FALSE(detail::winograd_preferred({1, 1024, 6, 8}, {1024, 1024, 3, 3}, 1, 1));
+  EXPECT_FALSE(detail::winograd_preferred({1, 512, 12, 16}, {512, 512, 3, 3}, 1, 1));
+  EXPECT_TRUE(detail::winograd_preferred({1, 512, 24, 32}, {512, 512, 3, 3}, 1, 1));
+  EXPECT_TRUE(detail::winograd_preferred({}, {512, 512, 3, 3}, 1, 1));  // size unknown
+  EXPECT_FALSE(detail::winograd_preferred({1, 512, 24, 32}, {512, 512, 3, 3}, 2, 1));
   const auto leaky = ActivationSpec::leaky_relu(0.1f);
   expect_winograd_matches({"tiles_32", 32, 16, 16, 32, 1, 1, true, leaky}, {1}, true, true);
   expect_winograd_matches({"tiles_28", 32, 16, 16, 28, 1, 1, true, leaky}, {2}, false, true);
@@ -191,9 +192,106 @@ TEST(Winograd, DeepLayersUseTheWidestRegisterTile) {
   expect_winograd_matches({"conv4_1_like", 384, 16, 24, 32, 1, 1, true, leaky}, {2}, true, true);
   Queue& queue = testing::test_queue();
   const Tensor w = Tensor::from_host(queue, {30, 384, 3, 3}, testing::random_vector(30 * 384 * 9, 7));
-  const GemmWeights prepared = prepare_conv2d_weights(queue, w, GemmBackend::Winograd, 1, Shape{});
+  const GemmWeights prepared = prepare_conv2d_weights(queue, w, GemmBackend::Winograd, 1, 1, Shape{});
   ASSERT_EQ(prepared.winograd.size(), 1u);
   EXPECT_EQ(prepared.winograd[0].width, detail::winograd_tile_rows(30, 384, packed_gemm_setting(queue.device(), "MR")));
+}
+
+// The phase form (ops/winograd.hpp): 5×5 stride-2 padding-2 layers as 3×3 Winograd over the
+// input's four stride-2 phase images, against the same float64 reference and bound.
+class FlowNetPhaseShapes : public ::testing::TestWithParam<Case> {};
+
+TEST_P(FlowNetPhaseShapes, MatchTheReference) { expect_winograd_matches(GetParam(), Placement{}); }
+
+// FlowNet2's 5×5 stride-2 layers (FlowNetC conv2/conv3, FlowNetS conv2/conv3) at a 64×64 network
+// input: their real ci and co (an output's error depends on its window and ci, not on H×W).
+std::vector<Case> flownet2_phase_cases() {
+  std::vector<Case> cases;
+  for (const auto& l : flownet_layers::flownet2_layers(64, 64, flownet_layers::LayerKind::Conv)) {
+    if (!detail::winograd_phase_eligible({l.co, l.ci, l.k, l.k}, l.stride, l.padding)) continue;
+    cases.push_back({l.identifier(), l.ci, l.co, l.h, l.w, l.stride, l.padding, l.bias, l.activation, l.k});
+  }
+  return cases;
+}
+
+INSTANTIATE_TEST_SUITE_P(FlowNet2, FlowNetPhaseShapes, ::testing::ValuesIn(flownet2_phase_cases()),
+                         [](const ::testing::TestParamInfo<Case>& info) { return info.param.name; });
+
+TEST(WinogradPhases, FlowNet2HasPhaseLayers) {
+  // conv2 (64→128) and conv3 (128→256): FlowNetC's and both FlowNetS' share the two shapes,
+  // which the table lists once.
+  EXPECT_GE(flownet2_phase_cases().size(), 2u);
+}
+
+TEST(WinogradPhases, OddSizesOnePixelRowsAndColumns) {
+  // Odd H and W leave the odd phases a row / column shorter than the even ones (zeros there); a
+  // 1×1 input has three all-zero phases; 1×N and N×1 inputs give one row or column of tiles.
+  // ci = 9: 36 phase channels, the last block of 8 partial; co = 17: a partial row panel.
+  const auto leaky = ActivationSpec::leaky_relu(0.1f);
+  expect_winograd_matches({"odd_37x23", 9, 17, 37, 23, 2, 2, true, leaky, 5}, {3});
+  expect_winograd_matches({"even_38x22", 8, 16, 38, 22, 2, 2, false, ActivationSpec::relu(), 5}, {2});
+  expect_winograd_matches({"one_pixel", 8, 16, 1, 1, 2, 2, true, ActivationSpec::none(), 5}, {3});
+  expect_winograd_matches({"one_row", 10, 16, 1, 37, 2, 2, true, leaky, 5}, {2});
+  expect_winograd_matches({"one_column", 10, 16, 29, 1, 2, 2, true, leaky, 5}, {1});
+  expect_winograd_matches({"two_by_three", 11, 20, 2, 3, 2, 2, false, ActivationSpec::none(), 5}, {1});
+}
+
+TEST(WinogradPhases, WholeVectorRowsAndEdges) {
+  // Phase rows of 16 whole tiles side by side are read as pairs of input vectors split into even
+  // or odd lanes (kernels_cl/winograd.cl); widths 130, 131 and 259 put groups against both edges
+  // (a vector that runs past the input's right edge goes element by element), odd widths make
+  // the rx = 1 phase a column shorter; 256 is FlowNetC conv2's width.
+  const auto leaky = ActivationSpec::leaky_relu(0.1f);
+  expect_winograd_matches({"w130", 8, 16, 9, 130, 2, 2, true, leaky, 5}, {2});
+  expect_winograd_matches({"w131_h10", 9, 16, 10, 131, 2, 2, false, ActivationSpec::relu(), 5}, {1});
+  expect_winograd_matches({"w259", 8, 24, 7, 259, 2, 2, true, leaky, 5}, {1});
+  expect_winograd_matches({"w256", 12, 16, 8, 256, 2, 2, true, leaky, 5}, {1});
+}
+
+TEST(WinogradPhases, ChannelSlicesTileRangesAndDeepLayers) {
+  const auto leaky = ActivationSpec::leaky_relu(0.1f);
+  // The input and output as channel slices of wider tensors (the phases index the slice's planes).
+  expect_winograd_matches({"slice", 9, 18, 37, 23, 2, 2, true, leaky, 5}, {3, 2, 3, 5, 4, 0});
+  // A budget of 40 tiles of 36·(4·10) floats: ranges of 32 tiles, starting mid-row.
+  expect_winograd_matches({"ranges", 10, 20, 75, 41, 2, 2, true, leaky, 5}, {2, 1, 1, 2, 2, 36 * 40 * 40});
+  // 96 inputs are 384 phase channels: U on the deep layers' 14-row panels; 24×32 outputs (48
+  // tiles: the second panel's low half alone), as FlowNet2's 3×3 conv4_1.
+  expect_winograd_matches({"deep_24x32", 96, 30, 48, 64, 2, 2, true, leaky, 5}, {1}, true, true);
+}
+
+TEST(WinogradPhases, OnlyFiveByFiveStrideTwoPaddingTwoQualifies) {
+  // Other paddings and strides, other kernels, and too few channels (4·ci < 32, co < 16) keep the
+  // packed GEMM (and the direct convolution), with its own bound.
+  EXPECT_TRUE(detail::winograd_phase_eligible({16, 8, 5, 5}, 2, 2));
+  EXPECT_FALSE(detail::winograd_phase_eligible({16, 8, 5, 5}, 2, 1));
+  EXPECT_FALSE(detail::winograd_phase_eligible({16, 8, 5, 5}, 1, 2));
+  EXPECT_FALSE(detail::winograd_phase_eligible({16, 8, 7, 7}, 2, 2));
+  EXPECT_FALSE(detail::winograd_phase_eligible({16, 8, 3, 3}, 2, 2));
+  EXPECT_FALSE(detail::winograd_phase_eligible({16, 7, 5, 5}, 2, 2));
+  EXPECT_FALSE(detail::winograd_phase_eligible({15, 8, 5, 5}, 2, 2));
+  expect_winograd_matches({"pad1", 12, 20, 21, 17, 2, 1, true, ActivationSpec::relu(), 5}, {2}, false);
+  expect_winograd_matches({"stride1", 12, 20, 21, 17, 1, 2, true, ActivationSpec::relu(), 5}, {1}, false);
+  expect_winograd_matches({"k7s2", 12, 20, 21, 17, 2, 3, true, ActivationSpec::relu(), 7}, {1}, false);
+  expect_winograd_matches({"ci7", 7, 20, 21, 17, 2, 2, true, ActivationSpec::relu(), 5}, {1}, false);
+  // The size rule counts the phase images' tiles (ceil(H/2) × ceil(W/2) outputs): FlowNetC
+  // conv2 at 512×384 (96×128 outputs) qualifies, a 12×16 input (6×8 outputs, 4 tiles) does not.
+  EXPECT_TRUE(detail::winograd_preferred({1, 64, 192, 256}, {128, 64, 5, 5}, 2, 2));
+  EXPECT_TRUE(detail::winograd_preferred({1, 64, 63, 64}, {128, 64, 5, 5}, 2, 2));   // 32×32: 64 tiles
+  EXPECT_FALSE(detail::winograd_preferred({1, 64, 32, 32}, {128, 64, 5, 5}, 2, 2));  // 16×16: 16 tiles
+  EXPECT_FALSE(detail::winograd_preferred({1, 64, 12, 16}, {128, 64, 5, 5}, 2, 2));
+  expect_winograd_matches({"tiles_32", 8, 16, 32, 63, 2, 2, true, ActivationSpec::none(), 5}, {1}, true, true);
+  expect_winograd_matches({"tiles_24", 8, 16, 24, 64, 2, 2, true, ActivationSpec::none(), 5}, {1}, false, true);
+  // The prepared matrices take the 4·ci phase channels.
+  Queue& queue = testing::test_queue();
+  const Tensor w = Tensor::from_host(queue, {16, 9, 5, 5}, testing::random_vector(16 * 9 * 25, 8));
+  const GemmWeights prepared = prepare_conv2d_weights(queue, w, GemmBackend::Winograd, 2, 2, Shape{});
+  ASSERT_EQ(prepared.winograd.size(), 1u);
+  EXPECT_EQ(prepared.winograd[0].depth, 36u);
+  // Weights prepared for the phase form do not run a layer of another padding.
+  const Tensor in = Tensor::empty(queue, {1, 9, 12, 12});
+  Conv2dOptions pad1{2, 1, ActivationSpec::none(), 0, &prepared};
+  testing::expect_invalid_input([&] { conv2d(queue, in, w, Tensor(), Tensor::empty(queue, {1, 16, 5, 5}), pad1); },
+                                "prepared for Winograd");
 }
 
 TEST(Winograd, PlanName) {

@@ -86,7 +86,7 @@ inline void expect_conv_matches(const ConvCase& c, const ConvPlacement& p, const
   const double floor = std::sqrt(static_cast<double>(c.ci) * c.k * c.k);
   const bool winograd = run.algorithm == Conv2dAlgorithm::Default &&
                         gemm_backend(queue.device().info()) == GemmBackend::Winograd &&
-                        detail::winograd_preferred(in.view.shape(), w.shape(), c.stride);
+                        detail::winograd_preferred(in.view.shape(), w.shape(), c.stride, c.padding);
   EXPECT_TRUE(all_close(view_values(queue, out), expected, winograd ? kWinogradRelativeTolerance : 1e-5, floor));
 }
 

@@ -41,7 +41,7 @@ GemmWeights time_candidates(Queue& queue, const PlannedLayer& layer, Prepare& pr
 PreparedWeights::PreparedWeights(std::filesystem::path plan_directory) : plan_directory_(std::move(plan_directory)) {}
 PreparedWeights::~PreparedWeights() = default;
 
-GemmWeights prepare_conv2d_weights(Queue& queue, const Tensor& weight, GemmBackend backend, int stride,
+GemmWeights prepare_conv2d_weights(Queue& queue, const Tensor& weight, GemmBackend backend, int stride, int padding,
                                    const Shape& input) {
   if (weight.rank() != 4 || !weight.contiguous()) {
     throw invalid_input("conv2d weights must be a contiguous [co, ci, kh, kw] tensor, got " + to_string(weight.shape()));
@@ -49,8 +49,10 @@ GemmWeights prepare_conv2d_weights(Queue& queue, const Tensor& weight, GemmBacke
   GemmWeights prepared;
   prepared.backend = backend;
   const auto rows = static_cast<std::size_t>(weight.dim(0));
-  if (backend == GemmBackend::Winograd && detail::winograd_preferred(input, weight.shape(), stride)) {
-    prepared.winograd = detail::winograd_weights(queue, weight, &queue.device());
+  if (backend == GemmBackend::Winograd && detail::winograd_preferred(input, weight.shape(), stride, padding)) {
+    prepared.winograd = detail::winograd_phase_eligible(weight.shape(), stride, padding)
+                            ? detail::winograd_phase_weights(queue, weight, &queue.device())
+                            : detail::winograd_weights(queue, weight, &queue.device());
   } else if (uses_packed_kernels(backend) && weight.dim(0) > kDirectConvMaxChannels) {
     const std::size_t depth = static_cast<std::size_t>(weight.numel()) / rows;
     prepared.packed = pack_a(queue, Transpose::No, rows, depth, MatrixView::of(weight, depth), 0, &queue.device());
@@ -106,9 +108,10 @@ const GemmWeights& PreparedWeights::get(Queue& queue, const std::string& name, P
 }
 
 const GemmWeights& PreparedWeights::conv2d(Queue& queue, const std::string& name, const Tensor& weight, int stride,
-                                            const PlannedLayer* layer, const Shape& input) {
+                                            int padding, const PlannedLayer* layer, const Shape& input) {
   return get(
-      queue, name, [&](GemmBackend backend) { return prepare_conv2d_weights(queue, weight, backend, stride, input); },
+      queue, name,
+      [&](GemmBackend backend) { return prepare_conv2d_weights(queue, weight, backend, stride, padding, input); },
       layer);
 }
 

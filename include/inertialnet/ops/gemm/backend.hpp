@@ -5,8 +5,9 @@
 // one-sample fully connected layers).
 //
 // `Winograd` is the packed backend with Winograd F(4×4, 3×3) for the 3×3 stride-1 convolutions
-// of at least 16 output and 32 input channels (src/ops/winograd.hpp); every other layer runs as
-// on `Packed`.
+// of at least 16 output and 32 input channels, and for the 5×5 stride-2 padding-2 ones of at least
+// 16 output and 8 input channels as 3×3 over their input's four stride-2 phases
+// (src/ops/winograd.hpp); every other layer runs as on `Packed`.
 //
 // Without timing the choice is deterministic: $INERTIALNET_PLAN=clblast|packed|winograd forces
 // one backend everywhere (tests run every suite under each; `bench` compares them), otherwise CPU

@@ -7,8 +7,9 @@
 // graph but shares one WeightSet, so the packed weights are kept per WeightSet (one cache per
 // device's weights), not per graph: pipeline lanes do not duplicate them. Layers with very few
 // output channels (predict_flow*) run a direct convolution and need no packing; fully connected
-// layers read their weights in place (GEMV). On the winograd plan, the 3×3 stride-1 layers keep
-// their 36 Winograd-transformed weight matrices, packed as one, instead (src/ops/winograd.hpp).
+// layers read their weights in place (GEMV). On the winograd plan, the 3×3 stride-1 layers (and the
+// 5×5 stride-2 padding-2 ones, as 3×3 over 4·ci phase channels) keep their 36 Winograd-transformed
+// weight matrices, packed as one, instead (src/ops/winograd.hpp).
 //
 // Under $INERTIALNET_PLAN=auto the backend of a layer comes from timing: the layer runs on its
 // real shape with the weights prepared for each candidate of gemm_candidates() (one warm-up,
@@ -47,11 +48,11 @@ struct GemmWeights {
 // backend (FlowNet's predict_flow*: 2).
 inline constexpr std::int64_t kDirectConvMaxChannels = 4;
 
-// Prepares conv2d weights [co, ci, kh, kw] (of a layer of `stride` on `input`; empty: size not
-// known) / conv_transpose2d weights [ci, co, kh, kw] (of a layer on `input` with `stride` and
+// Prepares conv2d weights [co, ci, kh, kw] (of a layer of `stride` and `padding` on `input`;
+// empty: size not known) / conv_transpose2d weights [ci, co, kh, kw] (of a layer on `input` with `stride` and
 // `padding`) for `backend`, packing on `queue` into long-lived storage of `device`. Wait for
 // `queue` before another queue uses the result.
-GemmWeights prepare_conv2d_weights(Queue& queue, const Tensor& weight, GemmBackend backend, int stride,
+GemmWeights prepare_conv2d_weights(Queue& queue, const Tensor& weight, GemmBackend backend, int stride, int padding,
                                    const Shape& input = {});
 GemmWeights prepare_conv_transpose2d_weights(Queue& queue, const Tensor& weight, GemmBackend backend,
                                              const Shape& input, int stride, int padding);
@@ -77,7 +78,7 @@ class PreparedWeights {
   // Timed plans are cached in `plan_directory` (empty: the device's program-cache directory).
   explicit PreparedWeights(std::filesystem::path plan_directory = {});
   ~PreparedWeights();
-  const GemmWeights& conv2d(Queue& queue, const std::string& name, const Tensor& weight, int stride,
+  const GemmWeights& conv2d(Queue& queue, const std::string& name, const Tensor& weight, int stride, int padding,
                             const PlannedLayer* layer = nullptr, const Shape& input = {});
   const GemmWeights& conv_transpose2d(Queue& queue, const std::string& name, const Tensor& weight,
                                       const Shape& input, int stride, int padding,
