@@ -149,7 +149,8 @@ void conv2d(Queue& queue, const Tensor& input, const Tensor& weight, const Tenso
                             options.prepared ? options.prepared->winograd
                             : phases         ? detail::winograd_phase_weights(queue, weight, nullptr)
                                              : detail::winograd_weights(queue, weight, nullptr),
-                            bias, output, options, phases);
+                            bias, output, options,
+                            phases ? detail::WinogradForm::InputPhases : detail::WinogradForm::Plain);
     return;
   }
   if (uses_packed_kernels(backend)) {

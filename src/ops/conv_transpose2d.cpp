@@ -10,6 +10,7 @@
 #include "inertialnet/ops/gemm/gemm.hpp"
 #include "ops/deconv_subpixel.hpp"
 #include "ops/op_support.hpp"
+#include "ops/winograd.hpp"
 
 namespace inertialnet {
 
@@ -60,6 +61,30 @@ void conv_transpose2d(Queue& queue, const Tensor& input, const Tensor& weight, c
   }
 
   const GemmBackend backend = options.prepared ? options.prepared->backend : gemm_backend(queue.device().info());
+  // On the winograd plan a 4×4 stride-2 layer on an input large enough runs as a 3×3 Winograd
+  // convolution into its output's phases (src/ops/winograd.hpp); prepared weights say whether
+  // (prepare_conv_transpose2d_weights applied the shape rule), else the rule decides here.
+  const bool winograd =
+      options.algorithm == DeconvAlgorithm::Default && backend == GemmBackend::Winograd &&
+      (options.prepared ? !options.prepared->winograd.empty()
+                        : detail::winograd_deconv_preferred(input.shape(), weight.shape(), options.stride,
+                                                            options.padding));
+  if (winograd) {
+    if (!detail::winograd_deconv_eligible(weight.shape(), options.stride, options.padding)) {
+      throw invalid_input("conv_transpose2d: weights prepared for Winograd, but a layer of weight " +
+                          to_string(weight.shape()) + ", stride " + std::to_string(options.stride) +
+                          " and padding " + std::to_string(options.padding) + " does not run it");
+    }
+    detail::report_backend(queue, to_string(backend));
+    Conv2dOptions as_conv;
+    as_conv.activation = options.activation;
+    as_conv.max_column_floats = options.max_column_floats;
+    detail::conv2d_winograd(queue, input,
+                            options.prepared ? options.prepared->winograd
+                                             : detail::winograd_deconv_weights(queue, weight, nullptr),
+                            bias, output, as_conv, detail::WinogradForm::OutputPhases);
+    return;
+  }
   const bool eligible = detail::subpixel_eligible(weight.shape(), options.stride, options.padding);
   const bool forced_subpixel =
       options.algorithm == DeconvAlgorithm::SubPixel || options.algorithm == DeconvAlgorithm::SubPixelDirect;

@@ -40,6 +40,17 @@ bool winograd_phase_eligible(const Shape& weight, int stride, int padding) {
          winograd_eligible({weight[0], 4 * weight[1], 3, 3}, 1);
 }
 
+bool winograd_deconv_eligible(const Shape& weight, int stride, int padding) {
+  return weight.size() == 4 && weight[2] == kWinogradDeconvKernel && weight[3] == kWinogradDeconvKernel &&
+         stride == kWinogradDeconvStride && padding == kWinogradDeconvPadding &&
+         winograd_eligible({4 * weight[1], weight[0], 3, 3}, 1);
+}
+
+bool winograd_deconv_preferred(const Shape& input, const Shape& weight, int stride, int padding) {
+  if (!winograd_deconv_eligible(weight, stride, padding)) return false;
+  return input.size() != 4 || ((input[2] + 3) / 4) * ((input[3] + 3) / 4) >= kWinogradDeconvMinTiles;
+}
+
 bool winograd_preferred(const Shape& input, const Shape& weight, int stride, int padding) {
   const bool phases = winograd_phase_eligible(weight, stride, padding);
   if (!phases && !winograd_eligible(weight, stride)) return false;
@@ -100,22 +111,63 @@ std::vector<PackedPanels> winograd_phase_weights(Queue& queue, const Tensor& wei
   return winograd_weights(queue, as_3x3, long_lived);
 }
 
+std::vector<PackedPanels> winograd_deconv_weights(Queue& queue, const Tensor& weight, Device* long_lived) {
+  if (!winograd_deconv_eligible(weight.shape(), kWinogradDeconvStride, kWinogradDeconvPadding) ||
+      !weight.contiguous()) {
+    throw invalid_input("winograd: the weights of a transposed convolution must be a contiguous [ci ≥ 32, co ≥ 4, "
+                        "4, 4] tensor, got " + to_string(weight.shape()));
+  }
+  const auto ci = static_cast<std::size_t>(weight.dim(0)), co = static_cast<std::size_t>(weight.dim(1));
+  const std::vector<float> w = weight.to_host(queue);
+  std::vector<float> phased(4 * co * ci * 9, 0.0f);  // [4·co, ci, 3, 3]; taps outside the 4×4 kernel stay zero
+  constexpr int k = kWinogradDeconvKernel;
+  for (std::size_t o = 0; o < co; ++o) {
+    for (int py = 0; py < 2; ++py) {
+      for (int px = 0; px < 2; ++px) {
+        const std::size_t row = 4 * o + 2 * static_cast<std::size_t>(py) + static_cast<std::size_t>(px);
+        for (std::size_t c = 0; c < ci; ++c) {
+          for (int a = -1; a <= 1; ++a) {
+            for (int b = -1; b <= 1; ++b) {
+              const int ky = py + 1 - 2 * a, kx = px + 1 - 2 * b;  // winograd.hpp: the tap of offset (a, b)
+              if (ky < 0 || ky >= k || kx < 0 || kx >= k) continue;
+              phased[((row * ci + c) * 3 + static_cast<std::size_t>(a + 1)) * 3 + static_cast<std::size_t>(b + 1)] =
+                  w[((c * co + o) * k + static_cast<std::size_t>(ky)) * k + static_cast<std::size_t>(kx)];
+            }
+          }
+        }
+      }
+    }
+  }
+  const Tensor as_3x3 = Tensor::from_host(queue, {4 * weight.dim(1), weight.dim(0), 3, 3}, phased);
+  return winograd_weights(queue, as_3x3, long_lived);
+}
+
 void conv2d_winograd(Queue& queue, const Tensor& input, const std::vector<PackedPanels>& weights, const Tensor& bias,
-                     const Tensor& output, const Conv2dOptions& options, bool phases) {
+                     const Tensor& output, const Conv2dOptions& options, WinogradForm form) {
   if (weights.size() != 1 || weights[0].lines % (kElements * static_cast<std::size_t>(weights[0].width)) != 0) {
     throw invalid_input("winograd: expected the 36 transformed weight matrices packed as one");
   }
   const PackedPanels& u = weights[0];
+  const bool phases = form == WinogradForm::InputPhases;
   // A phase-form layer reads its input's 4·ci phase images with padding 1 (winograd_phase_eligible).
   const std::size_t input_channels = static_cast<std::size_t>(input.c()) * (phases ? 4 : 1);
   if (u.depth != input_channels) {
     throw invalid_input("winograd: the prepared weights take " + std::to_string(u.depth) + " input channels, the " +
                         (phases ? "phase images have " : "input has ") + std::to_string(input_channels));
   }
-  const int padding = phases ? 1 : options.padding;
-  const std::size_t channels = u.depth, out_channels = static_cast<std::size_t>(output.c());
+  const bool subpixel = form == WinogradForm::OutputPhases;
+  const int padding = phases || subpixel ? 1 : options.padding;
+  // The 3×3 layer's output channels and size: for a transposed convolution, 4 phases per channel
+  // of half the output's height and width (winograd_deconv_eligible).
+  const std::size_t out_channels = static_cast<std::size_t>(output.c()) * (subpixel ? 4 : 1);
+  if (subpixel && (output.h() != 2 * input.h() || output.w() != 2 * input.w())) {
+    throw invalid_input("winograd: a transposed convolution's output must be twice its input's size, got " +
+                        to_string(output.shape()) + " from " + to_string(input.shape()));
+  }
+  const std::size_t channels = u.depth;
   const std::size_t row_panels = u.panels() / kElements;
-  const auto out_h = static_cast<std::size_t>(output.h()), out_w = static_cast<std::size_t>(output.w());
+  const auto out_h = static_cast<std::size_t>(output.h()) / (subpixel ? 2 : 1);
+  const auto out_w = static_cast<std::size_t>(output.w()) / (subpixel ? 2 : 1);
   const std::size_t tiles_w = (out_w + kTile - 1) / kTile, tiles = (out_h + kTile - 1) / kTile * tiles_w;
   // A range of tiles at a time: its V (36 × ci floats a tile) within the packed budget, whole
   // panels. The products stay in the GEMM kernel's local memory (kernels_cl/winograd_gemm.cl).
@@ -133,6 +185,7 @@ void conv2d_winograd(Queue& queue, const Tensor& input, const std::vector<Packed
                                  KernelDefines()
                                      .add("MR", u.width)
                                      .add("HAS_BIAS", has_bias)
+                                     .add("SUBPIXEL", subpixel)
                                      .add(activation_defines(options.activation)));
   for (std::int64_t n = 0; n < input.n(); ++n) {
     const Tensor in_n = input.sample(n);

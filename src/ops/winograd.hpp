@@ -60,6 +60,37 @@ inline constexpr int kWinogradPhasePadding = 2;
 // form on the winograd plan: 5×5, stride 2, padding 2, and as a 3×3 layer of 4·ci inputs eligible.
 bool winograd_phase_eligible(const Shape& weight, int stride, int padding);
 
+// 4×4 stride-2 padding-1 transposed convolutions (every FlowNet up-convolution) as one 3×3
+// stride-1 padding-1 Winograd convolution of the input with 4·co output channels, one per output
+// channel and output phase (sub-pixel decomposition, as ops/deconv_subpixel.hpp): output pixel
+// (2m + py, 2n + px) is Σ_c Σ_{a,b=−1..1} x[c, m + a, n + b]·w[c, o, py + 1 − 2a, px + 1 − 2b]
+// (taps outside 0…3 are zero: each phase uses 2×2 of the 3×3), so output channel
+// o' = 4·o + 2·py + px of the 3×3 layer has the weights w'[o', c, a + 1, b + 1] of that sum, and
+// its output, the input's size, is that phase of channel o: the output transform stores it
+// interleaved (kernels_cl/winograd_gemm.cl, SUBPIXEL). 4·36/16 = 9 products per input pixel and
+// channel pair instead of 16 (the direct sub-pixel form's 4 phases × 2×2 taps). The zero taps
+// cost products here: F(4×4, 2×2) per phase would need 4·25/16 = 6.25, with transforms of its own.
+inline constexpr int kWinogradDeconvKernel = 4;
+inline constexpr int kWinogradDeconvStride = 2;
+inline constexpr int kWinogradDeconvPadding = 1;
+
+// Whether a transposed convolution with weights [ci, co, kh, kw], `stride` and `padding` runs as
+// that form on the winograd plan: 4×4, stride 2, padding 1, and as a 3×3 layer of ci inputs and
+// 4·co outputs eligible.
+bool winograd_deconv_eligible(const Shape& weight, int stride, int padding);
+
+// 4×4 output tiles of the 3×3 layer (its output is the input's size) from which an eligible
+// transposed convolution runs Winograd on that plan. Measured at 512×384 (docs/performance.md,
+// "Issue 24, seventh pass"): deconv2 (386 → 64 channels, 48×64 inputs, 192 tiles) 24 → 18.5 ms and
+// FlowNetFusion's deconv1 (96×128) and deconv0 (192×256) faster too, but deconv3 (770 → 128,
+// 24×32 inputs, 48 tiles: 512 rows of deep products over a panel and a half) 23 → 27–31 ms against
+// the direct sub-pixel form; the rule's threshold lies between the two.
+inline constexpr std::int64_t kWinogradDeconvMinTiles = 96;
+
+// Eligible, and on an NCHW `input` of at least kWinogradDeconvMinTiles tiles. An empty `input`
+// (size unknown) counts as large enough.
+bool winograd_deconv_preferred(const Shape& input, const Shape& weight, int stride, int padding);
+
 // Eligible (either form), and on an NCHW `input` whose output has at least kWinogradMinTiles
 // tiles (3×3 stride 1: about the input's size; the phase form: ceil(H/2) × ceil(W/2)). An empty
 // `input` (size unknown) counts as large enough.
@@ -88,9 +119,21 @@ std::vector<PackedPanels> winograd_weights(Queue& queue, const Tensor& weight, D
 // 3×3 weights [co, 4·ci, 3, 3] of the phase images, then transformed and packed as above.
 std::vector<PackedPanels> winograd_phase_weights(Queue& queue, const Tensor& weight, Device* long_lived);
 
-// output = activation(conv(input, weight) + bias) from the prepared U panels; shapes checked by
-// the caller (conv2d). `phases`: the layer is a phase-form one (winograd_phase_weights' panels).
+// The same for a transposed convolution's weights [ci, co, 4, 4]: rearranged on the host into
+// the 3×3 weights [4·co, ci, 3, 3] of its output phases (winograd_deconv_eligible), then as above.
+std::vector<PackedPanels> winograd_deconv_weights(Queue& queue, const Tensor& weight, Device* long_lived);
+
+// How a Winograd layer reads its input and writes its output.
+enum class WinogradForm {
+  Plain,         // a 3×3 stride-1 convolution
+  InputPhases,   // a 5×5 stride-2 one over its input's phase images (winograd_phase_weights)
+  OutputPhases,  // a 4×4 stride-2 transposed one into its output's phases (winograd_deconv_weights)
+};
+
+// output = activation(conv(input, weight) + bias) (conv_transpose for OutputPhases) from the
+// prepared U panels of that form; shapes checked by the caller (conv2d, conv_transpose2d). Of the
+// options only the activation and the column budget are read.
 void conv2d_winograd(Queue& queue, const Tensor& input, const std::vector<PackedPanels>& weights, const Tensor& bias,
-                     const Tensor& output, const Conv2dOptions& options, bool phases = false);
+                     const Tensor& output, const Conv2dOptions& options, WinogradForm form = WinogradForm::Plain);
 
 }  // namespace inertialnet::detail

@@ -11,7 +11,9 @@
 // on inputs large enough run the sub-pixel decomposition instead: four 2×2 convolutions, one per
 // output phase, either as one packed GEMM over the (H+1)×(W+1) window grid or each over exactly
 // its H·W windows read straight from the input (the direct form), stored into the interleaved
-// output directly, with no column matrix (src/ops/deconv_subpixel.hpp says when and why).
+// output directly, with no column matrix (src/ops/deconv_subpixel.hpp says when and why). On the
+// winograd plan those of large inputs run as one 3×3 Winograd convolution into the four output
+// phases instead (src/ops/winograd.hpp, winograd_deconv_eligible).
 //
 // Input and output may be channel slices of larger tensors; they must not overlap.
 #pragma once
@@ -25,9 +27,10 @@
 
 namespace inertialnet {
 
-// How a layer runs: Default is a sub-pixel form on the packed backends where the layer has that
-// form and it measured faster (detail::subpixel_preferred, docs/performance.md), GEMM + col2im
-// elsewhere; the others force one (tests). SubPixel (the window-grid GEMM) and SubPixelDirect
+// How a layer runs: Default is the Winograd form on the winograd plan where the layer has it
+// (detail::winograd_deconv_preferred), else a sub-pixel form on the packed backends where the
+// layer has that form and it measured faster (detail::subpixel_preferred, docs/performance.md),
+// GEMM + col2im elsewhere; the others force one (tests). SubPixel (the window-grid GEMM) and SubPixelDirect
 // (each phase on its own windows, read from the input without im2col panels) on a layer
 // without that form are invalid_input; on the CLBlast backend they run the packed kernels.
 enum class DeconvAlgorithm { Default, Col2im, SubPixel, SubPixelDirect };

@@ -68,7 +68,9 @@ GemmWeights prepare_conv_transpose2d_weights(Queue& queue, const Tensor& weight,
   }
   GemmWeights prepared;
   prepared.backend = backend;
-  if (uses_packed_kernels(backend) && detail::subpixel_preferred(input, weight.shape(), stride, padding)) {
+  if (backend == GemmBackend::Winograd && detail::winograd_deconv_preferred(input, weight.shape(), stride, padding)) {
+    prepared.winograd = detail::winograd_deconv_weights(queue, weight, &queue.device());
+  } else if (uses_packed_kernels(backend) && detail::subpixel_preferred(input, weight.shape(), stride, padding)) {
     // conv_transpose2d's default on the packed backends for this shape (ops/conv_transpose2d.hpp).
     prepared.subpixel = detail::subpixel_weights(queue, weight, &queue.device());
   } else if (uses_packed_kernels(backend)) {

@@ -6,8 +6,10 @@
 //
 // `Winograd` is the packed backend with Winograd F(4×4, 3×3) for the 3×3 stride-1 convolutions
 // of at least 16 output and 32 input channels, and for the 5×5 stride-2 padding-2 ones of at least
-// 16 output and 8 input channels as 3×3 over their input's four stride-2 phases
-// (src/ops/winograd.hpp); every other layer runs as on `Packed`.
+// 16 output and 8 input channels as 3×3 over their input's four stride-2 phases, and for the 4×4
+// stride-2 padding-1 transposed convolutions of at least 4 output and 32 input channels on inputs
+// of at least 96 tiles as 3×3 into their output's four phases (src/ops/winograd.hpp); every other
+// layer runs as on `Packed`.
 //
 // Without timing the choice is deterministic: $INERTIALNET_PLAN=clblast|packed|winograd forces
 // one backend everywhere (tests run every suite under each; `bench` compares them), otherwise CPU

@@ -8,8 +8,9 @@
 // device's weights), not per graph: pipeline lanes do not duplicate them. Layers with very few
 // output channels (predict_flow*) run a direct convolution and need no packing; fully connected
 // layers read their weights in place (GEMV). On the winograd plan, the 3×3 stride-1 layers (and the
-// 5×5 stride-2 padding-2 ones, as 3×3 over 4·ci phase channels) keep their 36 Winograd-transformed
-// weight matrices, packed as one, instead (src/ops/winograd.hpp).
+// 5×5 stride-2 padding-2 ones, as 3×3 over 4·ci phase channels, and the large 4×4 stride-2
+// transposed ones, as 3×3 into 4·co phase channels) keep their 36 Winograd-transformed weight
+// matrices, packed as one, instead (src/ops/winograd.hpp).
 //
 // Under $INERTIALNET_PLAN=auto the backend of a layer comes from timing: the layer runs on its
 // real shape with the weights prepared for each candidate of gemm_candidates() (one warm-up,
