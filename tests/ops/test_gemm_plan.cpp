@@ -68,17 +68,22 @@ TEST(GemmPlanCache, StoredPlansAreReadBack) {
   EXPECT_EQ(*merged.find(key2), GemmBackend::Packed);
 }
 
+// The fake device's plans file holding `text` reads as empty, and the next store rewrites it
+// readably.
+void expect_ignored_and_rewritten(const std::string& dir, const std::string& text) {
+  SCOPED_TRACE(text);
+  write_text(GemmPlanCache::file_for(fake_device("1.0"), dir), text);
+  GemmPlanCache plans(fake_device("1.0"), dir);
+  EXPECT_FALSE(plans.find(kKey));
+  plans.store(kKey, GemmBackend::Packed, {{GemmBackend::Packed, 0.5}});
+  EXPECT_EQ(*GemmPlanCache(fake_device("1.0"), dir).find(kKey), GemmBackend::Packed);
+}
+
 TEST(GemmPlanCache, CorruptAndForeignFilesAreIgnoredAndRewritten) {
   const std::string dir = testing::temporary_directory("plans");
-  const auto file = GemmPlanCache::file_for(fake_device("1.0"), dir);
   for (const std::string& text :
        {std::string("{ not json"), std::string("[]"), plans_text("0.9", "packed"), plans_text("1.0", "systolic")}) {
-    SCOPED_TRACE(text);
-    write_text(file, text);
-    GemmPlanCache plans(fake_device("1.0"), dir);
-    EXPECT_FALSE(plans.find(kKey));
-    plans.store(kKey, GemmBackend::Packed, {{GemmBackend::Packed, 0.5}});
-    EXPECT_EQ(*GemmPlanCache(fake_device("1.0"), dir).find(kKey), GemmBackend::Packed);
+    expect_ignored_and_rewritten(dir, text);
   }
   // Another driver reads the file as foreign: its plans were timed elsewhere.
   EXPECT_FALSE(GemmPlanCache(fake_device("2.0"), dir).find(kKey));
@@ -88,24 +93,18 @@ TEST(GemmPlanCache, CorruptAndForeignFilesAreIgnoredAndRewritten) {
 // none) count as absent: the layer is timed again with this build's forms. The same stamp reads.
 TEST(GemmPlanCache, PlansOfAnotherBuildOfTheKernelsAreIgnored) {
   const std::string dir = testing::temporary_directory("plans");
-  const auto file = GemmPlanCache::file_for(fake_device("1.0"), dir);
   ASSERT_EQ(embedded_kernels_stamp().size(), 16u);
-  write_text(file, plans_text("1.0", "clblast"));
+  write_text(GemmPlanCache::file_for(fake_device("1.0"), dir), plans_text("1.0", "clblast"));
   ASSERT_TRUE(GemmPlanCache(fake_device("1.0"), dir).find(kKey));
   EXPECT_EQ(*GemmPlanCache(fake_device("1.0"), dir).find(kKey), GemmBackend::CLBlast);
 
+  // Each is rewritten with this build's stamp on the next store.
   std::string other = embedded_kernels_stamp();
   other[0] = other[0] == '0' ? '1' : '0';
   const std::string first_format = "inertialnet-gemm-plans-1";
   for (const std::string& text : {plans_text("1.0", "clblast", other), plans_text("1.0", "clblast", ""),
                                   plans_text("1.0", "clblast", embedded_kernels_stamp(), first_format)}) {
-    SCOPED_TRACE(text);
-    write_text(file, text);
-    GemmPlanCache plans(fake_device("1.0"), dir);
-    EXPECT_FALSE(plans.find(kKey));
-    // Rewritten with this build's stamp on the next store.
-    plans.store(kKey, GemmBackend::Packed, {{GemmBackend::Packed, 0.5}});
-    EXPECT_EQ(*GemmPlanCache(fake_device("1.0"), dir).find(kKey), GemmBackend::Packed);
+    expect_ignored_and_rewritten(dir, text);
   }
 }
 
