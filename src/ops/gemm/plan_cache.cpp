@@ -18,7 +18,8 @@ namespace inertialnet {
 namespace {
 
 // Bumped when a backend's host-side form for a layer changes (what the kernels stamp cannot
-// see): -2 added the kernels stamp, after 5×5 stride-2 layers got the Winograd phase form.
+// see): -2 added the kernels stamp, after the winograd plan took 5×5 stride-2 convolutions and
+// 4×4 stride-2 transposed convolutions into phase forms.
 constexpr const char* kFormat = "inertialnet-gemm-plans-2";
 
 std::string layer_key(const char* kind, const Shape& input, const Shape& weight, int stride, int padding) {
