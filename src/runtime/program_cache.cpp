@@ -83,6 +83,20 @@ std::string_view embedded_kernel_source(std::string_view family) {
   throw invalid_input("no embedded kernel family '" + std::string(family) + "'");
 }
 
+const std::string& embedded_kernels_stamp() {
+  static const std::string stamp = [] {
+    std::uint64_t hash = detail::kFnv1a64Offset;
+    for (const auto& source : detail::embedded_kernel_sources()) {
+      // A NUL ends each name and source (kernel text has none): no text can move across entries.
+      for (const std::string_view part : {source.family, source.source}) {
+        hash = detail::fnv1a64(std::string_view("\0", 1), detail::fnv1a64(part, hash));
+      }
+    }
+    return hex64(hash);
+  }();
+  return stamp;
+}
+
 ProgramCache::ProgramCache(const DeviceInfo& device, cl_context context, DiskCacheMode mode,
                            std::filesystem::path directory)
     : device_(device), context_(context), disk_enabled_(decide_disk_cache(mode)),

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Timed GEMM plans ($INERTIALNET_PLAN=auto): the on-disk plan cache (round trip, corrupt and
-// foreign files), forced plans over cached ones, and a timed layer that still matches the
-// reference convolution whichever candidate won.
+// foreign files, files of another build of the kernels), forced plans over cached ones, and a
+// timed layer that still matches the reference convolution whichever candidate won.
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -9,6 +9,7 @@
 
 #include "inertialnet/ops/conv2d.hpp"
 #include "inertialnet/ops/gemm/plan_cache.hpp"
+#include "inertialnet/runtime/program_cache.hpp"
 #include "reference/conv.hpp"
 #include "support/testing.hpp"
 
@@ -37,6 +38,15 @@ void write_text(const std::filesystem::path& file, const std::string& text) {
 
 const std::string kKey = conv2d_plan_key({1, 8, 12, 16}, {16, 8, 3, 3}, 1, 1);
 
+// A plans file of the fake device with one plan for kKey; by default as this build writes it.
+std::string plans_text(const std::string& driver, const std::string& backend,
+                       const std::string& kernels = embedded_kernels_stamp(),
+                       const std::string& format = "inertialnet-gemm-plans-2") {
+  return R"({"format": ")" + format + R"(", "kernels": ")" + kernels +
+         R"(", "platform": "Test platform", "device": "test device", "driver": ")" + driver +
+         R"(", "plans": {")" + kKey + R"(": {"backend": ")" + backend + R"(", "seconds": {}}}})";
+}
+
 TEST(GemmPlanCache, StoredPlansAreReadBack) {
   const std::string dir = testing::temporary_directory("plans");
   {
@@ -58,24 +68,44 @@ TEST(GemmPlanCache, StoredPlansAreReadBack) {
   EXPECT_EQ(*merged.find(key2), GemmBackend::Packed);
 }
 
+// The fake device's plans file holding `text` reads as empty, and the next store rewrites it
+// readably.
+void expect_ignored_and_rewritten(const std::string& dir, const std::string& text) {
+  SCOPED_TRACE(text);
+  write_text(GemmPlanCache::file_for(fake_device("1.0"), dir), text);
+  GemmPlanCache plans(fake_device("1.0"), dir);
+  EXPECT_FALSE(plans.find(kKey));
+  plans.store(kKey, GemmBackend::Packed, {{GemmBackend::Packed, 0.5}});
+  EXPECT_EQ(*GemmPlanCache(fake_device("1.0"), dir).find(kKey), GemmBackend::Packed);
+}
+
 TEST(GemmPlanCache, CorruptAndForeignFilesAreIgnoredAndRewritten) {
   const std::string dir = testing::temporary_directory("plans");
-  const auto file = GemmPlanCache::file_for(fake_device("1.0"), dir);
   for (const std::string& text :
-       {std::string("{ not json"), std::string("[]"),
-        R"({"format": "inertialnet-gemm-plans-1", "platform": "Test platform", "device": "test device",
-            "driver": "0.9", "plans": {")" + kKey + R"(": {"backend": "packed", "seconds": {}}}})",
-        R"({"format": "inertialnet-gemm-plans-1", "platform": "Test platform", "device": "test device",
-            "driver": "1.0", "plans": {")" + kKey + R"(": {"backend": "systolic", "seconds": {}}}})"}) {
-    SCOPED_TRACE(text);
-    write_text(file, text);
-    GemmPlanCache plans(fake_device("1.0"), dir);
-    EXPECT_FALSE(plans.find(kKey));
-    plans.store(kKey, GemmBackend::Packed, {{GemmBackend::Packed, 0.5}});
-    EXPECT_EQ(*GemmPlanCache(fake_device("1.0"), dir).find(kKey), GemmBackend::Packed);
+       {std::string("{ not json"), std::string("[]"), plans_text("0.9", "packed"), plans_text("1.0", "systolic")}) {
+    expect_ignored_and_rewritten(dir, text);
   }
   // Another driver reads the file as foreign: its plans were timed elsewhere.
   EXPECT_FALSE(GemmPlanCache(fake_device("2.0"), dir).find(kKey));
+}
+
+// Plans timed by another build of the kernels (another stamp, or the first format, which had
+// none) count as absent: the layer is timed again with this build's forms. The same stamp reads.
+TEST(GemmPlanCache, PlansOfAnotherBuildOfTheKernelsAreIgnored) {
+  const std::string dir = testing::temporary_directory("plans");
+  ASSERT_EQ(embedded_kernels_stamp().size(), 16u);
+  write_text(GemmPlanCache::file_for(fake_device("1.0"), dir), plans_text("1.0", "clblast"));
+  ASSERT_TRUE(GemmPlanCache(fake_device("1.0"), dir).find(kKey));
+  EXPECT_EQ(*GemmPlanCache(fake_device("1.0"), dir).find(kKey), GemmBackend::CLBlast);
+
+  // Each is rewritten with this build's stamp on the next store.
+  std::string other = embedded_kernels_stamp();
+  other[0] = other[0] == '0' ? '1' : '0';
+  const std::string first_format = "inertialnet-gemm-plans-1";
+  for (const std::string& text : {plans_text("1.0", "clblast", other), plans_text("1.0", "clblast", ""),
+                                  plans_text("1.0", "clblast", embedded_kernels_stamp(), first_format)}) {
+    expect_ignored_and_rewritten(dir, text);
+  }
 }
 
 TEST(GemmPlan, CandidatesStartWithTheDeterministicChoice) {

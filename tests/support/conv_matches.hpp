@@ -1,13 +1,15 @@
 // SPDX-License-Identifier: Apache-2.0
 // The one convolution check of the conv2d suites (test_conv2d: the plan's choice; test_conv2d_splitk:
-// the split-K forms forced): a case's random input, weights and bias, conv2d run with its input
-// and output as channel slices of wider tensors, and the output against the float64 direct
-// convolution of tests/reference/conv.cpp with the bound of every GEMM and direct convolution.
+// the split-K forms forced; test_winograd: weights prepared on the winograd plan): a case's random
+// input, weights and bias, conv2d run with its input and output as channel slices of wider
+// tensors, and the output against the float64 direct convolution of tests/reference/conv.cpp with
+// the bound of every GEMM and direct convolution (the Winograd form's where it ran).
 #pragma once
 
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -16,6 +18,7 @@
 
 #include "inertialnet/ops/conv2d.hpp"
 #include "inertialnet/ops/gemm/backend.hpp"
+#include "inertialnet/ops/gemm/plan.hpp"
 #include "ops/op_testing.hpp"
 #include "ops/winograd.hpp"
 #include "reference/conv.hpp"
@@ -50,13 +53,18 @@ struct ConvPlacement {
 
 // How a suite runs its cases: the form it forces (Default: the plan's choice) and the first of
 // the five seeds of a case's random data (input, weights, bias, the wider input and output), so
-// that each suite keeps data of its own.
+// that each suite keeps data of its own; `prepared_on`: the weights prepared once for that
+// backend, as a network prepares them (none: conv2d prepares them itself, on the device's plan),
+// with the input's shape where `knowing_input` (as a network's graph: the size rules apply).
 struct ConvRun {
   Conv2dAlgorithm algorithm = Conv2dAlgorithm::Default;
   std::uint32_t first_seed = 101;
+  std::optional<GemmBackend> prepared_on = std::nullopt;
+  bool knowing_input = false;
 };
 
-inline void expect_conv_matches(const ConvCase& c, const ConvPlacement& p, const ConvRun& run = {}) {
+// Returns whether the Winograd form computed the output (and set the bound).
+inline bool expect_conv_matches(const ConvCase& c, const ConvPlacement& p, const ConvRun& run = {}) {
   SCOPED_TRACE(c.name);
   Queue& queue = test_queue();
   const reference::ConvShape s{p.batch, c.ci, c.h, c.w, c.co, c.k, c.k, c.stride, c.padding};
@@ -75,19 +83,33 @@ inline void expect_conv_matches(const ConvCase& c, const ConvPlacement& p, const
   const Tensor b = c.bias ? Tensor::from_host(queue, {c.co}, bias) : Tensor();
   Conv2dOptions options{c.stride, c.padding, c.activation, p.max_column_floats};
   options.algorithm = run.algorithm;
+  GemmWeights prepared;
+  if (run.prepared_on) {
+    prepared = prepare_conv2d_weights(queue, w, *run.prepared_on, c.stride, c.padding,
+                                      run.knowing_input ? in.view.shape() : Shape{});
+    options.prepared = &prepared;
+    // The 36 transformed matrices packed as one (ops/winograd.hpp).
+    if (!prepared.winograd.empty()) {
+      EXPECT_EQ(prepared.winograd.size(), 1u);
+      const PackedPanels& u = prepared.winograd[0];
+      EXPECT_EQ(u.lines % (detail::kWinogradElements * static_cast<std::size_t>(u.width)), 0u);
+    }
+  }
   conv2d(queue, in.view, w, b, out.view, options);
   EXPECT_TRUE(untouched_outside(queue, out)) << "elements outside the output slice were written";
   // float32 accumulation of K = ci·k·k products of magnitude ≲ 1 against a double reference:
   // the error grows with the reduction length, so the absolute floor is sqrt(K) (the typical
   // output magnitude) and 1e-5 relative to that leaves ~10× margin over K·eps at K ≈ 10^4. The
   // split-K forms add the same products in another order, which changes the rounding by a few
-  // K·eps at most. The winograd plan's F(4×4, 3×3) layers, where the plan chooses, have a
-  // measured bound of their own (op_testing.hpp).
+  // K·eps at most. The winograd plan's F(4×4, 3×3) layers, where the plan chooses or the
+  // weights were prepared as Winograd matrices, have a measured bound of their own (op_testing.hpp).
   const double floor = std::sqrt(static_cast<double>(c.ci) * c.k * c.k);
-  const bool winograd = run.algorithm == Conv2dAlgorithm::Default &&
-                        gemm_backend(queue.device().info()) == GemmBackend::Winograd &&
-                        detail::winograd_preferred(in.view.shape(), w.shape(), c.stride, c.padding);
+  const bool plan_winograd = run.algorithm == Conv2dAlgorithm::Default &&
+                             gemm_backend(queue.device().info()) == GemmBackend::Winograd &&
+                             detail::winograd_preferred(in.view.shape(), w.shape(), c.stride, c.padding);
+  const bool winograd = run.prepared_on ? !prepared.winograd.empty() : plan_winograd;
   EXPECT_TRUE(all_close(view_values(queue, out), expected, winograd ? kWinogradRelativeTolerance : 1e-5, floor));
+  return winograd;
 }
 
 }  // namespace inertialnet::testing

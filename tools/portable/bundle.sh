@@ -12,14 +12,26 @@
 # travel as stand-ins (stub_library.py): the bundle runs bench, the network tests and
 # tools/compare/compare.py; reading a video or a TIFF through it aborts naming the stand-in.
 # glibc and libstdc++ are the other machine's (they must be as new as Debian 12's).
+#
+# Exits 2 on bad input (a missing build folder, binary or output folder, a wrong argument count),
+# 1 when the bundling itself fails (a copy or the tarball could not be written), each with one
+# message naming the file.
 set -euo pipefail
-build=$1 out=$2; shift 2
 here=$(cd "$(dirname "$0")" && pwd)
+me=bundle
+source "$here/errors.sh"
+[ $# -ge 2 ] || fail 2 "usage: tools/portable/bundle.sh BUILD_DIR OUT.tar.xz [test_name ...]"
+build=$1 out=$2; shift 2
+[ -d "$build" ] || fail 2 "no build folder $build"
+[ -f "$build/inertialnet" ] || fail 2 "no CLI binary $build/inertialnet (build the inertialnet_cli target first)"
+for t in "$@"; do [ -f "$build/tests/$t" ] || fail 2 "no test binary $build/tests/$t"; done
+[ -d "$(dirname "$out")" ] || fail 2 "no folder $(dirname "$out") for the bundle $out"
+[ ! -d "$out" ] || fail 2 "the bundle $out would replace a folder"
 work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
 mkdir -p "$work/bin" "$work/lib"
-cp "$build/inertialnet" "$work/bin/"
-for t in "$@"; do cp "$build/tests/$t" "$work/bin/"; done
-strip "$work"/bin/*
+attempt "cannot copy $build/inertialnet into the bundle" cp "$build/inertialnet" "$work/bin/"
+for t in "$@"; do attempt "cannot copy $build/tests/$t into the bundle" cp "$build/tests/$t" "$work/bin/"; done
+attempt "cannot strip the binaries in the bundle" strip "$work"/bin/*
 # Kept as they are (by name, any version); the system's own libraries stay the other machine's;
 # every other library one of these needs becomes a stand-in.
 keep='^lib(opencv_(core|imgproc|imgcodecs|videoio|video|calib3d|features2d|flann)|opengv|clblast|OpenCL|sqlite3|tbb|z|jpeg|png16|zstd|lz4|bz2)\.so'
@@ -41,9 +53,9 @@ while [ -n "$queue" ]; do
     done_[$n]=1
     case "$system" in *" $n "*) continue ;; esac
     real=${path_of[$n]:-}
-    [ -n "$real" ] || { echo "bundle: cannot find $n" >&2; exit 1; }
+    [ -n "$real" ] || fail 1 "cannot find $n"
     if [[ $n =~ $keep ]]; then
-      cp -L "$real" "$work/lib/$n"
+      attempt "cannot copy $real into the bundle" cp -L "$real" "$work/lib/$n"
       next="$next $(needed_by "$work/lib/$n")"
     else
       python3 "$here/stub_library.py" "$real" "$work/lib"
@@ -55,7 +67,7 @@ done
 for b in "$work"/bin/*; do
   missing=$(LD_LIBRARY_PATH="$work/lib" ldd "$b" | awk '$3 ~ /^\// && $3 !~ /^'"${work//\//\\/}"'/ {print $1}' |
             while read -r l; do case "$system" in *" $l "*) ;; *) echo "$l" ;; esac; done)
-  [ -z "$missing" ] || { echo "bundle: $b still loads from the system: $missing" >&2; exit 1; }
+  [ -z "$missing" ] || fail 1 "$b still loads from the system: $missing"
 done
-tar cJf "$out" -C "$work" bin lib
+attempt "cannot write the bundle $out" tar cJf "$out" -C "$work" bin lib
 echo "bundle: $out ($(du -h "$out" | cut -f1))"

@@ -58,6 +58,9 @@ struct ProgramCacheStats {
 // The embedded kernel families ("elementwise", "correlation", …) and their sources.
 std::vector<std::string> embedded_kernel_families();
 std::string_view embedded_kernel_source(std::string_view family);  // invalid_input if unknown
+// fnv1a64 over every embedded family's name and source, as 16 hex digits: another build of the
+// kernels has another stamp (the timed GEMM plans keep it, ops/gemm/plan_cache.hpp).
+const std::string& embedded_kernels_stamp();
 
 class ProgramCache {
  public:

@@ -9,6 +9,7 @@
 
 #include "inertialnet/runtime/device.hpp"
 #include "inertialnet/runtime/error.hpp"
+#include "inertialnet/runtime/program_cache.hpp"
 #include "runtime/atomic_file.hpp"
 #include "runtime/hash.hpp"
 
@@ -16,7 +17,10 @@ namespace inertialnet {
 
 namespace {
 
-constexpr const char* kFormat = "inertialnet-gemm-plans-1";
+// Bumped when a backend's host-side form for a layer changes (what the kernels stamp cannot
+// see): -2 added the kernels stamp, after the winograd plan took 5×5 stride-2 convolutions and
+// 4×4 stride-2 transposed convolutions into phase forms.
+constexpr const char* kFormat = "inertialnet-gemm-plans-2";
 
 std::string layer_key(const char* kind, const Shape& input, const Shape& weight, int stride, int padding) {
   return std::string(kind) + " in=" + to_string(input) + " w=" + to_string(weight) + " s=" + std::to_string(stride) +
@@ -60,8 +64,9 @@ std::map<std::string, GemmPlanCache::Entry> GemmPlanCache::read() const {
   // Anything unexpected makes the whole file count as absent: it is rewritten on the next store.
   try {
     const nlohmann::json json = nlohmann::json::parse(in);
-    if (json.at("format") != kFormat || json.at("platform") != device_.platform_name ||
-        json.at("device") != device_.name || json.at("driver") != device_.driver_version) {
+    if (json.at("format") != kFormat || json.at("kernels") != embedded_kernels_stamp() ||
+        json.at("platform") != device_.platform_name || json.at("device") != device_.name ||
+        json.at("driver") != device_.driver_version) {
       return {};
     }
     for (const auto& [key, value] : json.at("plans").items()) {
@@ -100,6 +105,7 @@ void GemmPlanCache::store(const std::string& key, GemmBackend chosen, const std:
     plans[plan_key] = {{"backend", to_string(entry.backend)}, {"seconds", timed}};
   }
   const nlohmann::json json = {{"format", kFormat},
+                               {"kernels", embedded_kernels_stamp()},
                                {"platform", device_.platform_name},
                                {"device", device_.name},
                                {"driver", device_.driver_version},

@@ -3,14 +3,18 @@
 // kept on disk beside the program cache so that a layer shape is timed once per machine:
 //
 //   <cache directory>/gemm-plans/<fnv1a64(platform, device, driver) in hex>.json
-//   {"format": "inertialnet-gemm-plans-1", "platform": ..., "device": ..., "driver": ...,
+//   {"format": "inertialnet-gemm-plans-2", "kernels": "<embedded_kernels_stamp()>",
+//    "platform": ..., "device": ..., "driver": ...,
 //    "plans": {"<layer key>": {"backend": "packed", "seconds": {"clblast": 0.012, "packed": 0.004}}}}
 //
 // The layer key names the op kind and every size the cost depends on (see conv2d_plan_key()).
-// A file that does not parse, has another format, names another device or driver, or names a
-// backend this build does not know is ignored (its entries count as untimed) and rewritten on
-// the next store. Writes are atomic (runtime/atomic_file.hpp) and re-read the file first, so two
-// processes or two weight sets of one device add to the same file instead of dropping entries.
+// A file that does not parse, has another format, was written by another build of the kernels
+// (another "kernels" stamp: fnv1a64 of the embedded kernels_cl/ sources, runtime/program_cache.hpp),
+// names another device or driver, or names a backend this build does not know is ignored (its
+// entries count as untimed: each layer is timed again) and rewritten on the next store. A change
+// to a backend's host-side form for a layer, which the stamp cannot see, bumps the format.
+// Writes are atomic (runtime/atomic_file.hpp) and re-read the file first, so two processes or two
+// weight sets of one device add to the same file instead of dropping entries.
 #pragma once
 
 #include <filesystem>
