@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // conv_transpose2d (GEMM + gather col2im with fused bias/activation, and the two sub-pixel forms
-// of the 4×4 / stride 2 / padding 1 layers) against the scatter definition of tests/reference/conv.cpp:
+// of the 4×4 / stride 2 / padding 1 layers; under INERTIALNET_PLAN=winograd the Winograd form where
+// the plan chooses it) against the scatter definition of tests/reference/conv.cpp
+// (support/deconv_matches.hpp):
 // every FlowNet2 up-convolution at a 64×64 input on each algorithm, other kernels/strides/paddings,
 // odd sizes, batches, channel slices, channel and window blocks, bad shapes.
 #include <algorithm>
@@ -14,64 +16,17 @@
 #include "reference/conv.hpp"
 #include "ops/deconv_subpixel.hpp"
 #include "ops/op_testing.hpp"
+#include "support/deconv_matches.hpp"
 #include "support/flownet_layers.hpp"
 #include "support/testing.hpp"
 
 namespace inertialnet {
 namespace {
 
-struct DeconvCase {
-  std::string name;
-  int ci, co, h, w, k, stride, padding;
-  bool bias;
-  ActivationSpec activation;
-};
-void PrintTo(const DeconvCase& c, std::ostream* os) { *os << c.name; }
-
-struct Placement {
-  int batch = 1;
-  int in_before = 0, in_after = 0;
-  int out_before = 0, out_after = 0;
-  std::size_t max_column_floats = 0;
-  DeconvAlgorithm algorithm = DeconvAlgorithm::Default;
-};
-
-// A FlowNet2 layer of the shared table as a test case.
-DeconvCase from_layer(const flownet_layers::LayerShape& l) {
-  return {l.identifier(), l.ci, l.co, l.h, l.w, l.k, l.stride, l.padding, l.bias, l.activation};
-}
-
-void expect_deconv_matches(const DeconvCase& c, const Placement& p) {
-  SCOPED_TRACE(c.name);
-  Queue& queue = testing::test_queue();
-  reference::ConvShape s{p.batch, c.ci, c.h, c.w, c.co, c.k, c.k, c.stride, c.padding};
-  const int oh = s.deconv_out_h(), ow = s.deconv_out_w();
-  const std::size_t in_plane = static_cast<std::size_t>(c.h) * c.w;
-
-  const auto input = testing::random_vector(static_cast<std::size_t>(p.batch) * c.ci * in_plane, 201);
-  const auto weight = testing::random_vector(static_cast<std::size_t>(c.ci) * c.co * c.k * c.k, 202);
-  const auto bias = c.bias ? testing::random_vector(static_cast<std::size_t>(c.co), 203) : std::vector<float>{};
-  const auto expected = reference::conv_transpose2d(s, input, weight, bias, c.activation);
-
-  // The input and the output as channel slices of wider tensors whose other channels must survive.
-  const testing::Sliced in =
-      testing::embed_sliced(queue, input, {p.batch, c.ci, c.h, c.w}, p.in_before, p.in_before + p.in_after, 204);
-  const testing::Sliced out =
-      testing::make_sliced(queue, {p.batch, c.co, oh, ow}, p.out_before, p.out_before + p.out_after, 205);
-  Tensor w = Tensor::from_host(queue, {c.ci, c.co, c.k, c.k}, weight);
-  Tensor b = c.bias ? Tensor::from_host(queue, {c.co}, bias) : Tensor();
-  ConvTranspose2dOptions options{c.stride, c.padding, c.activation, p.max_column_floats};
-  options.algorithm = p.algorithm;
-  conv_transpose2d(queue, in.view, w, b, out.view, options);
-  EXPECT_TRUE(testing::untouched_outside(queue, out)) << "elements outside the output slice were written";
-  const auto got = testing::view_values(queue, out);
-  // Each output sums at most ci·ceil(k/s)² float32 products of magnitude ≲ 1 (ci per GEMM
-  // entry, then the taps that land on the pixel): as for conv2d, an absolute floor of sqrt(K)
-  // for that reduction length K and 1e-5 relative to it.
-  const int taps = (c.k + c.stride - 1) / c.stride;
-  const double floor = std::sqrt(static_cast<double>(c.ci) * taps * taps);
-  EXPECT_TRUE(testing::all_close(got, expected, 1e-5, floor));
-}
+using testing::DeconvCase;
+using testing::deconv_case_of;
+using testing::expect_deconv_matches;
+using Placement = testing::DeconvPlacement;
 
 class FlowNetDeconvShapes : public ::testing::TestWithParam<DeconvCase> {};
 
@@ -101,7 +56,7 @@ TEST_P(FlowNetDeconvShapes, Col2imMatchesTheReference) {
 std::vector<DeconvCase> flownet2_deconv_cases() {
   std::vector<DeconvCase> cases;
   for (const auto& layer : flownet_layers::flownet2_layers(64, 64, flownet_layers::LayerKind::Deconv)) {
-    cases.push_back(from_layer(layer));
+    cases.push_back(deconv_case_of(layer));
   }
   return cases;
 }
@@ -126,6 +81,10 @@ TEST(ConvTranspose2d, WritesIntoAChannelSliceAndReadsFromOne) {
   expect_deconv_matches({"slice", 6, 10, 37, 23, 4, 2, 1, true, ActivationSpec::leaky_relu(0.1f)}, {3, 2, 3, 5, 4});
   expect_deconv_matches({"slice_up_last", 2, 2, 8, 8, 4, 2, 1, false, ActivationSpec::none()}, {3, 1, 0, 9, 0});
   expect_deconv_matches({"slice_first", 4, 3, 8, 8, 4, 2, 1, true, ActivationSpec::none()}, {3, 0, 2, 0, 6});
+  // Large enough for the winograd plan's form (≥ 32 input channels, ≥ 96 tiles: the suite's
+  // _winograd copy runs it there, prepared by the op itself; the direct sub-pixel form elsewhere).
+  expect_deconv_matches({"slice_large", 33, 5, 40, 50, 4, 2, 1, true, ActivationSpec::leaky_relu(0.1f)},
+                        {2, 3, 2, 1, 4});
 }
 
 TEST(ConvTranspose2d, SmallColumnBudgetProcessesChannelBlocks) {
@@ -204,7 +163,7 @@ TEST(ConvTranspose2d, SubPixelDirectAtFlowNet2sRealSize) {
     // deconv2 and FlowNetFusion's (48×64 and up) are left to the 64×64 cases: the scalar
     // reference would take minutes, and they use no tile shape that the cases above do not.
     if (layer.h > 24) continue;
-    expect_deconv_matches(from_layer(layer), p);
+    expect_deconv_matches(deconv_case_of(layer), p);
   }
 }
 

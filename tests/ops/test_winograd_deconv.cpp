@@ -5,125 +5,74 @@
 // sizes, batches, channel slices, tile ranges, rows of 16 whole tiles against the output's edges,
 // the deep layers' 14-row panels, and the layers the rule leaves on the sub-pixel form.
 //
-// Error bound: the layer runs as a 3×3 Winograd convolution of ci input channels, whose rounding
-// does not know that a phase's 5 of 9 taps are zero (the transformed weights U are not), so it is
-// held to that layer's bound: testing::kWinogradRelativeTolerance (tests/ops/op_testing.hpp)
-// relative to the output plus the floor sqrt(ci·9) of the 3×3 layer's ci·9 products. Measured on
-// PoCL: at most 2.2e-5 (flownetc.deconv3, ci = 770; 3.2e-5 against the floor sqrt(ci·4) of the
-// products an output pixel really sums, the bound of tests/ops/test_conv_transpose2d.cpp).
-#include <cmath>
+// The check and its bound are the shared ones (support/deconv_matches.hpp): the Winograd form is
+// held to the 3×3 Winograd layers' bound, measured at most 2.2e-5 here (flownetc.deconv3).
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "inertialnet/ops/conv_transpose2d.hpp"
 #include "inertialnet/ops/gemm/backend.hpp"
 #include "inertialnet/ops/gemm/plan.hpp"
-#include "ops/op_testing.hpp"
 #include "ops/winograd.hpp"
-#include "reference/conv.hpp"
+#include "support/deconv_matches.hpp"
 #include "support/flownet_layers.hpp"
 #include "support/testing.hpp"
 
 namespace inertialnet {
 namespace {
 
-struct Case {
-  std::string name;
-  int ci, co, h, w;
-  bool bias;
-  ActivationSpec activation;
-};
+using testing::DeconvCase;
+using testing::DeconvPlacement;
+using testing::DeconvRun;
 
-struct Placement {
-  int batch = 1;
-  int in_before = 0, in_after = 0;
-  int out_before = 0, out_after = 0;
-  std::size_t max_column_floats = 0;
-};
-
-// Runs the case with its weights prepared for the winograd plan as a network prepares them (the
-// input's size known); `expect_winograd`: whether the rule gives the Winograd form (else the
-// sub-pixel form's phase weights and their 1e-5 bound).
-void expect_deconv_matches(const Case& c, const Placement& p, bool expect_winograd = true) {
-  SCOPED_TRACE(c.name);
-  Queue& queue = testing::test_queue();
-  const reference::ConvShape s{p.batch, c.ci, c.h, c.w, c.co, 4, 4, 2, 1};
-  const auto input = testing::random_vector(static_cast<std::size_t>(p.batch) * c.ci * c.h * c.w, 301);
-  const auto weight = testing::random_vector(static_cast<std::size_t>(c.ci) * c.co * 16, 302);
-  const auto bias = c.bias ? testing::random_vector(static_cast<std::size_t>(c.co), 303) : std::vector<float>{};
-  const auto expected = reference::conv_transpose2d(s, input, weight, bias, c.activation);
-
-  const testing::Sliced in =
-      testing::embed_sliced(queue, input, {p.batch, c.ci, c.h, c.w}, p.in_before, p.in_before + p.in_after, 304);
-  const testing::Sliced out = testing::make_sliced(queue, {p.batch, c.co, 2 * c.h, 2 * c.w}, p.out_before,
-                                                   p.out_before + p.out_after, 305);
-  const Tensor w = Tensor::from_host(queue, {c.ci, c.co, 4, 4}, weight);
-  const Tensor b = c.bias ? Tensor::from_host(queue, {c.co}, bias) : Tensor();
-  const GemmWeights prepared =
-      prepare_conv_transpose2d_weights(queue, w, GemmBackend::Winograd, in.view.shape(), 2, 1);
-  ASSERT_EQ(prepared.winograd.size(), expect_winograd ? 1u : 0u);
-  if (expect_winograd) {
-    // The 36 matrices of the 3×3 layer: 4·co rows (padded to whole panels) by ci.
-    EXPECT_EQ(prepared.winograd[0].depth, static_cast<std::size_t>(c.ci));
-    EXPECT_GE(prepared.winograd[0].lines, detail::kWinogradElements * 4 * static_cast<std::size_t>(c.co));
-  }
-  ConvTranspose2dOptions options{2, 1, c.activation, p.max_column_floats, &prepared};
-  conv_transpose2d(queue, in.view, w, b, out.view, options);
-  EXPECT_TRUE(testing::untouched_outside(queue, out)) << "elements outside the output slice were written";
-  // The sub-pixel form (below the size rule) keeps test_conv_transpose2d's bound and floor.
-  const double floor = std::sqrt(static_cast<double>(c.ci) * (expect_winograd ? 9 : 4));
-  EXPECT_TRUE(testing::all_close(testing::view_values(queue, out), expected,
-                                 expect_winograd ? testing::kWinogradRelativeTolerance : 1e-5, floor));
+// A layer with the k = 4, stride 2, padding 1 of every FlowNet up-convolution.
+DeconvCase deconv(std::string name, int ci, int co, int h, int w, bool bias, ActivationSpec activation) {
+  return {std::move(name), ci, co, h, w, 4, 2, 1, bias, activation};
 }
 
-class FlowNetWinogradDeconvShapes : public ::testing::TestWithParam<Case> {};
+// Runs the case with its weights prepared for the winograd plan as a network prepares them (the
+// input's size known: the rule applies) and checks which form ran: `expect_winograd` (else the
+// sub-pixel form's phase weights and their 1e-5 bound).
+void expect_prepared_matches(const DeconvCase& c, const DeconvPlacement& p, bool expect_winograd = true) {
+  EXPECT_EQ(testing::expect_deconv_matches(c, p, DeconvRun{301, GemmBackend::Winograd, true}), expect_winograd)
+      << c.name << ": not the expected form";
+}
 
-// Prepared knowing the input's size: the table's inputs below 32 tiles keep the sub-pixel form.
+// The same prepared without the input's size (as for an unknown size): the rule counts it large
+// enough, so every eligible layer runs Winograd, small inputs on partial tiles.
+void expect_unsized_prepared_matches(const DeconvCase& c) {
+  EXPECT_TRUE(testing::expect_deconv_matches(c, DeconvPlacement{}, DeconvRun{311, GemmBackend::Winograd, false}))
+      << c.name << ": not run as Winograd";
+}
+
+class FlowNetWinogradDeconvShapes : public ::testing::TestWithParam<DeconvCase> {};
+
+// Prepared knowing the input's size: the table's inputs below 96 tiles keep the sub-pixel form.
 TEST_P(FlowNetWinogradDeconvShapes, MatchTheReference) {
-  const Case& c = GetParam();
-  expect_deconv_matches(c, Placement{},
+  const DeconvCase& c = GetParam();
+  expect_prepared_matches(c, DeconvPlacement{},
                         detail::winograd_deconv_preferred({1, c.ci, c.h, c.w}, {c.ci, c.co, 4, 4}, 2, 1));
 }
 
 // FlowNet2's eligible up-convolutions (ci ≥ 32; not the 2-channel flow up-sampling) at a 64×64
 // network input, their real ci and co. The error depends on ci and the window, not on H×W, and
 // the table's small inputs (1×1 … 32×32) exercise partial tiles; the 512×384 sizes are the rule's.
-std::vector<Case> flownet2_deconv_cases() {
-  std::vector<Case> cases;
+std::vector<DeconvCase> flownet2_deconv_cases() {
+  std::vector<DeconvCase> cases;
   for (const auto& l : flownet_layers::flownet2_layers(64, 64, flownet_layers::LayerKind::Deconv)) {
     if (!detail::winograd_deconv_eligible({l.ci, l.co, l.k, l.k}, l.stride, l.padding)) continue;
-    cases.push_back({l.identifier(), l.ci, l.co, l.h, l.w, l.bias, l.activation});
+    cases.push_back(testing::deconv_case_of(l));
   }
   return cases;
 }
 
-void expect_unsized_deconv_matches(const Case& c) {
-  SCOPED_TRACE(c.name);
-  Queue& queue = testing::test_queue();
-  const reference::ConvShape s{1, c.ci, c.h, c.w, c.co, 4, 4, 2, 1};
-  const auto input = testing::random_vector(static_cast<std::size_t>(c.ci) * c.h * c.w, 311);
-  const auto weight = testing::random_vector(static_cast<std::size_t>(c.ci) * c.co * 16, 312);
-  const auto bias = testing::random_vector(static_cast<std::size_t>(c.co), 313);
-  const auto expected = reference::conv_transpose2d(s, input, weight, bias, c.activation);
-  const Tensor in = Tensor::from_host(queue, {1, c.ci, c.h, c.w}, input);
-  const Tensor w = Tensor::from_host(queue, {c.ci, c.co, 4, 4}, weight);
-  const Tensor b = Tensor::from_host(queue, {c.co}, bias);
-  const GemmWeights prepared = prepare_conv_transpose2d_weights(queue, w, GemmBackend::Winograd, Shape{}, 2, 1);
-  ASSERT_EQ(prepared.winograd.size(), 1u);
-  const Tensor out = Tensor::empty(queue, {1, c.co, 2 * c.h, 2 * c.w});
-  conv_transpose2d(queue, in, w, b, out, ConvTranspose2dOptions{2, 1, c.activation, 0, &prepared});
-  EXPECT_TRUE(testing::all_close(out.to_host(queue), expected, testing::kWinogradRelativeTolerance,
-                                 std::sqrt(static_cast<double>(c.ci) * 9)));
-}
-
-// Prepared without the input's size (as for an unknown size) the rule counts it large enough:
-// every eligible layer runs Winograd, the table's small inputs on partial tiles.
 TEST_P(FlowNetWinogradDeconvShapes, MatchTheReferencePreparedWithoutTheSize) {
-  expect_unsized_deconv_matches(GetParam());
+  expect_unsized_prepared_matches(GetParam());
 }
 
 INSTANTIATE_TEST_SUITE_P(FlowNet2, FlowNetWinogradDeconvShapes, ::testing::ValuesIn(flownet2_deconv_cases()),
-                         [](const ::testing::TestParamInfo<Case>& info) { return info.param.name; });
+                         [](const ::testing::TestParamInfo<DeconvCase>& info) { return info.param.name; });
 
 TEST(WinogradDeconv, FlowNet2HasEligibleLayers) {
   // deconv5 … deconv2 (FlowNetC's, shared by FlowNetS and FlowNetSD) and FlowNetFusion's deconv1
@@ -134,28 +83,28 @@ TEST(WinogradDeconv, FlowNet2HasEligibleLayers) {
 TEST(WinogradDeconv, OddSizesBatchesAndEdges) {
   const auto leaky = ActivationSpec::leaky_relu(0.1f);
   // Odd sizes: partial tiles on the right and bottom; co = 5: 20 rows, a partial row panel.
-  expect_deconv_matches({"odd_37x45", 33, 5, 37, 45, true, leaky}, {3});
+  expect_prepared_matches(deconv("odd_37x45", 33, 5, 37, 45, true, leaky), {3});
   // Rows of 16 whole tiles (64 input columns): each pair of column phases stored as whole vectors;
   // 131 and 67 leave a partial group at the right edge, 64 × 25 rows a partial tile row below.
   // (Every case here has the size rule's 96 tiles.)
-  expect_deconv_matches({"w64_h25", 32, 4, 25, 64, false, ActivationSpec::relu()}, {2});
-  expect_deconv_matches({"w131_h10", 40, 8, 10, 131, true, leaky}, {1});
-  expect_deconv_matches({"w67_h33", 35, 6, 33, 67, true, ActivationSpec::none()}, {1});
-  expect_deconv_matches({"one_row", 32, 4, 1, 390, true, leaky}, {1});
-  expect_deconv_matches({"one_column", 32, 4, 390, 1, true, leaky}, {1});
+  expect_prepared_matches(deconv("w64_h25", 32, 4, 25, 64, false, ActivationSpec::relu()), {2});
+  expect_prepared_matches(deconv("w131_h10", 40, 8, 10, 131, true, leaky), {1});
+  expect_prepared_matches(deconv("w67_h33", 35, 6, 33, 67, true, ActivationSpec::none()), {1});
+  expect_prepared_matches(deconv("one_row", 32, 4, 1, 390, true, leaky), {1});
+  expect_prepared_matches(deconv("one_column", 32, 4, 390, 1, true, leaky), {1});
 }
 
 TEST(WinogradDeconv, ChannelSlicesTileRangesAndDeepLayers) {
   const auto leaky = ActivationSpec::leaky_relu(0.1f);
   // Input and output as channel slices of wider tensors (FlowNet's decoders concatenate in place).
-  expect_deconv_matches({"slice", 34, 6, 37, 70, true, leaky}, {2, 3, 1, 5, 2});
+  expect_prepared_matches(deconv("slice", 34, 6, 37, 70, true, leaky), {2, 3, 1, 5, 2});
   // A budget of 40 tiles of 36·34 floats: ranges of 32 tiles, starting mid-row.
-  expect_deconv_matches({"ranges", 34, 6, 41, 75, true, leaky}, {2, 1, 1, 2, 2, 36 * 34 * 40});
+  expect_prepared_matches(deconv("ranges", 34, 6, 41, 75, true, leaky), {2, 1, 1, 2, 2, 36 * 34 * 40});
   // ci ≥ 384: U on the 14-row panels (pairs of column phases still within one work-item); 24×32
   // inputs (48 tiles: the second panel's low half alone), as FlowNet2's deconv3 at 512×384 (the
   // size rule leaves that layer on the sub-pixel form; prepared without the size it runs here).
-  expect_unsized_deconv_matches({"deep_24x32", 390, 7, 24, 32, true, leaky});
-  expect_deconv_matches({"deep_odd", 400, 5, 33, 70, false, leaky}, {1});
+  expect_unsized_prepared_matches(deconv("deep_24x32", 390, 7, 24, 32, true, leaky));
+  expect_prepared_matches(deconv("deep_odd", 400, 5, 33, 70, false, leaky), {1});
 }
 
 TEST(WinogradDeconv, OnlyFourByFourStrideTwoPaddingOneOfEnoughChannelsQualifies) {
@@ -174,8 +123,8 @@ TEST(WinogradDeconv, OnlyFourByFourStrideTwoPaddingOneOfEnoughChannelsQualifies)
   EXPECT_FALSE(detail::winograd_deconv_preferred({1, 1026, 12, 16}, {1026, 256, 4, 4}, 2, 1));
   EXPECT_TRUE(detail::winograd_deconv_preferred({}, {1026, 256, 4, 4}, 2, 1));
   // Below the rule the winograd plan keeps the sub-pixel form, with its own bound.
-  expect_deconv_matches({"tiles_96", 32, 4, 32, 47, true, ActivationSpec::none()}, {1});
-  expect_deconv_matches({"tiles_84", 32, 4, 28, 48, true, ActivationSpec::none()}, {1}, false);
+  expect_prepared_matches(deconv("tiles_96", 32, 4, 32, 47, true, ActivationSpec::none()), {1});
+  expect_prepared_matches(deconv("tiles_84", 32, 4, 28, 48, true, ActivationSpec::none()), {1}, false);
   // Weights prepared for Winograd do not run a layer of another geometry.
   Queue& queue = testing::test_queue();
   const Tensor w = Tensor::from_host(queue, {32, 4, 4, 4}, testing::random_vector(32 * 4 * 16, 9));
