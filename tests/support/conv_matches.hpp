@@ -3,7 +3,8 @@
 // the split-K forms forced; test_winograd: weights prepared on the winograd plan): a case's random
 // input, weights and bias, conv2d run with its input and output as channel slices of wider
 // tensors, and the output against the float64 direct convolution of tests/reference/conv.cpp with
-// the bound of every GEMM and direct convolution (the Winograd form's where it ran).
+// the bound of every GEMM and direct convolution (the Winograd form's where it ran). Its operands
+// (layer_operands) and the Winograd matrices' check also serve support/deconv_matches.hpp.
 #pragma once
 
 #include <cmath>
@@ -63,40 +64,69 @@ struct ConvRun {
   bool knowing_input = false;
 };
 
+// A case's operands: random input, weights and bias from five seeds (seed … seed + 4: input,
+// weights, bias, the wider input and output), the input and the output as channel slices of
+// wider tensors whose other channels must survive, the weights and bias on the device.
+struct LayerOperands {
+  std::vector<float> input, weight, bias;
+  Sliced in, out;
+  Tensor w, b;
+};
+
+inline LayerOperands layer_operands(Queue& queue, std::uint32_t seed, const Shape& input, const Shape& weight,
+                                    const Shape& output, bool bias, int in_before, int in_after, int out_before,
+                                    int out_after) {
+  auto count = [](const Shape& s) {
+    std::size_t n = 1;
+    for (const std::int64_t d : s) n *= static_cast<std::size_t>(d);
+    return n;
+  };
+  const std::int64_t co = output[1];
+  LayerOperands o;
+  o.input = random_vector(count(input), seed);
+  o.weight = random_vector(count(weight), seed + 1);
+  o.bias = bias ? random_vector(static_cast<std::size_t>(co), seed + 2) : std::vector<float>{};
+  o.in = embed_sliced(queue, o.input, input, in_before, in_before + in_after, seed + 3);
+  o.out = make_sliced(queue, output, out_before, out_before + out_after, seed + 4);
+  o.w = Tensor::from_host(queue, weight, o.weight);
+  o.b = bias ? Tensor::from_host(queue, {co}, o.bias) : Tensor();
+  return o;
+}
+
+// Weights prepared as Winograd matrices: the 36 transformed matrices of `ci` input channels and at
+// least `rows` output rows, packed as one (ops/winograd.hpp).
+inline void expect_winograd_matrices(const GemmWeights& prepared, std::int64_t ci, std::int64_t rows) {
+  if (prepared.winograd.empty()) return;
+  EXPECT_EQ(prepared.winograd.size(), 1u);
+  const PackedPanels& u = prepared.winograd[0];
+  EXPECT_EQ(u.depth, static_cast<std::size_t>(ci));
+  EXPECT_EQ(u.lines % (detail::kWinogradElements * static_cast<std::size_t>(u.width)), 0u);
+  EXPECT_GE(u.lines, detail::kWinogradElements * static_cast<std::size_t>(rows));
+}
+
 // Returns whether the Winograd form computed the output (and set the bound).
 inline bool expect_conv_matches(const ConvCase& c, const ConvPlacement& p, const ConvRun& run = {}) {
   SCOPED_TRACE(c.name);
   Queue& queue = test_queue();
   const reference::ConvShape s{p.batch, c.ci, c.h, c.w, c.co, c.k, c.k, c.stride, c.padding};
   const int oh = s.conv_out_h(), ow = s.conv_out_w();
-  const std::uint32_t seed = run.first_seed;
-
-  const auto input = random_vector(static_cast<std::size_t>(p.batch) * c.ci * c.h * c.w, seed);
-  const auto weight = random_vector(static_cast<std::size_t>(c.co) * c.ci * c.k * c.k, seed + 1);
-  const auto bias = c.bias ? random_vector(static_cast<std::size_t>(c.co), seed + 2) : std::vector<float>{};
-  const auto expected = reference::conv2d(s, input, weight, bias, c.activation);
-
-  // The input and the output as channel slices of wider tensors whose other channels must survive.
-  const Sliced in = embed_sliced(queue, input, {p.batch, c.ci, c.h, c.w}, p.in_before, p.in_before + p.in_after, seed + 3);
-  const Sliced out = make_sliced(queue, {p.batch, c.co, oh, ow}, p.out_before, p.out_before + p.out_after, seed + 4);
-  const Tensor w = Tensor::from_host(queue, {c.co, c.ci, c.k, c.k}, weight);
-  const Tensor b = c.bias ? Tensor::from_host(queue, {c.co}, bias) : Tensor();
+  const LayerOperands o = layer_operands(queue, run.first_seed, {p.batch, c.ci, c.h, c.w}, {c.co, c.ci, c.k, c.k},
+                                         {p.batch, c.co, oh, ow}, c.bias, p.in_before, p.in_after, p.out_before,
+                                         p.out_after);
+  const auto expected = reference::conv2d(s, o.input, o.weight, o.bias, c.activation);
   Conv2dOptions options{c.stride, c.padding, c.activation, p.max_column_floats};
   options.algorithm = run.algorithm;
   GemmWeights prepared;
   if (run.prepared_on) {
-    prepared = prepare_conv2d_weights(queue, w, *run.prepared_on, c.stride, c.padding,
-                                      run.knowing_input ? in.view.shape() : Shape{});
+    prepared = prepare_conv2d_weights(queue, o.w, *run.prepared_on, c.stride, c.padding,
+                                      run.knowing_input ? o.in.view.shape() : Shape{});
     options.prepared = &prepared;
-    // The 36 transformed matrices packed as one (ops/winograd.hpp).
-    if (!prepared.winograd.empty()) {
-      EXPECT_EQ(prepared.winograd.size(), 1u);
-      const PackedPanels& u = prepared.winograd[0];
-      EXPECT_EQ(u.lines % (detail::kWinogradElements * static_cast<std::size_t>(u.width)), 0u);
-    }
+    // A phase-form layer's matrices take its 4·ci phase images.
+    const bool phases = detail::winograd_phase_eligible(o.w.shape(), c.stride, c.padding);
+    expect_winograd_matrices(prepared, (phases ? 4 : 1) * c.ci, c.co);
   }
-  conv2d(queue, in.view, w, b, out.view, options);
-  EXPECT_TRUE(untouched_outside(queue, out)) << "elements outside the output slice were written";
+  conv2d(queue, o.in.view, o.w, o.b, o.out.view, options);
+  EXPECT_TRUE(untouched_outside(queue, o.out)) << "elements outside the output slice were written";
   // float32 accumulation of K = ci·k·k products of magnitude ≲ 1 against a double reference:
   // the error grows with the reduction length, so the absolute floor is sqrt(K) (the typical
   // output magnitude) and 1e-5 relative to that leaves ~10× margin over K·eps at K ≈ 10^4. The
@@ -106,9 +136,9 @@ inline bool expect_conv_matches(const ConvCase& c, const ConvPlacement& p, const
   const double floor = std::sqrt(static_cast<double>(c.ci) * c.k * c.k);
   const bool plan_winograd = run.algorithm == Conv2dAlgorithm::Default &&
                              gemm_backend(queue.device().info()) == GemmBackend::Winograd &&
-                             detail::winograd_preferred(in.view.shape(), w.shape(), c.stride, c.padding);
+                             detail::winograd_preferred(o.in.view.shape(), o.w.shape(), c.stride, c.padding);
   const bool winograd = run.prepared_on ? !prepared.winograd.empty() : plan_winograd;
-  EXPECT_TRUE(all_close(view_values(queue, out), expected, winograd ? kWinogradRelativeTolerance : 1e-5, floor));
+  EXPECT_TRUE(all_close(view_values(queue, o.out), expected, winograd ? kWinogradRelativeTolerance : 1e-5, floor));
   return winograd;
 }
 

@@ -23,6 +23,7 @@
 #include "ops/op_testing.hpp"
 #include "ops/winograd.hpp"
 #include "reference/conv.hpp"
+#include "support/conv_matches.hpp"
 #include "support/flownet_layers.hpp"
 #include "support/testing.hpp"
 
@@ -70,37 +71,21 @@ inline bool expect_deconv_matches(const DeconvCase& c, const DeconvPlacement& p,
   Queue& queue = test_queue();
   const reference::ConvShape s{p.batch, c.ci, c.h, c.w, c.co, c.k, c.k, c.stride, c.padding};
   const int oh = s.deconv_out_h(), ow = s.deconv_out_w();
-  const std::uint32_t seed = run.first_seed;
-
-  const auto input = random_vector(static_cast<std::size_t>(p.batch) * c.ci * c.h * c.w, seed);
-  const auto weight = random_vector(static_cast<std::size_t>(c.ci) * c.co * c.k * c.k, seed + 1);
-  const auto bias = c.bias ? random_vector(static_cast<std::size_t>(c.co), seed + 2) : std::vector<float>{};
-  const auto expected = reference::conv_transpose2d(s, input, weight, bias, c.activation);
-
-  // The input and the output as channel slices of wider tensors whose other channels must survive.
-  const Sliced in = embed_sliced(queue, input, {p.batch, c.ci, c.h, c.w}, p.in_before, p.in_before + p.in_after, seed + 3);
-  const Sliced out = make_sliced(queue, {p.batch, c.co, oh, ow}, p.out_before, p.out_before + p.out_after, seed + 4);
-  const Tensor w = Tensor::from_host(queue, {c.ci, c.co, c.k, c.k}, weight);
-  const Tensor b = c.bias ? Tensor::from_host(queue, {c.co}, bias) : Tensor();
+  const LayerOperands o = layer_operands(queue, run.first_seed, {p.batch, c.ci, c.h, c.w}, {c.ci, c.co, c.k, c.k},
+                                         {p.batch, c.co, oh, ow}, c.bias, p.in_before, p.in_after, p.out_before,
+                                         p.out_after);
+  const auto expected = reference::conv_transpose2d(s, o.input, o.weight, o.bias, c.activation);
   ConvTranspose2dOptions options{c.stride, c.padding, c.activation, p.max_column_floats};
   options.algorithm = p.algorithm;
   GemmWeights prepared;
   if (run.prepared_on) {
-    prepared = prepare_conv_transpose2d_weights(queue, w, *run.prepared_on,
-                                                run.knowing_input ? in.view.shape() : Shape{}, c.stride, c.padding);
+    prepared = prepare_conv_transpose2d_weights(queue, o.w, *run.prepared_on,
+                                                run.knowing_input ? o.in.view.shape() : Shape{}, c.stride, c.padding);
     options.prepared = &prepared;
-    // The 36 transformed matrices of the 3×3 layer (4·co rows, padded to whole panels, by ci),
-    // packed as one (ops/winograd.hpp).
-    if (!prepared.winograd.empty()) {
-      EXPECT_EQ(prepared.winograd.size(), 1u);
-      const PackedPanels& u = prepared.winograd[0];
-      EXPECT_EQ(u.depth, static_cast<std::size_t>(c.ci));
-      EXPECT_EQ(u.lines % (detail::kWinogradElements * static_cast<std::size_t>(u.width)), 0u);
-      EXPECT_GE(u.lines, detail::kWinogradElements * 4 * static_cast<std::size_t>(c.co));
-    }
+    expect_winograd_matrices(prepared, c.ci, 4 * c.co);  // the 3×3 layer's 4·co phase rows
   }
-  conv_transpose2d(queue, in.view, w, b, out.view, options);
-  EXPECT_TRUE(untouched_outside(queue, out)) << "elements outside the output slice were written";
+  conv_transpose2d(queue, o.in.view, o.w, o.b, o.out.view, options);
+  EXPECT_TRUE(untouched_outside(queue, o.out)) << "elements outside the output slice were written";
   // Each output sums at most ci·ceil(k/s)² float32 products of magnitude ≲ 1 (ci per GEMM entry,
   // then the taps that land on the pixel): as for conv2d, an absolute floor of sqrt(K) for that
   // reduction length K and 1e-5 relative to it. The Winograd form runs a 3×3 convolution of ci
@@ -109,11 +94,11 @@ inline bool expect_deconv_matches(const DeconvCase& c, const DeconvPlacement& p,
   // (test_winograd_deconv): at most 2.2e-5 (flownetc.deconv3, ci = 770; 3.2e-5 against sqrt(4·ci)).
   const bool plan_winograd = p.algorithm == DeconvAlgorithm::Default &&
                              gemm_backend(queue.device().info()) == GemmBackend::Winograd &&
-                             detail::winograd_deconv_preferred(in.view.shape(), w.shape(), c.stride, c.padding);
+                             detail::winograd_deconv_preferred(o.in.view.shape(), o.w.shape(), c.stride, c.padding);
   const bool winograd = run.prepared_on ? !prepared.winograd.empty() : plan_winograd;
   const int taps = winograd ? 3 : (c.k + c.stride - 1) / c.stride;
   const double floor = std::sqrt(static_cast<double>(c.ci) * taps * taps);
-  EXPECT_TRUE(all_close(view_values(queue, out), expected, winograd ? kWinogradRelativeTolerance : 1e-5, floor));
+  EXPECT_TRUE(all_close(view_values(queue, o.out), expected, winograd ? kWinogradRelativeTolerance : 1e-5, floor));
   return winograd;
 }
 
