@@ -29,19 +29,10 @@
 
 namespace inertialnet::testing {
 
-// One transposed convolution: ci → co channels on an h×w input, a k×k kernel.
-struct DeconvCase {
-  std::string name;
-  int ci, co, h, w, k, stride, padding;
-  bool bias;
-  ActivationSpec activation;
-};
-inline void PrintTo(const DeconvCase& c, std::ostream* os) { *os << c.name; }
-
-// A FlowNet2 layer of the shared table as a case.
-inline DeconvCase deconv_case_of(const flownet_layers::LayerShape& l) {
-  return {l.identifier(), l.ci, l.co, l.h, l.w, l.k, l.stride, l.padding, l.bias, l.activation};
-}
+// One transposed convolution: ci → co channels on an h×w input, a k×k kernel (the fields of a
+// convolution's case), and a FlowNet2 layer of the shared table as one.
+using DeconvCase = ConvCase;
+inline DeconvCase deconv_case_of(const flownet_layers::LayerShape& l) { return conv_case_of(l); }
 
 // Where the op's tensors sit inside wider tensors (`*_before` / `*_after` extra channels around
 // the input and the output), the column budget of ConvTranspose2dOptions (0: the op's own) and
