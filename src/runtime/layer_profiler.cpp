@@ -73,6 +73,25 @@ std::vector<LayerTime> total_by_layer(const std::vector<LayerTime>& layers) {
   return totals;
 }
 
+std::vector<LayerTime> median_by_layer(const std::vector<std::vector<LayerTime>>& runs) {
+  if (runs.empty()) return {};
+  std::vector<LayerTime> medians = runs.front();
+  for (std::size_t i = 0; i < medians.size(); ++i) {
+    std::vector<double> times;
+    for (const auto& run : runs) {
+      if (run.size() != medians.size() || run[i].layer.name != medians[i].layer.name) {
+        throw invalid_input("profile: the runs to take the median of do not list the same layers (layer " +
+                            std::to_string(i) + ": '" + medians[i].layer.name + "')");
+      }
+      times.push_back(run[i].seconds);
+    }
+    std::sort(times.begin(), times.end());
+    const std::size_t n = times.size();
+    medians[i].seconds = n % 2 ? times[n / 2] : 0.5 * (times[n / 2 - 1] + times[n / 2]);
+  }
+  return medians;
+}
+
 std::vector<KindTime> group_by_kind(const std::vector<LayerTime>& layers) {
   std::map<std::string, KindTime> by_kind;
   for (const auto& l : layers) {

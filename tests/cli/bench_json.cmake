@@ -67,6 +67,10 @@ foreach(field weight_bytes head_weight_bytes activation_bytes unplanned_activati
   endif()
 endforeach()
 expect_field(results 0 profile seconds)
+expect_field(results 0 profile pairs)  # the median of min(--pairs, 3) profiled pairs
+if(NOT value EQUAL 1)
+  message(FATAL_ERROR "profile.pairs is ${value} for --pairs 1")
+endif()
 expect_field(results 0 gemm_tuning)
 
 # Every kind FlowNet2 has appears in the per-kind table, with its fields; GEMM layers name a backend.

@@ -58,7 +58,8 @@ std::string format_bench_text(const BenchResult& r, bool layers) {
          megabytes(r.head_weight_bytes) + " (head); activations " + megabytes(r.activation_bytes) + " planned (" +
          megabytes(r.unplanned_activation_bytes) + " with one buffer each); total " + megabytes(r.total_bytes()) + "\n";
   out += "GEMM tuning: " + (r.gemm_tuning.empty() ? std::string("defaults") : r.gemm_tuning) + "\n\n";
-  out += "per layer kind (one profiled pair, device time " + fixed(profiled_seconds(r.layers), 3) + " s):\n";
+  out += "per layer kind (each layer's median over " + std::to_string(r.profiled_pairs) + " profiled pair" +
+         (r.profiled_pairs == 1 ? "" : "s") + ", device time " + fixed(profiled_seconds(r.layers), 3) + " s):\n";
   out += format_kind_table(group_by_kind(r.layers));
   if (!r.gemm_references.empty()) {
     // Where the layers ran on CLBlast (GPUs), its rate on the same products comes first: the
@@ -156,7 +157,7 @@ std::string format_bench_json(const std::vector<BenchResult>& results) {
                         {"gflops", l.seconds > 0 ? l.layer.flops * 1e-9 / l.seconds : 0},
                         {"backend", l.layer.backend}});
     }
-    j["profile"] = {{"seconds", total}, {"kinds", kinds}, {"layers", layers}};
+    j["profile"] = {{"pairs", r.profiled_pairs}, {"seconds", total}, {"kinds", kinds}, {"layers", layers}};
     doc["results"].push_back(std::move(j));
   }
   return doc.dump(2) + "\n";

@@ -25,10 +25,13 @@
 //       "gemm_tuning": string                the CLBlast / packed parameters applied beyond the
 //                                            defaults (the shipped table, `inertialnet tune`'s
 //                                            file); "" for none
-//       "profile": {                         one more pair on a profiling queue, device time
+//       "profile": {                         device time per layer on a profiling queue: the
+//                                            median of "pairs" pairs after one unprofiled pair
+//         "pairs": int                       min(pairs, 3) (absent from earlier releases, which
+//                                            profiled one pair, the queue's first)
 //         "seconds": number                  the sum over layers
 //         "kinds": [ { "kind", "layers", "seconds", "share", "gflops", "backends": [string],
-//                      "gflop": number       the kind's work in the profiled pair (GFLOP)
+//                      "gflop": number       the kind's work in one pair (GFLOP)
 //                      "packed_gemm": { "layer", "m", "n", "k", "products", "gflops" } | null
 //                                            the packed GEMM kernel alone on the products of the
 //                                            kind's layers (operands packed beforehand: the best
@@ -69,7 +72,8 @@ struct BenchResult {
   std::string gemm_tuning;
 
   std::size_t total_bytes() const { return weight_bytes + prepared_weight_bytes + head_weight_bytes + activation_bytes; }
-  std::vector<LayerTime> layers;  // the profiled pair
+  std::vector<LayerTime> layers;  // the profile: each layer's median over the profiled pairs
+  int profiled_pairs = 0;
   std::vector<KindGemmReference> gemm_references;  // the packed GEMM on each GEMM kind's product
 
   double seconds_per_pair() const { return upload + flow + head_seconds + download; }

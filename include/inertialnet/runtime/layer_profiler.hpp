@@ -62,6 +62,11 @@ class LayerProfiler {
 // in the order of first appearance.
 std::vector<LayerTime> total_by_layer(const std::vector<LayerTime>& layers);
 
+// The per-layer median of several runs of one network (each run's layers in the same order, as
+// collect() returns them): a layer's time is the median of its times (the mean of the middle two
+// for an even count). Throws invalid_input when the runs do not list the same layers.
+std::vector<LayerTime> median_by_layer(const std::vector<std::vector<LayerTime>>& runs);
+
 // Per-kind totals of a profile: kind, share of the total time, time, FLOPs, layer count.
 struct KindTime {
   std::string kind;
