@@ -69,7 +69,14 @@ __kernel void gemm_packed(__global const float* restrict a_packed, const int a_o
   if (row0 >= m || col0 >= n) return;
   __global const float* ap = a_packed + a_offset + (size_t)panel * k * MR;
   __global const float* bp = b_packed + b_offset + (size_t)column_panel * k * 32;
-  TILE_PRODUCT(ap, bp, k)
   const int cols = min(32, n - col0);
-  EACH_ROW(STORE)
+  if (cols <= 16) {
+    // The last B panel holds 16 columns or fewer (n = 48 at FlowNet2's 6×8 layers: conv6, conv6_1,
+    // deconv5): the low half alone, instead of a whole panel's products on padding.
+    TILE_PRODUCT_LOW(ap, bp, k)
+    EACH_ROW(STORE)
+  } else {
+    TILE_PRODUCT(ap, bp, k)
+    EACH_ROW(STORE)
+  }
 }

@@ -41,3 +41,21 @@
     ap += MR;                                                  \
     bp += 32;                                                  \
   }
+
+// TILE_PRODUCT for a B panel whose columns past the first 16 are padding: only the low 16 columns,
+// one B vector per k instead of two, MR fma per MR + 1 loads (hi0 … hi(MR−1) stay zero). At
+// FlowNet2's 6×8 layers (n = 48) the second panel is half padding, a third of the product; at
+// 24×32 outputs the winograd products' second 32-tile panel likewise.
+#define ACCUMULATE_LOW(r)                \
+  {                                      \
+    const float16 a = (float16)(ap[r]);  \
+    lo##r = fma(a, b_lo, lo##r);         \
+  }
+#define TILE_PRODUCT_LOW(ap, bp, k)      \
+  EACH_ROW(DECLARE)                      \
+  for (int q_ = 0; q_ < (k); ++q_) {     \
+    const float16 b_lo = vload16(0, bp); \
+    EACH_ROW(ACCUMULATE_LOW)             \
+    ap += MR;                            \
+    bp += 32;                            \
+  }

@@ -70,23 +70,6 @@ inline void pixel_order(const float16* y, float16* p) {
   vstore16(hi##r, 0, scratch + (e * MR + r) * 32 + 16);
 #define PARK_LOW(r) vstore16(lo##r, 0, scratch + (e * MR + r) * 32);
 
-// TILE_PRODUCT (packed_tile.cl) for a B panel whose tiles past the first 16 are padding: only the
-// low 16 columns, one B vector per k instead of two (24×32 outputs: 48 tiles, the second panel of
-// 32 half empty, a quarter of the products padding otherwise).
-#define ACCUMULATE_LOW(r)                   \
-  {                                         \
-    const float16 a = (float16)(ap[r]);     \
-    lo##r = fma(a, b_lo, lo##r);            \
-  }
-#define TILE_PRODUCT_LOW(ap, bp, k)            \
-  EACH_ROW(DECLARE)                            \
-  for (int q_ = 0; q_ < (k); ++q_) {           \
-    const float16 b_lo = vload16(0, bp);       \
-    EACH_ROW(ACCUMULATE_LOW)                   \
-    ap += MR;                                  \
-    bp += 32;                                  \
-  }
-
 __kernel void winograd_gemm(__global const float* restrict u, const int u_offset, __global const float* restrict v,
                             const int v_offset, const int v_element_floats, __global float* restrict out,
                             const int out_offset, __global const float* restrict bias, const int bias_offset,

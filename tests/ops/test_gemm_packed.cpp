@@ -109,7 +109,9 @@ INSTANTIATE_TEST_SUITE_P(
                       PackedCase{"leaky_no_bias", 13, 50, 19, 0, false, false, false, kLeaky},
                       PackedCase{"strided_view", 13, 50, 19, 0, false, false, true, kLeaky, 7, 11},
                       PackedCase{"strided_edge_tile", 9, 33, 8, 4, false, false, true, kRelu, 1, 3},
-                      PackedCase{"alpha_beta", 17, 23, 29, 0, true, false, false, {}, 3, 5, 1.5f, 0.5f}),
+                      PackedCase{"alpha_beta", 17, 23, 29, 0, true, false, false, {}, 3, 5, 1.5f, 0.5f},
+                      // n = 45: the last B panel's 13 columns run the low-half product (TILE_PRODUCT_LOW).
+                      PackedCase{"alpha_beta_low_half", 17, 45, 29, 0, true, false, true, kLeaky, 3, 5, 1.5f, 0.5f}),
     [](const ::testing::TestParamInfo<PackedCase>& info) { return std::string(info.param.name); });
 
 // FlowNet2's GEMM shapes at 512×384 (M output channels, K input channels × kernel area) with the
