@@ -18,43 +18,6 @@
 
 #define STORE(r) store_row(c, c_offset + (row0 + r) * ldc + col0, lo##r, hi##r, row0 + r < m, cols, alpha, beta, bias, bias_offset + row0 + r);
 
-// One row of a tile: `cols` (1..32) valid columns starting at c[index].
-inline void store_row(__global float* c, const int index, float16 lo, float16 hi, const bool valid_row,
-                      const int cols, const float alpha, const float beta, __global const float* bias,
-                      const int bias_index) {
-  if (!valid_row) return;
-  lo *= alpha;
-  hi *= alpha;
-#if HAS_BETA
-  if (cols == 32) {
-    lo += beta * vload16(0, c + index);
-    hi += beta * vload16(0, c + index + 16);
-  } else {
-    float t[32];
-    for (int q = 0; q < cols; ++q) t[q] = beta * c[index + q];
-    for (int q = cols; q < 32; ++q) t[q] = 0.0f;
-    lo += vload16(0, t);
-    hi += vload16(0, t + 16);
-  }
-#endif
-#if HAS_BIAS
-  const float b = bias[bias_index];
-  lo += b;
-  hi += b;
-#endif
-  lo = ACTIVATE(lo);
-  hi = ACTIVATE(hi);
-  if (cols == 32) {
-    vstore16(lo, 0, c + index);
-    vstore16(hi, 0, c + index + 16);
-  } else {
-    float t[32];
-    vstore16(lo, 0, t);
-    vstore16(hi, 0, t + 16);
-    for (int q = 0; q < cols; ++q) c[index + q] = t[q];
-  }
-}
-
 __kernel void gemm_packed(__global const float* restrict a_packed, const int a_offset,
                           __global const float* restrict b_packed, const int b_offset,
                           __global float* restrict c, const int c_offset, const int ldc,

@@ -29,14 +29,10 @@ __kernel void pack_panels(__global const float* restrict src, const int src_offs
 }
 
 #ifdef KH
-// im2col straight into B panels (WIDTH = 32): the column of output pixel first_pixel + j is
-// line j; its depth index is (channel·KH + ky)·KW + kx, as the weight matrix [co, ci·KH·KW]
-// orders it, so each (channel, ky, kx) of a panel is 32 consecutive floats.
+// im2col straight into B panels (WIDTH = 32; the fill and its layout: im2col_panel.cl).
 // One work-item per (panel, block of CHANNEL_BLOCK input channels), launched in work-groups of
-// one: PoCL does not vectorise across work-items through the kernel's own loops, so the 32
-// lanes are written explicitly — float16 copies where a stride-1 or stride-2 panel lies inside
-// one output row and inside the input row (FlowNet's widths are multiples of 32), a plain loop
-// elsewhere (borders, other strides, panels across rows, the partial last panel).
+// one.
+#include "im2col_panel.cl"
 #define CHANNEL_BLOCK 16
 __kernel void im2col_panels(__global const float* restrict in, const int in_offset,
                             __global float* restrict dst, const int dst_offset,
@@ -47,66 +43,9 @@ __kernel void im2col_panels(__global const float* restrict in, const int in_offs
   const int c0 = get_global_id(1) * CHANNEL_BLOCK;
   const int j0 = panel * WIDTH;
   if (j0 >= pixel_count || c0 >= channels) return;
-  const int c1 = min(channels, c0 + CHANNEL_BLOCK);
   const int depth = channels * KH * KW;
-  const int lanes = min(WIDTH, pixel_count - j0);
-  const int p0 = first_pixel + j0;
-  const int oy0 = p0 / out_width;
-  const int ox0 = p0 - oy0 * out_width;
-  // STRIDE is a build option, so the preprocessor picks the strides with a fast path (in C code
-  // the constant `STRIDE == 1 || STRIDE == 2` is a -Wconstant-logical-operand warning, which PoCL
-  // prints on the user's terminal).
-#if STRIDE == 1 || STRIDE == 2
-  const bool one_row = lanes == WIDTH && ox0 + WIDTH <= out_width;
-#else
-  const bool one_row = false;
-#endif
-  __global float* out = dst + dst_offset + panel * depth * WIDTH + c0 * (KH * KW) * WIDTH;
-  for (int c = c0; c < c1; ++c) {
-    const __global float* plane = in + in_offset + c * height * width;
-    for (int ky = 0; ky < KH; ++ky) {
-      for (int kx = 0; kx < KW; ++kx, out += WIDTH) {
-        if (one_row) {
-          const int y = oy0 * STRIDE - PAD + ky, x = ox0 * STRIDE - PAD + kx;
-          if (y < 0 || y >= height) {
-            vstore16((float16)(0.0f), 0, out);
-            vstore16((float16)(0.0f), 1, out);
-            continue;
-          }
-          const __global float* src = plane + y * width + x;
-          if (x >= 0 && x + WIDTH * STRIDE <= width) {
-#if STRIDE == 1
-            vstore16(vload16(0, src), 0, out);
-            vstore16(vload16(1, src), 1, out);
-#else
-            // Every other input pixel: the even lanes of 64 consecutive floats.
-            const float16 a0 = vload16(0, src), a1 = vload16(1, src), a2 = vload16(2, src), a3 = vload16(3, src);
-            vstore16((float16)(a0.even, a1.even), 0, out);
-            vstore16((float16)(a2.even, a3.even), 1, out);
-#endif
-            continue;
-          }
-          for (int q = 0; q < WIDTH; ++q) {
-            const int xi = x + q * STRIDE;
-            out[q] = (xi >= 0 && xi < width) ? src[q * STRIDE] : 0.0f;
-          }
-          continue;
-        }
-        int oy = oy0, ox = ox0;
-        for (int q = 0; q < WIDTH; ++q) {
-          float v = 0.0f;
-          if (q < lanes) {
-            const int y = oy * STRIDE - PAD + ky, x = ox * STRIDE - PAD + kx;
-            if (y >= 0 && y < height && x >= 0 && x < width) v = plane[y * width + x];
-            if (++ox == out_width) {
-              ox = 0;
-              ++oy;
-            }
-          }
-          out[q] = v;
-        }
-      }
-    }
-  }
+  im2col_panel(dst + dst_offset + panel * depth * WIDTH + c0 * (KH * KW) * WIDTH, in + in_offset, c0,
+               min(channels, c0 + CHANNEL_BLOCK), height, width, out_width, first_pixel + j0,
+               min(WIDTH, pixel_count - j0));
 }
 #endif

@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
-// The register tile of the packed-panel GEMM and its loop over k, shared by every kernel that
-// runs it (gemm_packed.cl, deconv_subpixel.cl, winograd_gemm.cl) so that they differ only in
-// which panels they pair and how the tile is stored:
+// The register tile of the packed-panel GEMM, its loop over k and its store, shared by every
+// kernel that runs it (gemm_packed.cl, conv2d_implicit.cl, deconv_subpixel.cl, winograd_gemm.cl)
+// so that they differ only in which panels they pair and where the tile goes:
 // MR rows of A broadcast against 32 columns of B, 2·MR float16 accumulators (see gemm_packed.cl).
-// A header: included after common.cl, never built on its own. Build option: -DMR.
+// A header: included after common.cl, never built on its own. Build option: -DMR (and the
+// store's -DHAS_BIAS, -DHAS_BETA, -DACTIVATION).
 
 #if MR == 1
 #define EACH_ROW(X) X(0)
@@ -59,3 +60,41 @@
     ap += MR;                            \
     bp += 32;                            \
   }
+
+// One row of a tile into C: `cols` (1..32) valid columns starting at c[index], alpha·tile (+ beta·C
+// with -DHAS_BETA) + bias[bias_index] (with -DHAS_BIAS), then the activation (common.cl).
+inline void store_row(__global float* c, const int index, float16 lo, float16 hi, const bool valid_row,
+                      const int cols, const float alpha, const float beta, __global const float* bias,
+                      const int bias_index) {
+  if (!valid_row) return;
+  lo *= alpha;
+  hi *= alpha;
+#if HAS_BETA
+  if (cols == 32) {
+    lo += beta * vload16(0, c + index);
+    hi += beta * vload16(0, c + index + 16);
+  } else {
+    float t[32];
+    for (int q = 0; q < cols; ++q) t[q] = beta * c[index + q];
+    for (int q = cols; q < 32; ++q) t[q] = 0.0f;
+    lo += vload16(0, t);
+    hi += vload16(0, t + 16);
+  }
+#endif
+#if HAS_BIAS
+  const float b = bias[bias_index];
+  lo += b;
+  hi += b;
+#endif
+  lo = ACTIVATE(lo);
+  hi = ACTIVATE(hi);
+  if (cols == 32) {
+    vstore16(lo, 0, c + index);
+    vstore16(hi, 0, c + index + 16);
+  } else {
+    float t[32];
+    vstore16(lo, 0, t);
+    vstore16(hi, 0, t + 16);
+    for (int q = 0; q < cols; ++q) c[index + q] = t[q];
+  }
+}

@@ -19,17 +19,32 @@ namespace {
 
 const std::string kOp = "conv2d";
 
-// The packed backend: weights in MR-row panels (prepared once, or packed now), im2col writing
-// the B panels of a range of output pixels, and a GEMM whose store adds the bias, applies the
-// activation and writes the range's pixels of every output channel into the output view.
+// The packed backend: weights in MR-row panels (prepared once, or packed now), then either the
+// implicit GEMM (few output channels: each work-item builds its B panel in local memory) or
+// im2col writing the B panels of a range of output pixels and a GEMM; either store adds the bias,
+// applies the activation and writes the pixels of every output channel into the output view.
 void conv2d_packed(Queue& queue, const Tensor& input, const Tensor& weight, const Tensor& bias, const Tensor& output,
                    const Conv2dOptions& options) {
   const bool prepared = options.prepared && options.prepared->packed.data.defined();
-  const PackedPanels weights = prepared ? options.prepared->packed
-                                        : prepare_conv2d_weights(queue, weight, GemmBackend::Packed, options.stride, options.padding).packed;
-  const std::size_t reduction = weights.depth;
+  const auto rows = static_cast<std::size_t>(weight.dim(0));
+  const std::size_t reduction = static_cast<std::size_t>(weight.numel()) / rows;
+  // Packed now where they were not (also a layer of few outputs forced off the direct kernel).
+  const PackedPanels weights =
+      prepared ? options.prepared->packed
+               : pack_a(queue, Transpose::No, rows, reduction, MatrixView::of(weight, reduction));
   const auto out_h = static_cast<int>(output.h()), out_w = static_cast<int>(output.w());
   const std::size_t pixels = static_cast<std::size_t>(out_h) * static_cast<std::size_t>(out_w);
+  const Im2colGeometry geometry{static_cast<int>(weight.dim(2)), static_cast<int>(weight.dim(3)), options.stride,
+                                options.padding, out_h, out_w};
+  const GemmEpilogue epilogue{1.0f, 0.0f, bias, options.activation};
+  if (options.algorithm == Conv2dAlgorithm::ImplicitGemm ||
+      (options.algorithm == Conv2dAlgorithm::Default &&
+       implicit_gemm_preferred(queue.device().info(), weights.lines, reduction))) {
+    for (std::int64_t n = 0; n < input.n(); ++n) {
+      conv2d_implicit_gemm(queue, weights, input.sample(n), geometry, MatrixView::of(output.sample(n), pixels), epilogue);
+    }
+    return;
+  }
   // Whole panels per range, so only the last range of a sample has a partial panel.
   std::size_t chunk =
       std::clamp<std::size_t>(detail::packed_column_budget(queue.device(), options.max_column_floats) / reduction, 1, pixels);
@@ -37,9 +52,6 @@ void conv2d_packed(Queue& queue, const Tensor& input, const Tensor& weight, cons
   if (options.max_column_floats == 0) chunk = std::max(chunk, std::min(pixels, kPackedColumns));
   if (chunk >= kPackedColumns && chunk < pixels) chunk -= chunk % kPackedColumns;
   const Tensor columns = Tensor::empty(queue, {static_cast<std::int64_t>(PackedPanels::floats(chunk, reduction, static_cast<int>(kPackedColumns)))});
-  const Im2colGeometry geometry{static_cast<int>(weight.dim(2)), static_cast<int>(weight.dim(3)), options.stride,
-                                options.padding, out_h, out_w};
-  const GemmEpilogue epilogue{1.0f, 0.0f, bias, options.activation};
   for (std::int64_t n = 0; n < input.n(); ++n) {
     const Tensor in_n = input.sample(n);
     const Tensor out_n = output.sample(n);
@@ -130,9 +142,14 @@ void conv2d(Queue& queue, const Tensor& input, const Tensor& weight, const Tenso
     detail::conv2d_slices(queue, input, weight, bias, output, options);
     return;
   }
+  if (options.algorithm == Conv2dAlgorithm::ImplicitGemm) {
+    detail::report_backend(queue, to_string(GemmBackend::Packed));
+    conv2d_packed(queue, input, weight, bias, output, options);
+    return;
+  }
   // Prepared weights say which form the layer runs (prepare_conv2d_weights applied the shape
   // rule); without them the rule decides here.
-  const bool winograd = backend == GemmBackend::Winograd &&
+  const bool winograd = options.algorithm == Conv2dAlgorithm::Default && backend == GemmBackend::Winograd &&
                         (options.prepared ? !options.prepared->winograd.empty()
                                           : detail::winograd_preferred(input.shape(), weight.shape(), options.stride,
                                                                        options.padding));
@@ -154,7 +171,7 @@ void conv2d(Queue& queue, const Tensor& input, const Tensor& weight, const Tenso
     return;
   }
   if (uses_packed_kernels(backend)) {
-    if (weight.dim(0) <= kDirectConvMaxChannels) {
+    if (options.algorithm == Conv2dAlgorithm::Default && weight.dim(0) <= kDirectConvMaxChannels) {
       detail::report_backend(queue, "direct");
       conv2d_direct(queue, input, weight, bias, output, options);
     } else {

@@ -61,11 +61,81 @@ TEST(Conv2d, WritesIntoAChannelSliceAndReadsFromOne) {
 }
 
 TEST(Conv2d, SmallColumnBudgetProcessesPixelRanges) {
-  // A budget of 100 columns splits 37×23 outputs into 9 ranges, the last one partial.
+  // A budget of 100 columns splits 37×23 outputs into 9 ranges, the last one partial (the im2col
+  // form forced: the plan would run these few-channel layers as an implicit GEMM, without columns).
+  const testing::ConvRun im2col{Conv2dAlgorithm::Im2colGemm};
   ConvPlacement p{3, 1, 1, 2, 2, 5 * 3 * 3 * 100};
-  expect_conv_matches({"chunked", 5, 7, 37, 23, 3, 1, 1, true, ActivationSpec::leaky_relu(0.1f)}, p);
+  expect_conv_matches({"chunked", 5, 7, 37, 23, 3, 1, 1, true, ActivationSpec::leaky_relu(0.1f)}, p, im2col);
   p.max_column_floats = 1;  // one pixel at a time
-  expect_conv_matches({"one_pixel", 2, 3, 5, 4, 3, 2, 1, true, ActivationSpec::relu()}, p);
+  expect_conv_matches({"one_pixel", 2, 3, 5, 4, 3, 2, 1, true, ActivationSpec::relu()}, p, im2col);
+}
+
+// The implicit GEMM (packed kernels; the plan's choice for ≤ kImplicitGemmMaxRows outputs and a
+// panel within kImplicitGemmMaxPanelBytes): every A panel against a B panel built in local memory.
+// Output channels around the 14-row tile (5, 14, 15, 29, 64: a partial panel, one, one row over,
+// three, FlowNet2's five), panels inside one output row with whole input vectors (output widths
+// 32 and 64 at strides 1 and 2), across rows and at the left and right padding (37, 23), a partial
+// last panel, strides 1, 2 and 3 (no vector path), 7×7, 5×5, 3×3 and 1×1 windows, batches, channel
+// slices on both sides, with and without bias.
+TEST(Conv2d, ImplicitGemmAtOddSizes) {
+  const testing::ConvRun implicit{Conv2dAlgorithm::ImplicitGemm};
+  const auto leaky = ActivationSpec::leaky_relu(0.1f);
+  for (int co : {5, 14, 15, 29, 64}) {
+    const std::string c = "_co" + std::to_string(co);
+    expect_conv_matches({"implicit_k3s1_w32" + c, 6, co, 9, 32, 3, 1, 1, co % 2 == 1, leaky}, {2}, implicit);
+    expect_conv_matches({"implicit_k3s2_w64" + c, 5, co, 11, 128, 3, 2, 1, true, leaky}, {1}, implicit);
+    expect_conv_matches({"implicit_k7s2_rows" + c, 3, co, 23, 37, 7, 2, 3, true, ActivationSpec::relu()}, {3}, implicit);
+  }
+  expect_conv_matches({"implicit_k5s2_odd", 4, 9, 37, 23, 5, 2, 2, false, ActivationSpec::none()}, {2}, implicit);
+  expect_conv_matches({"implicit_k3s3p0", 4, 11, 37, 41, 3, 3, 0, true, leaky}, {1}, implicit);
+  expect_conv_matches({"implicit_k1", 7, 12, 9, 50, 1, 1, 0, true, leaky}, {1}, implicit);
+  expect_conv_matches({"implicit_slices", 6, 10, 13, 70, 3, 2, 1, true, leaky}, {3, 2, 3, 1, 4, 0}, implicit);
+  expect_conv_matches({"implicit_slice_last", 3, 20, 16, 16, 3, 1, 1, true, ActivationSpec::none()}, {2, 1, 0, 7, 0},
+                      implicit);
+}
+
+// Where the plan runs it: FlowNet2's few-channel layers at 512×384 (FlowNetC/S conv1, FlowNetSD
+// and FlowNetFusion conv0 and conv1), not the layers of 128 outputs or deep reductions; a panel
+// that does not fit a device's local memory is refused, on the plan and when forced.
+TEST(Conv2d, ImplicitGemmRule) {
+  Queue& queue = testing::test_queue();
+  const DeviceInfo& device = queue.device().info();
+  if (device.local_memory_bytes < 2 * kImplicitGemmMaxPanelBytes) GTEST_SKIP() << "local memory below two panels";
+  int implicit = 0;
+  for (const auto& layer : flownet_layers::flownet2_layers(384, 512, flownet_layers::LayerKind::Conv)) {
+    const auto depth = static_cast<std::size_t>(layer.ci * layer.k * layer.k);
+    const bool expected = layer.co <= 64 && depth <= 1024;
+    EXPECT_EQ(implicit_gemm_preferred(device, static_cast<std::size_t>(layer.co), depth), expected) << layer.name;
+    implicit += expected && layer.co > kDirectConvMaxChannels;  // fewer outputs run the direct kernel
+  }
+  // FlowNetC's conv1 and conv_redir, FlowNetS's conv1, conv0 and conv1 of FlowNetSD and FlowNetFusion,
+  // FlowNetFusion's inter_conv0 (on the packed plan; the winograd plan runs it as Winograd).
+  EXPECT_EQ(implicit, 8);
+  DeviceInfo small = device;
+  small.local_memory_bytes = 32 * 1024;  // a GPU's: a panel of 576 rows (72 KiB) does not fit
+  EXPECT_FALSE(implicit_gemm_eligible(small, 576));
+  EXPECT_FALSE(implicit_gemm_preferred(small, 64, 576));
+  EXPECT_TRUE(implicit_gemm_eligible(small, 54));
+
+  Device& d = testing::test_device();
+  const auto too_deep = static_cast<std::int64_t>(device.local_memory_bytes / (2 * kPackedColumns * sizeof(float)) + 9);
+  Conv2dOptions forced{1, 0, ActivationSpec::none()};
+  forced.algorithm = Conv2dAlgorithm::ImplicitGemm;
+  testing::expect_invalid_input(
+      [&] {
+        conv2d(queue, Tensor::empty(d, {1, too_deep, 2, 2}), Tensor::empty(d, {8, too_deep, 1, 1}), Tensor(),
+               Tensor::empty(d, {1, 8, 2, 2}), forced);
+      },
+      "does not fit the local memory");
+}
+
+// FlowNetC's conv1 (3 → 64, 7×7 stride 2) at the real 512×384 input, the plan's choice (the
+// implicit GEMM on the packed plans).
+TEST(Conv2d, FewChannelLayerAtFlowNet2sRealSize) {
+  for (const auto& layer : flownet_layers::flownet2_layers(384, 512, flownet_layers::LayerKind::Conv)) {
+    if (layer.name != "flownetc.conv1") continue;
+    expect_conv_matches(testing::conv_case_of(layer), ConvPlacement{});
+  }
 }
 
 // The direct kernel (≤ kDirectConvMaxChannels outputs, packed plans): blocks of 2 or 4 output

@@ -22,13 +22,17 @@
 namespace inertialnet {
 
 // How a layer runs: Default is the plan's choice (the backend's GEMM or Winograd form; on CPUs the
-// direct kernel for ≤ kDirectConvMaxChannels outputs; on other devices the split-K forms where
-// their rules say, src/ops/conv2d_splitk.hpp); the others force one (tests). SplitKGroup (one
-// work-group per few pixels, the reduction split across its work-items) on a layer of more than
+// direct kernel for ≤ kDirectConvMaxChannels outputs and the implicit GEMM where
+// implicit_gemm_preferred() says; on other devices the split-K forms where their rules say,
+// src/ops/conv2d_splitk.hpp); the others force one (tests). SplitKGroup (one work-group per few
+// pixels, the reduction split across its work-items) on a layer of more than
 // kDirectConvMaxChannels outputs is invalid_input. SplitKSlices (the reduction cut into slices
 // run as one strided-batched GEMM on the device's backend, then summed with bias and activation,
-// src/ops/conv2d_slices.hpp) takes any layer.
-enum class Conv2dAlgorithm { Default, SplitKGroup, SplitKSlices };
+// src/ops/conv2d_slices.hpp) takes any layer. Im2colGemm: the im2col columns (B panels on the
+// packed kernels) and the backend's GEMM, in ranges within max_column_floats. ImplicitGemm: the
+// packed kernels' implicit GEMM (ops/gemm/packed_gemm.hpp) on any backend; invalid_input where its
+// panel does not fit the device's local memory.
+enum class Conv2dAlgorithm { Default, SplitKGroup, SplitKSlices, Im2colGemm, ImplicitGemm };
 
 struct Conv2dOptions {
   int stride = 1;

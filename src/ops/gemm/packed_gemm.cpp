@@ -168,6 +168,62 @@ PackedPanels im2col_panels(Queue& queue, const Tensor& sample, const Im2colGeome
   return packed;
 }
 
+bool implicit_gemm_eligible(const DeviceInfo& device, std::size_t depth) {
+  const std::size_t panel_bytes = depth * kPackedColumns * sizeof(float);
+  return depth > 0 && 2 * panel_bytes <= device.local_memory_bytes;
+}
+
+bool implicit_gemm_preferred(const DeviceInfo& device, std::size_t rows, std::size_t depth) {
+  return rows <= kImplicitGemmMaxRows && depth * kPackedColumns * sizeof(float) <= kImplicitGemmMaxPanelBytes &&
+         implicit_gemm_eligible(device, depth);
+}
+
+void conv2d_implicit_gemm(Queue& queue, const PackedPanels& weights, const Tensor& sample, const Im2colGeometry& g,
+                          const MatrixView& c, const GemmEpilogue& epilogue) {
+  if (sample.rank() != 4 || sample.n() != 1) {
+    throw invalid_input("implicit GEMM: expected one NCHW sample, got shape " + to_string(sample.shape()));
+  }
+  const auto channels = static_cast<std::size_t>(sample.c());
+  const std::size_t depth = channels * static_cast<std::size_t>(g.kernel_h * g.kernel_w);
+  if (weights.depth != depth) {
+    throw invalid_input("implicit GEMM: the weights have depth " + std::to_string(weights.depth) + ", the input's " +
+                        std::to_string(channels) + " channels and " + std::to_string(g.kernel_h) + "×" +
+                        std::to_string(g.kernel_w) + " window " + std::to_string(depth));
+  }
+  if (!implicit_gemm_eligible(queue.device().info(), depth)) {
+    throw invalid_input("implicit GEMM: a panel of depth " + std::to_string(depth) + " does not fit the local memory of " +
+                        queue.device().info().name);
+  }
+  const std::size_t m = weights.lines;
+  const std::size_t pixels = static_cast<std::size_t>(g.out_h) * static_cast<std::size_t>(g.out_w);
+  detail::check_gemm_operand("C", c, m, pixels);
+  const bool has_bias = epilogue.bias.defined();
+  if (has_bias && static_cast<std::size_t>(epilogue.bias.numel()) != m) {
+    throw invalid_input("implicit GEMM: the bias has " + std::to_string(epilogue.bias.numel()) + " values for " +
+                        std::to_string(m) + " rows");
+  }
+  if (epilogue.alpha != 1.0f || epilogue.beta != 0.0f) {
+    throw invalid_input("implicit GEMM: only alpha = 1, beta = 0 (a convolution's output is written, not accumulated)");
+  }
+  Kernel& kernel = queue.kernel("conv2d_implicit", "conv2d_implicit",
+                                KernelDefines()
+                                    .add("MR", weights.width)
+                                    .add("DEPTH", static_cast<std::int64_t>(depth))
+                                    .add("KH", g.kernel_h)
+                                    .add("KW", g.kernel_w)
+                                    .add("STRIDE", g.stride)
+                                    .add("PAD", g.padding)
+                                    .add("HAS_BIAS", has_bias)
+                                    .add(activation_defines(epilogue.activation)));
+  // Without a bias the kernel never reads its bias argument; any valid buffer will do.
+  const cl_mem bias_buffer = has_bias ? epilogue.bias.buffer() : c.buffer;
+  const int bias_offset = has_bias ? epilogue.bias.offset_int() : 0;
+  kernel.set_args(sample, weights.data, bias_buffer, bias_offset, c.buffer, to_int(c.offset, "offset of C"),
+                  to_int(c.leading_dimension, "ldc"), static_cast<int>(channels), static_cast<int>(sample.h()),
+                  static_cast<int>(sample.w()), g.out_h, g.out_w, to_int(m, "m"));
+  queue.launch(kernel, Range((pixels + kPackedColumns - 1) / kPackedColumns), Range(1));
+}
+
 void gemm_packed(Queue& queue, const PackedPanels& a, const PackedPanels& b, const MatrixView& c,
                  const GemmEpilogue& epilogue, int panels_first) {
   if (a.depth != b.depth) {

@@ -19,6 +19,7 @@
 
 #include "inertialnet/ops/activation.hpp"
 #include "inertialnet/ops/gemm/gemm.hpp"
+#include "inertialnet/runtime/device_info.hpp"
 #include "inertialnet/runtime/queue.hpp"
 #include "inertialnet/runtime/tensor.hpp"
 
@@ -97,6 +98,24 @@ struct GemmEpilogue {
   Tensor bias;
   ActivationSpec activation{};
 };
+
+// The implicit GEMM of a convolution (kernels_cl/conv2d_implicit.cl): each work-item builds the B
+// panel of 32 output pixels in its work-group's local memory (im2col_panels' fill) and multiplies
+// every A panel with it, so that the column matrix is never written. It pays where A has few
+// panels (a separate im2col pass writes k floats a pixel, then read back for a few products
+// each): preferred for at most kImplicitGemmMaxRows rows and a panel of at most
+// kImplicitGemmMaxPanelBytes (kept in the core's cache while every A panel passes it), on a
+// device whose local memory holds the panel twice over.
+inline constexpr std::size_t kImplicitGemmMaxRows = 64;
+inline constexpr std::size_t kImplicitGemmMaxPanelBytes = 128 * 1024;
+// Whether the device can run the form for a reduction of `depth` (its panel fits local memory).
+bool implicit_gemm_eligible(const DeviceInfo& device, std::size_t depth);
+bool implicit_gemm_preferred(const DeviceInfo& device, std::size_t rows, std::size_t depth);
+// C (the m×pixels view of one output sample; m = weights.lines) = the epilogue of the product of
+// the packed weights (depth ci·kh·kw) with the im2col columns of `sample`. Throws invalid_input
+// where implicit_gemm_eligible() does not hold or the shapes disagree.
+void conv2d_implicit_gemm(Queue& queue, const PackedPanels& weights, const Tensor& sample,
+                          const Im2colGeometry& geometry, const MatrixView& c, const GemmEpilogue& epilogue);
 
 // C (m×n view, m = a.lines, n = b.lines) from packed operands of equal depth. `panels_first`
 // (0 or 1) forces that build option; −1 takes packed_gemm_panels_first().
