@@ -28,6 +28,7 @@ struct PackedCase {
   std::size_t pad = 0;     // extra columns in C's leading dimension (a strided view)
   std::size_t offset = 0;  // elements before C's view
   float alpha = 1.0f, beta = 0.0f;
+  std::size_t depth_block = 0;  // forced blocks of the depth (0: the rule, packed_gemm_depth_block)
 };
 void PrintTo(const PackedCase& c, std::ostream* os) { *os << c.name; }
 
@@ -56,7 +57,8 @@ void expect_packed_matches(const PackedCase& p) {
   if (p.mr > 0) {
     EXPECT_EQ(pa.width, p.mr);
   }
-  gemm_packed(queue, pa, pb, MatrixView::of(tc, ldc, p.offset), GemmEpilogue{p.alpha, p.beta, tbias, p.activation});
+  gemm_packed(queue, pa, pb, MatrixView::of(tc, ldc, p.offset), GemmEpilogue{p.alpha, p.beta, tbias, p.activation}, -1,
+              p.depth_block);
 
   reference::gemm(p.ta, p.tb, p.m, p.n, p.k, p.alpha, a, 0, a_cols, b, 0, b_cols, p.beta, c, p.offset, ldc);
   for (std::size_t i = 0; i < p.m; ++i) {
@@ -114,6 +116,37 @@ INSTANTIATE_TEST_SUITE_P(
                       PackedCase{"alpha_beta_low_half", 17, 45, 29, 0, true, false, true, kLeaky, 3, 5, 1.5f, 0.5f}),
     [](const ::testing::TestParamInfo<PackedCase>& info) { return std::string(info.param.name); });
 
+// Products over blocks of the depth, each adding into C: alpha and beta only once, the bias and the
+// activation only with the last block (a leaky ReLU applied to a partial sum, or a bias added
+// twice, fails), blocks that divide k and a partial last one, the low-half panel, a strided view,
+// a transposed A, the narrowest tile.
+INSTANTIATE_TEST_SUITE_P(
+    DepthBlocks, PackedGemmShapes,
+    ::testing::Values(PackedCase{"blocks_of_16", 29, 70, 64, 0, false, false, true, kLeaky, 0, 0, 1.0f, 0.0f, 16},
+                      PackedCase{"blocks_partial_alpha_beta", 17, 45, 100, 0, false, false, true, kLeaky, 3, 5, 1.5f,
+                                 0.5f, 48},
+                      PackedCase{"blocks_transposed_a", 33, 65, 47, 0, true, false, true, kRelu, 0, 0, 1.0f, 0.0f, 16},
+                      PackedCase{"blocks_mr1", 5, 40, 21, 1, false, false, false, kLeaky, 0, 0, -0.5f, 2.0f, 8}),
+    [](const ::testing::TestParamInfo<PackedCase>& info) { return std::string(info.param.name); });
+
+// Where the rule blocks the depth: FlowNet2's deep layers on small images (512×384), whose weights
+// are streamed from memory while all of B does not stay in cache; not where A is small, B fits, or
+// the blocks would be short.
+TEST(PackedGemm, DepthBlockRule) {
+  EXPECT_EQ(packed_gemm_depth_block(1024, 48, 9216), 3072u);  // conv6_1: B 2.4 MB, three blocks
+  EXPECT_EQ(packed_gemm_depth_block(1024, 48, 4608), 2304u);  // conv6: B 1.2 MB, two blocks
+  EXPECT_EQ(packed_gemm_depth_block(512, 192, 4608), 928u);   // conv5_1 (six B panels): five
+  EXPECT_EQ(packed_gemm_depth_block(8192, 48, 1024), 1024u);  // deconv5: B 256 KiB fits
+  EXPECT_EQ(packed_gemm_depth_block(1024, 1024, 1024), 1024u);  // A 4 MiB: not streamed
+  EXPECT_EQ(packed_gemm_depth_block(512, 768, 4608), 4608u);  // conv4_1: blocks of 243, too short
+  for (const std::size_t k : {4609u, 9217u, 20000u}) {
+    const std::size_t block = packed_gemm_depth_block(1024, 48, k);
+    EXPECT_EQ(block % 16, 0u);
+    EXPECT_LE(2 * kPackedColumns * block * sizeof(float), kPackedDepthBlockBytes);
+    EXPECT_GE(block, kPackedMinDepthBlock);
+  }
+}
+
 // FlowNet2's GEMM shapes at 512×384 (M output channels, K input channels × kernel area) with the
 // real M and K; N, the output pixels, only counts tiles, so a few odd tiles keep the reference
 // quick. conv6_1 runs at its full N.
@@ -125,6 +158,7 @@ INSTANTIATE_TEST_SUITE_P(
                       PackedCase{"conv3_5x5s2", 256, 45, 3200, 0, false, false, true, kLeaky},
                       PackedCase{"fusion_inter_conv0", 16, 97, 738, 0, false, false, true},
                       PackedCase{"fusion_inter_conv1", 32, 97, 1458, 0, false, false, true},
+                      // In three blocks of the depth (DepthBlockRule).
                       PackedCase{"conv6_1", 1024, 48, 9216, 0, false, false, true, kLeaky},
                       PackedCase{"predict_flow2", 2, 97, 1746, 0, false, false, true},
                       PackedCase{"deconv5_transposed", 8192, 12, 1024, 0, true, false}),

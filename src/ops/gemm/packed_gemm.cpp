@@ -224,8 +224,17 @@ void conv2d_implicit_gemm(Queue& queue, const PackedPanels& weights, const Tenso
   queue.launch(kernel, Range((pixels + kPackedColumns - 1) / kPackedColumns), Range(1));
 }
 
+std::size_t packed_gemm_depth_block(std::size_t m, std::size_t n, std::size_t k) {
+  const std::size_t column_panels = (n + kPackedColumns - 1) / kPackedColumns;
+  const std::size_t b_bytes = column_panels * kPackedColumns * k * sizeof(float);
+  if (m * k * sizeof(float) < kPackedStreamedOperandBytes || b_bytes <= kPackedDepthBlockBytes) return k;
+  const std::size_t blocks = (b_bytes + kPackedDepthBlockBytes - 1) / kPackedDepthBlockBytes;
+  const std::size_t block = ((k + blocks - 1) / blocks + 15) / 16 * 16;
+  return block < kPackedMinDepthBlock ? k : block;
+}
+
 void gemm_packed(Queue& queue, const PackedPanels& a, const PackedPanels& b, const MatrixView& c,
-                 const GemmEpilogue& epilogue, int panels_first) {
+                 const GemmEpilogue& epilogue, int panels_first, std::size_t depth_block) {
   if (a.depth != b.depth) {
     throw invalid_input("packed GEMM: A has depth " + std::to_string(a.depth) + ", B " + std::to_string(b.depth));
   }
@@ -237,24 +246,35 @@ void gemm_packed(Queue& queue, const PackedPanels& a, const PackedPanels& b, con
     throw invalid_input("packed GEMM: the bias has " + std::to_string(epilogue.bias.numel()) + " values for " +
                         std::to_string(m) + " rows");
   }
-  const bool has_beta = epilogue.beta != 0.0f;
-  if (panels_first != 0 && panels_first != 1) panels_first = packed_gemm_panels_first(queue.device(), m, n, k);
-  Kernel& kernel = queue.kernel("gemm_packed", "gemm_packed",
-                                KernelDefines()
-                                    .add("MR", a.width)
-                                    .add("PANELS_FIRST", panels_first)
-                                    .add("HAS_BIAS", has_bias)
-                                    .add("HAS_BETA", has_beta)
-                                    .add(activation_defines(epilogue.activation)));
-  // Without a bias the kernel never reads its bias argument; any valid buffer will do.
-  const cl_mem bias_buffer = has_bias ? epilogue.bias.buffer() : c.buffer;
-  const int bias_offset = has_bias ? epilogue.bias.offset_int() : 0;
-  kernel.set_args(a.data, b.data, c.buffer, to_int(c.offset, "offset of C"), to_int(c.leading_dimension, "ldc"),
-                  bias_buffer, bias_offset, to_int(m, "m"), to_int(n, "n"), to_int(k, "k"), epilogue.alpha,
-                  epilogue.beta);
+  const std::size_t block = std::min(k, depth_block > 0 ? depth_block : packed_gemm_depth_block(m, n, k));
+  if (panels_first != 0 && panels_first != 1) {
+    panels_first = block < k ? 0 : packed_gemm_panels_first(queue.device(), m, n, k);
+  }
   const std::size_t row_panels = a.panels(), column_panels = b.panels();
   const Range global = panels_first ? Range(row_panels, column_panels) : Range(column_panels, row_panels);
-  queue.launch(kernel, global, Range(1, 1));
+  for (std::size_t first = 0; first < k; first += block) {
+    const std::size_t count = std::min(block, k - first);
+    const bool opening = first == 0, closing = first + count == k;
+    // The first block stores alpha·A·B + beta·C, the others add theirs (beta = 1); the last one
+    // adds the bias and applies the activation.
+    const float beta = opening ? epilogue.beta : 1.0f;
+    const bool bias = closing && has_bias;
+    Kernel& kernel = queue.kernel("gemm_packed", "gemm_packed",
+                                  KernelDefines()
+                                      .add("MR", a.width)
+                                      .add("PANELS_FIRST", panels_first)
+                                      .add("HAS_BIAS", bias)
+                                      .add("HAS_BETA", beta != 0.0f)
+                                      .add(activation_defines(closing ? epilogue.activation : ActivationSpec::none())));
+    // Without a bias the kernel never reads its bias argument; any valid buffer will do.
+    const cl_mem bias_buffer = bias ? epilogue.bias.buffer() : c.buffer;
+    const int bias_offset = bias ? epilogue.bias.offset_int() : 0;
+    kernel.set_args(a.data.buffer(), to_int(a.data.offset() + first * static_cast<std::size_t>(a.width), "offset of A"),
+                    b.data.buffer(), to_int(b.data.offset() + first * kPackedColumns, "offset of B"), c.buffer,
+                    to_int(c.offset, "offset of C"), to_int(c.leading_dimension, "ldc"), bias_buffer, bias_offset,
+                    to_int(m, "m"), to_int(n, "n"), to_int(count, "k"), to_int(k, "k"), epilogue.alpha, beta);
+    queue.launch(kernel, global, Range(1, 1));
+  }
 }
 
 void gemv(Queue& queue, std::size_t rows, std::size_t depth, const MatrixView& w, const Tensor& x, const Tensor& y,
