@@ -40,6 +40,25 @@ bool is_candidate(const char* name, int value) {
   return false;
 }
 
+// A per-row bias (a layer's output channels) must hold one value per row of the product.
+void check_row_bias(const char* op, const Tensor& bias, std::size_t rows) {
+  if (bias.defined() && static_cast<std::size_t>(bias.numel()) != rows) {
+    throw invalid_input(std::string(op) + ": the bias has " + std::to_string(bias.numel()) + " values for " +
+                        std::to_string(rows) + " rows");
+  }
+}
+
+// The bias arguments (buffer, element offset) of a packed kernel that stores a tile into C: the
+// bias where the kernel is built with HAS_BIAS (`used`), else C's buffer (never read; any valid
+// buffer will do).
+struct BiasArguments {
+  cl_mem buffer;
+  int offset;
+};
+BiasArguments bias_arguments(const Tensor& bias, bool used, const MatrixView& c) {
+  return used ? BiasArguments{bias.buffer(), bias.offset_int()} : BiasArguments{c.buffer, 0};
+}
+
 // The destination of a packing: `into` when it is large enough, else a new tensor.
 Tensor panel_storage(Queue& queue, Device* long_lived, std::size_t floats, const Tensor& into) {
   if (into.defined() && into.buffer_floats() >= into.offset() + floats) return into;
@@ -62,6 +81,9 @@ PackedPanels pack(Queue& queue, std::size_t lines, std::size_t depth, int width,
                Range(std::min<std::size_t>(padded, kColumns), 1));
   return packed;
 }
+
+// The implicit GEMM's B panel in local memory: 32 columns of `depth` floats.
+std::size_t implicit_panel_bytes(std::size_t depth) { return depth * kPackedColumns * sizeof(float); }
 
 }  // namespace
 
@@ -169,12 +191,11 @@ PackedPanels im2col_panels(Queue& queue, const Tensor& sample, const Im2colGeome
 }
 
 bool implicit_gemm_eligible(const DeviceInfo& device, std::size_t depth) {
-  const std::size_t panel_bytes = depth * kPackedColumns * sizeof(float);
-  return depth > 0 && 2 * panel_bytes <= device.local_memory_bytes;
+  return depth > 0 && 2 * implicit_panel_bytes(depth) <= device.local_memory_bytes;
 }
 
 bool implicit_gemm_preferred(const DeviceInfo& device, std::size_t rows, std::size_t depth) {
-  return rows <= kImplicitGemmMaxRows && depth * kPackedColumns * sizeof(float) <= kImplicitGemmMaxPanelBytes &&
+  return rows <= kImplicitGemmMaxRows && implicit_panel_bytes(depth) <= kImplicitGemmMaxPanelBytes &&
          implicit_gemm_eligible(device, depth);
 }
 
@@ -197,11 +218,8 @@ void conv2d_implicit_gemm(Queue& queue, const PackedPanels& weights, const Tenso
   const std::size_t m = weights.lines;
   const std::size_t pixels = static_cast<std::size_t>(g.out_h) * static_cast<std::size_t>(g.out_w);
   detail::check_gemm_operand("C", c, m, pixels);
+  check_row_bias("implicit GEMM", epilogue.bias, m);
   const bool has_bias = epilogue.bias.defined();
-  if (has_bias && static_cast<std::size_t>(epilogue.bias.numel()) != m) {
-    throw invalid_input("implicit GEMM: the bias has " + std::to_string(epilogue.bias.numel()) + " values for " +
-                        std::to_string(m) + " rows");
-  }
   if (epilogue.alpha != 1.0f || epilogue.beta != 0.0f) {
     throw invalid_input("implicit GEMM: only alpha = 1, beta = 0 (a convolution's output is written, not accumulated)");
   }
@@ -215,10 +233,8 @@ void conv2d_implicit_gemm(Queue& queue, const PackedPanels& weights, const Tenso
                                     .add("PAD", g.padding)
                                     .add("HAS_BIAS", has_bias)
                                     .add(activation_defines(epilogue.activation)));
-  // Without a bias the kernel never reads its bias argument; any valid buffer will do.
-  const cl_mem bias_buffer = has_bias ? epilogue.bias.buffer() : c.buffer;
-  const int bias_offset = has_bias ? epilogue.bias.offset_int() : 0;
-  kernel.set_args(sample, weights.data, bias_buffer, bias_offset, c.buffer, to_int(c.offset, "offset of C"),
+  const BiasArguments bias = bias_arguments(epilogue.bias, has_bias, c);
+  kernel.set_args(sample, weights.data, bias.buffer, bias.offset, c.buffer, to_int(c.offset, "offset of C"),
                   to_int(c.leading_dimension, "ldc"), static_cast<int>(channels), static_cast<int>(sample.h()),
                   static_cast<int>(sample.w()), g.out_h, g.out_w, to_int(m, "m"));
   queue.launch(kernel, Range((pixels + kPackedColumns - 1) / kPackedColumns), Range(1));
@@ -241,11 +257,8 @@ void gemm_packed(Queue& queue, const PackedPanels& a, const PackedPanels& b, con
   if (b.width != kColumns) throw invalid_input("packed GEMM: B must be packed in panels of 32 columns");
   const std::size_t m = a.lines, n = b.lines, k = a.depth;
   detail::check_gemm_operand("C", c, m, n);
+  check_row_bias("packed GEMM", epilogue.bias, m);
   const bool has_bias = epilogue.bias.defined();
-  if (has_bias && static_cast<std::size_t>(epilogue.bias.numel()) != m) {
-    throw invalid_input("packed GEMM: the bias has " + std::to_string(epilogue.bias.numel()) + " values for " +
-                        std::to_string(m) + " rows");
-  }
   const std::size_t block = std::min(k, depth_block > 0 ? depth_block : packed_gemm_depth_block(m, n, k));
   if (panels_first != 0 && panels_first != 1) {
     panels_first = block < k ? 0 : packed_gemm_panels_first(queue.device(), m, n, k);
@@ -266,12 +279,10 @@ void gemm_packed(Queue& queue, const PackedPanels& a, const PackedPanels& b, con
                                       .add("HAS_BIAS", bias)
                                       .add("HAS_BETA", beta != 0.0f)
                                       .add(activation_defines(closing ? epilogue.activation : ActivationSpec::none())));
-    // Without a bias the kernel never reads its bias argument; any valid buffer will do.
-    const cl_mem bias_buffer = bias ? epilogue.bias.buffer() : c.buffer;
-    const int bias_offset = bias ? epilogue.bias.offset_int() : 0;
+    const BiasArguments bias_args = bias_arguments(epilogue.bias, bias, c);
     kernel.set_args(a.data.buffer(), to_int(a.data.offset() + first * static_cast<std::size_t>(a.width), "offset of A"),
                     b.data.buffer(), to_int(b.data.offset() + first * kPackedColumns, "offset of B"), c.buffer,
-                    to_int(c.offset, "offset of C"), to_int(c.leading_dimension, "ldc"), bias_buffer, bias_offset,
+                    to_int(c.offset, "offset of C"), to_int(c.leading_dimension, "ldc"), bias_args.buffer, bias_args.offset,
                     to_int(m, "m"), to_int(n, "n"), to_int(count, "k"), to_int(k, "k"), epilogue.alpha, beta);
     queue.launch(kernel, global, Range(1, 1));
   }
@@ -287,11 +298,8 @@ void gemv(Queue& queue, std::size_t rows, std::size_t depth, const MatrixView& w
   if (static_cast<std::size_t>(y.numel()) != rows || !y.contiguous()) {
     throw invalid_input("GEMV: y must be " + std::to_string(rows) + " contiguous floats, got " + to_string(y.shape()));
   }
+  check_row_bias("GEMV", bias, rows);
   const bool has_bias = bias.defined();
-  if (has_bias && static_cast<std::size_t>(bias.numel()) != rows) {
-    throw invalid_input("GEMV: the bias has " + std::to_string(bias.numel()) + " values for " + std::to_string(rows) +
-                        " rows");
-  }
   if (layout == GemvLayout::Default) {
     layout = queue.device().info().type == DeviceType::CPU ? GemvLayout::RowPerWorkItem : GemvLayout::RowPerWorkGroup;
   }
