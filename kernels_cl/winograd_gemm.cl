@@ -103,8 +103,13 @@ __kernel void winograd_gemm(__global const float* restrict u, const int u_offset
     const int ty = tile0 / tiles_w, tx = tile0 - ty * tiles_w;
     const bool whole = lanes == 16 && tx + 16 <= tiles_w && 4 * (tx + 16) <= out_w && 4 * ty + 4 <= out_h;
     // SUBPIXEL: rows 4·o + 2·py and the next are the two column phases of one output row, stored
-    // together as 128 consecutive floats (MR even: a pair never straddles two work-items).
-    const int pair = SUBPIXEL && MR % 2 == 0 && whole ? 2 : 1;
+    // together as 128 consecutive floats (MR even: a pair never straddles two work-items; an odd
+    // MR stores each phase alone into every other pixel).
+#if SUBPIXEL && MR % 2 == 0
+    const int pair = whole ? 2 : 1;
+#else
+    const int pair = 1;
+#endif
     for (int r = 0; r < MR; r += pair) {
       const int o = row0 + r;
       if (o >= out_channels) break;

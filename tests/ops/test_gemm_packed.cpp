@@ -8,7 +8,6 @@
 #include <string>
 
 #include "inertialnet/ops/gemm/packed_gemm.hpp"
-#include "inertialnet/runtime/program_cache.hpp"
 #include "reference/conv.hpp"
 #include "reference/gemm.hpp"
 #include "support/testing.hpp"
@@ -193,24 +192,10 @@ TEST(Im2colPanels, ConvolutionByPixelRangesMatchesTheReference) {
 // warning on the user's terminal ("1 warning generated.", five times on a first FlowNet2 run), and
 // `STRIDE == 1 || STRIDE == 2` in C code was -Wconstant-logical-operand.
 TEST(Im2colPanels, CompilesWithoutWarnings) {
-  Device& device = testing::test_device();
-  const std::string_view source = embedded_kernel_source("pack_panels");
   for (const int stride : {1, 2, 3}) {
-    SCOPED_TRACE("STRIDE=" + std::to_string(stride));
-    const std::string options = "-DWIDTH=32 -DKH=3 -DKW=3 -DPAD=1 -DSTRIDE=" + std::to_string(stride);
-    const char* text = source.data();
-    const std::size_t length = source.size();
-    cl_int status = CL_SUCCESS;
-    cl_program program = clCreateProgramWithSource(device.context(), 1, &text, &length, &status);
-    ASSERT_EQ(status, CL_SUCCESS);
-    const cl_device_id id = device.id();
-    EXPECT_EQ(clBuildProgram(program, 1, &id, options.c_str(), nullptr, nullptr), CL_SUCCESS);
-    std::size_t size = 0;
-    clGetProgramBuildInfo(program, id, CL_PROGRAM_BUILD_LOG, 0, nullptr, &size);
-    std::string log(size, '\0');
-    clGetProgramBuildInfo(program, id, CL_PROGRAM_BUILD_LOG, size, log.data(), nullptr);
-    clReleaseProgram(program);
-    EXPECT_EQ(log.find("warning"), std::string::npos) << log;
+    const std::string log =
+        testing::kernel_build_log("pack_panels", "-DWIDTH=32 -DKH=3 -DKW=3 -DPAD=1 -DSTRIDE=" + std::to_string(stride));
+    EXPECT_EQ(log.find("warning"), std::string::npos) << "STRIDE=" << stride << ":\n" << log;
   }
 }
 

@@ -13,6 +13,7 @@
 
 #include "inertialnet/ops/conv_transpose2d.hpp"
 #include "inertialnet/ops/gemm/backend.hpp"
+#include "inertialnet/ops/gemm/packed_gemm.hpp"
 #include "inertialnet/ops/gemm/plan.hpp"
 #include "ops/winograd.hpp"
 #include "support/deconv_matches.hpp"
@@ -105,6 +106,35 @@ TEST(WinogradDeconv, ChannelSlicesTileRangesAndDeepLayers) {
   // size rule leaves that layer on the sub-pixel form; prepared without the size it runs here).
   expect_unsized_prepared_matches(deconv("deep_24x32", 390, 7, 24, 32, true, leaky));
   expect_prepared_matches(deconv("deep_odd", 400, 5, 33, 70, false, leaky), {1});
+}
+
+// The product's row panels follow the device's tuned MR (`inertialnet tune` may store any of the
+// packed GEMM's candidates): with an even MR the two column phases of an output row are stored
+// together, with an odd one (MR = 1) each phase alone into every other pixel. Each form on rows of
+// whole tiles (w64_h25) and partial ones (odd_37x45), and panels that end mid-channel (co = 5:
+// 20 rows in panels of 6 or 12).
+TEST(WinogradDeconv, AnyTileRowsOfTheDevicesTuning) {
+  const auto leaky = ActivationSpec::leaky_relu(0.1f);
+  for (const int mr : {1, 2, 6, 12}) {
+    SCOPED_TRACE("MR " + std::to_string(mr));
+    const testing::ScopedPackedTuning tuning({{"MR", mr}});
+    ASSERT_EQ(packed_gemm_setting(testing::test_device(), "MR"), mr);
+    expect_prepared_matches(deconv("w64_h25", 32, 4, 25, 64, false, ActivationSpec::relu()), {2});
+    expect_prepared_matches(deconv("odd_37x45", 33, 5, 37, 45, true, leaky), {1});
+  }
+}
+
+// PoCL prints a compiler warning on every first compile; the product's store has none for either
+// form and either parity of MR.
+TEST(WinogradDeconv, ProductCompilesWithoutWarnings) {
+  for (const int subpixel : {0, 1}) {
+    for (const int mr : {1, 14}) {
+      const std::string options = "-DMR=" + std::to_string(mr) + " -DSUBPIXEL=" + std::to_string(subpixel) +
+                                  " -DHAS_BIAS=1 -DACTIVATION=2 -DNEGATIVE_SLOPE=0.1f";
+      const std::string log = testing::kernel_build_log("winograd_gemm", options);
+      EXPECT_EQ(log.find("warning"), std::string::npos) << options << ":\n" << log;
+    }
+  }
 }
 
 TEST(WinogradDeconv, OnlyFourByFourStrideTwoPaddingOneOfEnoughChannelsQualifies) {

@@ -10,6 +10,9 @@
 #include <map>
 #include <memory>
 #include <sstream>
+#include <string_view>
+
+#include "inertialnet/runtime/program_cache.hpp"
 
 namespace inertialnet::testing {
 
@@ -23,6 +26,36 @@ Device& test_device() {
 }
 
 Queue& test_queue() { return test_device().queue(); }
+
+std::string kernel_build_log(const std::string& family, const std::string& options) {
+  Device& device = test_device();
+  const std::string_view source = embedded_kernel_source(family);
+  const char* text = source.data();
+  const std::size_t length = source.size();
+  cl_int status = CL_SUCCESS;
+  cl_program program = clCreateProgramWithSource(device.context(), 1, &text, &length, &status);
+  if (status != CL_SUCCESS) {
+    ADD_FAILURE() << family << ": clCreateProgramWithSource returned " << status;
+    return "";
+  }
+  const cl_device_id id = device.id();
+  const cl_int built = clBuildProgram(program, 1, &id, options.c_str(), nullptr, nullptr);
+  std::size_t size = 0;
+  clGetProgramBuildInfo(program, id, CL_PROGRAM_BUILD_LOG, 0, nullptr, &size);
+  std::string log(size, '\0');
+  clGetProgramBuildInfo(program, id, CL_PROGRAM_BUILD_LOG, size, log.data(), nullptr);
+  clReleaseProgram(program);
+  EXPECT_EQ(built, CL_SUCCESS) << family << " " << options << ":\n" << log;
+  return log;
+}
+
+ScopedPackedTuning::ScopedPackedTuning(const std::map<std::string, int>& packed) : saved_(test_device().tuning()) {
+  DeviceTuning tuning = saved_;
+  for (const auto& [name, value] : packed) tuning.packed[name] = value;
+  test_device().set_tuning(tuning);
+}
+
+ScopedPackedTuning::~ScopedPackedTuning() { test_device().set_tuning(saved_); }
 
 std::vector<float> random_vector(std::size_t count, std::uint32_t seed, float lo, float hi) {
   std::mt19937 generator(seed);

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <random>
 #include <string>
 #include <vector>
@@ -19,6 +20,25 @@ namespace inertialnet::testing {
 // Opened once per process.
 Device& test_device();
 Queue& test_queue();
+
+// Gives the test device the packed GEMM's build options `packed` (e.g. {"MR", 1}: any value
+// `inertialnet tune` may store) for the guard's lifetime; its own tuning comes back at the end.
+// For the kernels whose panels follow the device's MR.
+class ScopedPackedTuning {
+ public:
+  explicit ScopedPackedTuning(const std::map<std::string, int>& packed);
+  ~ScopedPackedTuning();
+  ScopedPackedTuning(const ScopedPackedTuning&) = delete;
+  ScopedPackedTuning& operator=(const ScopedPackedTuning&) = delete;
+
+ private:
+  DeviceTuning saved_;
+};
+
+// The build log of the kernel family `family` (kernels_cl/<family>.cl as embedded) compiled for
+// the test device with `options`; a failed build is a test failure. For the tests that keep the
+// kernels free of compiler warnings (PoCL prints them on every first compile).
+std::string kernel_build_log(const std::string& family, const std::string& options);
 
 // Uniform values in [lo, hi) from a fixed seed.
 std::vector<float> random_vector(std::size_t count, std::uint32_t seed, float lo = -1.0f, float hi = 1.0f);
