@@ -50,13 +50,18 @@ inline void output_tiles(__local const float* scratch, const int r, const int pa
   for (int i = 0; i < 4; ++i) transform_at16(a[i], y[i]);
 }
 
+// shuffle2 masks that interleave two vectors a, b element by element: a0 b0 a1 b1 … of their
+// low halves, and of their high halves.
+#define INTERLEAVE_LOW (uint16)(0, 16, 1, 17, 2, 18, 3, 19, 4, 20, 5, 21, 6, 22, 7, 23)
+#define INTERLEAVE_HIGH (uint16)(8, 24, 9, 25, 10, 26, 11, 27, 12, 28, 13, 29, 14, 30, 15, 31)
+
 // Row i of 16 tiles side by side (pixel q of tile j in lane j of y[q]) in pixel order 4·j + q, as
 // four vectors: pairs (q0, q1) and (q2, q3) interleaved, then pairs of pairs.
 inline void pixel_order(const float16* y, float16* p) {
-  const float16 lo01 = shuffle2(y[0], y[1], (uint16)(0, 16, 1, 17, 2, 18, 3, 19, 4, 20, 5, 21, 6, 22, 7, 23));
-  const float16 hi01 = shuffle2(y[0], y[1], (uint16)(8, 24, 9, 25, 10, 26, 11, 27, 12, 28, 13, 29, 14, 30, 15, 31));
-  const float16 lo23 = shuffle2(y[2], y[3], (uint16)(0, 16, 1, 17, 2, 18, 3, 19, 4, 20, 5, 21, 6, 22, 7, 23));
-  const float16 hi23 = shuffle2(y[2], y[3], (uint16)(8, 24, 9, 25, 10, 26, 11, 27, 12, 28, 13, 29, 14, 30, 15, 31));
+  const float16 lo01 = shuffle2(y[0], y[1], INTERLEAVE_LOW);
+  const float16 hi01 = shuffle2(y[0], y[1], INTERLEAVE_HIGH);
+  const float16 lo23 = shuffle2(y[2], y[3], INTERLEAVE_LOW);
+  const float16 hi23 = shuffle2(y[2], y[3], INTERLEAVE_HIGH);
   const uint16 first_half = (uint16)(0, 1, 16, 17, 2, 3, 18, 19, 4, 5, 20, 21, 6, 7, 22, 23);
   const uint16 second_half = (uint16)(8, 9, 24, 25, 10, 11, 26, 27, 12, 13, 28, 29, 14, 15, 30, 31);
   p[0] = shuffle2(lo01, lo23, first_half);
@@ -143,10 +148,8 @@ __kernel void winograd_gemm(__global const float* restrict u, const int u_offset
             float16 p1[4];
             pixel_order(y1[i], p1);
             for (int k = 0; k < 4; ++k) {  // pixel 2·m of the row from the first row, 2·m + 1 from the second
-              vstore16(shuffle2(p[k], p1[k], (uint16)(0, 16, 1, 17, 2, 18, 3, 19, 4, 20, 5, 21, 6, 22, 7, 23)), 0,
-                       dst + 32 * k);
-              vstore16(shuffle2(p[k], p1[k], (uint16)(8, 24, 9, 25, 10, 26, 11, 27, 12, 28, 13, 29, 14, 30, 15, 31)),
-                       0, dst + 32 * k + 16);
+              vstore16(shuffle2(p[k], p1[k], INTERLEAVE_LOW), 0, dst + 32 * k);
+              vstore16(shuffle2(p[k], p1[k], INTERLEAVE_HIGH), 0, dst + 32 * k + 16);
             }
           } else {
             float pixels[64];
