@@ -94,6 +94,22 @@ TEST(Conv2d, ImplicitGemmAtOddSizes) {
                       implicit);
 }
 
+// Its A panels, as the im2col GEMM's, follow the device's tuned MR: rows of 1, 6 and 14, with
+// partial last panels, at strides 1 and 2, into a channel slice.
+TEST(Conv2d, ImplicitAndIm2colGemmUnderAnyTileRowsOfTheDevicesTuning) {
+  const auto leaky = ActivationSpec::leaky_relu(0.1f);
+  for (const int mr : {1, 6, 14}) {
+    SCOPED_TRACE("MR " + std::to_string(mr));
+    const testing::ScopedPackedTuning tuning({{"MR", mr}});
+    for (const auto algorithm : {Conv2dAlgorithm::ImplicitGemm, Conv2dAlgorithm::Im2colGemm}) {
+      const testing::ConvRun run{algorithm};
+      expect_conv_matches({"k3s1_w32_co29", 6, 29, 9, 32, 3, 1, 1, true, leaky}, {2}, run);
+      expect_conv_matches({"k3s2_w64_co15", 5, 15, 11, 64, 3, 2, 1, false, ActivationSpec::relu()}, {1}, run);
+      expect_conv_matches({"slices", 6, 10, 13, 70, 3, 2, 1, true, leaky}, {3, 2, 3, 1, 4, 0}, run);
+    }
+  }
+}
+
 // Where the plan runs it: FlowNet2's few-channel layers at 512×384 (FlowNetC/S conv1, FlowNetSD
 // and FlowNetFusion conv0 and conv1), not the layers of 128 outputs or deep reductions; a panel
 // that does not fit a device's local memory is refused, on the plan and when forced.

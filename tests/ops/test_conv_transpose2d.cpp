@@ -153,6 +153,22 @@ TEST(ConvTranspose2d, SubPixelDirectOnOddSizesSlicesAndBothWalks) {
   }
 }
 
+// The forms' A panels follow the device's tuned MR (`inertialnet tune` may store any of the packed
+// GEMM's candidates): phases padded to whole panels of 1, 6 or 14 rows, the direct form's blocks
+// of 8 panels ending mid-phase, partial channel blocks, channel slices, under each form.
+TEST(ConvTranspose2d, EveryFormUnderAnyTileRowsOfTheDevicesTuning) {
+  const auto leaky = ActivationSpec::leaky_relu(0.1f);
+  for (const int mr : {1, 6, 14}) {
+    SCOPED_TRACE("MR " + std::to_string(mr));
+    const testing::ScopedPackedTuning tuning({{"MR", mr}});
+    for (const auto algorithm : {DeconvAlgorithm::SubPixelDirect, DeconvAlgorithm::SubPixel, DeconvAlgorithm::Col2im}) {
+      expect_deconv_matches({"deep_w13", 70, 21, 3, 13, 4, 2, 1, true, leaky}, {2, 0, 0, 0, 0, 0, algorithm});
+      expect_deconv_matches({"blocks_w65", 32, 16, 5, 65, 4, 2, 1, true, leaky}, {1, 0, 0, 0, 0, 0, algorithm});
+      expect_deconv_matches({"slice", 6, 10, 37, 23, 4, 2, 1, true, leaky}, {3, 2, 3, 5, 4, 0, algorithm});
+    }
+  }
+}
+
 // The direct form on FlowNet2's deep up-convolutions at their real size for a 512×384 input
 // (6×8, 12×16 and 24×32 inputs: every tile shape, many blocks of A panels and of channels)
 // against the reference.
