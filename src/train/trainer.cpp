@@ -144,7 +144,7 @@ LrSchedule parse_lr_schedule(const std::string& text) {
 }
 
 Trainer::Trainer(Device& device, const TrainerOptions& options)
-    : device_(device), options_(options), queue_(device.create_queue()) {
+    : options_(options), queue_(device.create_queue()) {
   options_.head.validate();
   if (options.epochs < 1 || options.batch < 1) throw invalid_input("training: epochs and batch must be at least 1");
   // The value quoted like the decay's and the momentum's below (`--lr nan` said only "must be positive").

@@ -147,7 +147,6 @@ class Trainer {
   double lr_for(int epoch) const;
   void step(Queue& queue, double lr);
 
-  Device& device_;
   TrainerOptions options_;
   std::unique_ptr<Queue> queue_;
   std::map<std::int64_t, std::unique_ptr<HeadBackprop>> heads_;  // by batch size
