@@ -42,15 +42,6 @@ std::uint64_t hash_bytes(const unsigned char* data, std::size_t size) {
   return detail::fnv1a64(std::string_view(reinterpret_cast<const char*>(data), size));
 }
 
-std::string build_log(cl_program program, cl_device_id device) {
-  std::size_t size = 0;
-  if (clGetProgramBuildInfo(program, device, CL_PROGRAM_BUILD_LOG, 0, nullptr, &size) != CL_SUCCESS) return {};
-  std::string log(size, '\0');
-  if (clGetProgramBuildInfo(program, device, CL_PROGRAM_BUILD_LOG, size, log.data(), nullptr) != CL_SUCCESS) return {};
-  while (!log.empty() && (log.back() == '\0' || log.back() == '\n' || log.back() == ' ')) log.pop_back();
-  return log;
-}
-
 // Auto means on everywhere. PoCL keeps its own kernel cache ($POCL_CACHE_DIR) and was reported
 // to recompile when asked for CL_PROGRAM_BINARIES, so this was measured (README.md, "Program
 // cache"): on PoCL 3.1 a second start with our binaries reached the first FlowNet2-C result in
@@ -59,6 +50,15 @@ std::string build_log(cl_program program, cl_device_id device) {
 bool decide_disk_cache(DiskCacheMode mode) { return mode != DiskCacheMode::Off; }
 
 }  // namespace
+
+std::string program_build_log(cl_program program, cl_device_id device) {
+  std::size_t size = 0;
+  if (clGetProgramBuildInfo(program, device, CL_PROGRAM_BUILD_LOG, 0, nullptr, &size) != CL_SUCCESS) return {};
+  std::string log(size, '\0');
+  if (clGetProgramBuildInfo(program, device, CL_PROGRAM_BUILD_LOG, size, log.data(), nullptr) != CL_SUCCESS) return {};
+  while (!log.empty() && (log.back() == '\0' || log.back() == '\n' || log.back() == ' ')) log.pop_back();
+  return log;
+}
 
 std::filesystem::path default_cache_directory() {
   if (env_set(kCacheDirEnvironmentVariable)) return std::getenv(kCacheDirEnvironmentVariable);
@@ -178,7 +178,7 @@ ProgramHandle ProgramCache::build(const std::string& name, const std::string& so
   check_cl(status, INERTIALNET_CL_NAME(clCreateProgramWithSource), ClSite{device_.name, name});
   status = clBuildProgram(program.get(), 1, &device_.device_id, options.c_str(), nullptr, nullptr);
   if (status != CL_SUCCESS) {
-    const std::string log = build_log(program.get(), device_.device_id);
+    const std::string log = program_build_log(program.get(), device_.device_id);
     throw runtime_error("OpenCL call clBuildProgram failed with " + cl_error_name(status) + " (" +
                         std::to_string(status) + ") on device '" + device_.name + "' for kernel family '" +
                         name + "' with options '" + options + "'. Build log:\n" +

@@ -40,10 +40,7 @@ std::string kernel_build_log(const std::string& family, const std::string& optio
   }
   const cl_device_id id = device.id();
   const cl_int built = clBuildProgram(program, 1, &id, options.c_str(), nullptr, nullptr);
-  std::size_t size = 0;
-  clGetProgramBuildInfo(program, id, CL_PROGRAM_BUILD_LOG, 0, nullptr, &size);
-  std::string log(size, '\0');
-  clGetProgramBuildInfo(program, id, CL_PROGRAM_BUILD_LOG, size, log.data(), nullptr);
+  const std::string log = program_build_log(program, id);
   clReleaseProgram(program);
   EXPECT_EQ(built, CL_SUCCESS) << family << " " << options << ":\n" << log;
   return log;

@@ -61,6 +61,9 @@ std::string_view embedded_kernel_source(std::string_view family);  // invalid_in
 // fnv1a64 over every embedded family's name and source, as 16 hex digits: another build of the
 // kernels has another stamp (the timed GEMM plans keep it, ops/gemm/plan_cache.hpp).
 const std::string& embedded_kernels_stamp();
+// The driver's build log of `program` for `device`, trailing blanks and NULs trimmed; "" when it
+// gives none. A failed build's error carries it; the tests read it for compiler warnings.
+std::string program_build_log(cl_program program, cl_device_id device);
 
 class ProgramCache {
  public:
