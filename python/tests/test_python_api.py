@@ -57,6 +57,15 @@ def test_missing_files_are_file_not_found_errors(tmp_path):
         assert error.value.filename == str(missing)
 
 
+def test_a_file_of_no_frame_format_is_a_value_error(tmp_path):
+    # "DICM" at byte 128 once sent the bytes to OpenCV's DICOM decoder, whose assert ended the
+    # interpreter; now they are refused before any decoder sees them.
+    damaged = tmp_path / "frame.png"
+    damaged.write_bytes(b"\x89PDO" + bytes(124) + b"DICM\x02\x00")
+    with pytest.raises(ValueError, match=r"frame\.png.* cannot be decoded: it is a DICOM file"):
+        inertialnet.read_image(damaged)
+
+
 def test_geometric_head_takes_the_batches_dis_flow_returns(sequence):
     seq = inertialnet.Sequence(sequence)
     t = seq.timestamps_ns

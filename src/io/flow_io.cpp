@@ -15,6 +15,8 @@
 
 #include "inertialnet/core/constants.hpp"
 #include "inertialnet/runtime/error.hpp"
+#include "inertialnet/runtime/log.hpp"
+#include "io/image_format.hpp"
 #include "io/input_file.hpp"
 #include "runtime/atomic_file.hpp"
 
@@ -351,15 +353,24 @@ std::vector<unsigned char> read_flow_bytes(const fs::path& path) {
   return bytes;
 }
 
+bool is_png(const std::vector<unsigned char>& bytes) {
+  return io_detail::image_format_of(bytes) == io_detail::ImageFormat::Png;
+}
+
 FlowField decode_kitti_flow_png(const fs::path& path, const std::vector<unsigned char>& bytes) {
+  // Only a PNG reaches OpenCV, whose other decoders (DICOM's) can end the process on bad bytes.
+  if (!is_png(bytes)) {
+    throw invalid_input("The KITTI flow file " + quoted(path) + " is not a PNG (its first bytes are not PNG's signature).");
+  }
   cv::Mat image;
   try {
-    if (!bytes.empty()) {
-      image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U, const_cast<unsigned char*>(bytes.data())),
-                           cv::IMREAD_UNCHANGED);
-    }
+    image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U, const_cast<unsigned char*>(bytes.data())),
+                         cv::IMREAD_UNCHANGED);
   } catch (const cv::Exception& e) {
-    throw invalid_input("The KITTI flow file " + quoted(path) + " cannot be decoded: " + e.what());
+    // OpenCV's text is an assertion with its source path: for -v only, our words for the user.
+    log_message(LogLevel::Debug, "OpenCV on " + quoted(path) + ": " + e.what());
+    throw invalid_input("The KITTI flow file " + quoted(path) +
+                        " cannot be decoded: OpenCV's PNG decoder refuses it (its own words are in the debug log, -v).");
   }
   if (image.empty()) throw invalid_input("The KITTI flow file " + quoted(path) + " is not a decodable PNG.");
   if (image.depth() != CV_16U || image.channels() != 3) {
@@ -378,11 +389,6 @@ FlowField decode_kitti_flow_png(const fs::path& path, const std::vector<unsigned
     }
   }
   return flow;
-}
-
-bool is_png(const std::vector<unsigned char>& bytes) {
-  static const unsigned char signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
-  return bytes.size() >= 8 && std::equal(signature, signature + 8, bytes.begin());
 }
 
 }  // namespace

@@ -17,6 +17,7 @@
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/runtime/log.hpp"
 #include "io/crc32.hpp"
+#include "io/image_format.hpp"
 #include "io/input_file.hpp"
 #include "io/image_mat.hpp"
 #include "io/third_party_log.hpp"
@@ -108,12 +109,9 @@ std::string png_corruption(const Bytes& bytes) {
   return {};
 }
 
-bool is_png(const Bytes& bytes) {
-  static const unsigned char png_signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
-  return bytes.size() >= 8 && std::equal(png_signature, png_signature + 8, bytes.begin());
-}
+bool is_png(const Bytes& bytes) { return io_detail::image_format_of(bytes) == io_detail::ImageFormat::Png; }
 
-bool is_jpeg(const Bytes& bytes) { return bytes.size() >= 3 && bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF; }
+bool is_jpeg(const Bytes& bytes) { return io_detail::image_format_of(bytes) == io_detail::ImageFormat::Jpeg; }
 
 // Width and height as the header of a PNG (IHDR) or JPEG (its SOF segment) gives them; 0 × 0
 // when the file is neither or the header is not found.
@@ -204,6 +202,14 @@ void to_planar_rgb(const cv::Mat& image, float divisor, HostImage& out) {
 HostImage load_rgb_image(const fs::path& path) { return decode_image_bytes(read_whole_file(path), quoted(path)); }
 
 HostImage decode_image_bytes(const std::vector<unsigned char>& bytes, const std::string& what) {
+  // Only our formats reach OpenCV: its other decoders (DICOM's above all) can end the process.
+  if (io_detail::image_format_of(bytes) == io_detail::ImageFormat::Unknown) {
+    const std::string looks = io_detail::foreign_image_format(bytes);
+    const std::string formats = io_detail::kReadableImageFormats;
+    throw invalid_input("The image " + what + " cannot be decoded: " +
+                        (looks.empty() ? "its first bytes are not those of a " + formats + " file."
+                                       : "it is " + looks + "; frames are " + formats + " files."));
+  }
   const std::string missing = truncation(bytes);
   if (!missing.empty()) throw invalid_input("The image " + what + " is truncated: " + missing + ".");
   if (is_png(bytes)) {
@@ -226,7 +232,7 @@ HostImage decode_image_bytes(const std::vector<unsigned char>& bytes, const std:
   }
   if (image.empty()) {
     throw invalid_input("The image " + what +
-                        " cannot be decoded: it is not in a format OpenCV reads, or it is corrupt.");
+                        " cannot be decoded: OpenCV's decoder gives no image, so its data is corrupt.");
   }
   return host_image_from_mat(image, what);
 }

@@ -427,6 +427,11 @@ TEST(KittiFlow, ReaderRefusesOtherImagesAndReadFlowFileKnowsBothFormats) {
   write_bytes(dir / "text.flo", {'h', 'e', 'l', 'l', 'o'});
   EXPECT_TRUE(contains(invalid_input_message([&] { read_flow_file(dir / "text.flo"); }), "neither a Middlebury"));
   EXPECT_TRUE(contains(invalid_input_message([&] { read_flow_file(dir / "missing.flo"); }), "does not exist"));
+  // A .png that is no PNG never reaches OpenCV (whose DICOM decoder aborts on "DICM" at byte 128).
+  std::vector<unsigned char> dicom(128, 0);
+  for (char c : std::string("DICM\x02\x00")) dicom.push_back(static_cast<unsigned char>(c));
+  write_bytes(dir / "dicom.png", dicom);
+  EXPECT_TRUE(contains(invalid_input_message([&] { read_kitti_flow_png(dir / "dicom.png"); }), "is not a PNG"));
   const FlowField flow = rotating_field(10, 9);
   write_flo(dir / "f.flo", flow);
   const FlowField back = read_flow_file(dir / "f.flo");

@@ -290,3 +290,37 @@ TEST_F(ImageIo, FolderOfEveryRecordedFormatDecodes) {
     }
   }
 }
+
+// Bytes of no frame format never reach OpenCV: its DICOM decoder (GDCM) abort()s the process on a
+// damaged file that has "DICM" at byte 128 — the fuzzer found one (tests/fuzz/regressions/image),
+// whatever its first bytes said, including a RIFF/WEBP header libwebp declines. Each is one
+// readable refusal naming the file, what it looks like and the formats we read; formats OpenCV
+// writes but frames are not (PAM, PFM) are refused the same way.
+TEST_F(ImageIo, ForeignFormatsAreRefusedBeforeOpenCVSeesThem) {
+  auto dicom_like = [](const std::string& head) {
+    std::string bytes = head;
+    bytes.resize(128, '\0');
+    return bytes + "DICM" + std::string("\x02\x00\x10\x00UI\x04\x00", 8);  // a cut data element
+  };
+  struct Case {
+    std::string name, bytes, expected;
+  };
+  std::vector<Case> cases = {
+      {"preamble.png", dicom_like(""), "it is a DICOM file (\"DICM\" at byte 128)"},
+      {"like_png.png", dicom_like("\x89PDO"), "it is a DICOM file"},
+      {"riff.webp", dicom_like(std::string("RIFF\x10\0\0\0WEBPVP8 ", 16)), "it is a DICOM file"},
+      {"anim.png", "GIF89a\x01\x00\x01\x00", "it is a GIF file"},
+      {"text.png", "this is not an image\n", "its first bytes are not those of a PNG, JPEG, BMP, TIFF"}};
+  std::vector<unsigned char> encoded;
+  if (cv::imencode(".pam", pattern_bgr8(), encoded)) cases.push_back({"f.pam", {encoded.begin(), encoded.end()}, "a PAM file"});
+  if (cv::imencode(".pfm", cv::Mat(3, 5, CV_32FC3, cv::Scalar(0.5, 0.25, 1.0)), encoded)) {
+    cases.push_back({"f.pfm", {encoded.begin(), encoded.end()}, "a PFM (float) file"});
+  }
+  for (const auto& c : cases) {
+    std::ofstream(dir / c.name, std::ios::binary).write(c.bytes.data(), static_cast<std::streamsize>(c.bytes.size()));
+    const std::string m = invalid_input_message([&] { load_rgb_image(dir / c.name); });
+    EXPECT_TRUE(contains(m, (dir / c.name).string()) && contains(m, "cannot be decoded") && contains(m, c.expected) &&
+                contains(m, "PNG, JPEG, BMP, TIFF, PNM (.pgm/.ppm/.pnm) or WebP"))
+        << c.name << ": " << m;
+  }
+}
