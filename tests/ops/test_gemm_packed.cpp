@@ -251,7 +251,7 @@ TEST(GemmBackend, DeterministicChoiceByDeviceTypeAndPlan) {
   DeviceInfo cpu, gpu;
   cpu.type = DeviceType::CPU;
   gpu.type = DeviceType::GPU;
-  EXPECT_EQ(gemm_backend(cpu, ""), GemmBackend::Packed);
+  EXPECT_EQ(gemm_backend(cpu, ""), GemmBackend::Winograd);  // the packed kernels, Winograd where it wins
   EXPECT_EQ(gemm_backend(gpu, ""), GemmBackend::CLBlast);
   EXPECT_EQ(gemm_backend(cpu, "clblast"), GemmBackend::CLBlast);
   EXPECT_EQ(gemm_backend(gpu, "packed"), GemmBackend::Packed);

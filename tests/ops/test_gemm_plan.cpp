@@ -111,11 +111,11 @@ TEST(GemmPlanCache, PlansOfAnotherBuildOfTheKernelsAreIgnored) {
 TEST(GemmPlan, CandidatesStartWithTheDeterministicChoice) {
   const auto cpu = gemm_candidates(fake_device("1.0"));
   ASSERT_GE(cpu.size(), 2u);
-  EXPECT_EQ(cpu.front(), GemmBackend::Packed);
+  EXPECT_EQ(cpu.front(), GemmBackend::Winograd);
   DeviceInfo gpu = fake_device("1.0");
   gpu.type = DeviceType::GPU;
   EXPECT_EQ(gemm_candidates(gpu).front(), GemmBackend::CLBlast);
-  EXPECT_EQ(gemm_backend(fake_device("1.0"), "auto"), GemmBackend::Packed);
+  EXPECT_EQ(gemm_backend(fake_device("1.0"), "auto"), GemmBackend::Winograd);
   {
     ScopedPlan plan("auto");
     EXPECT_TRUE(gemm_plan_timed());

@@ -12,7 +12,8 @@ void add_global_options(CLI::App& app, GlobalOptions& global) {
   app.add_flag("--no-cache", global.no_cache, "do not read or write the on-disk caches (programs, GEMM plans, tuning)")
       ->group(kGlobalGroup);
   app.add_option("--plan", global.plan,
-                 "GEMM backend of every layer: auto times the candidates (env INERTIALNET_PLAN)")
+                 "GEMM backend of every layer (default: winograd on CPUs, clblast elsewhere; packed uses the least "
+                 "memory); auto times the candidates (env INERTIALNET_PLAN)")
       ->transform(choice("plan", {"clblast", "packed", "winograd", "auto"}))
       ->group(kGlobalGroup);
   auto* quiet = app.add_flag("-q,--quiet", global.quiet, "only warnings and errors on stderr; no progress line")

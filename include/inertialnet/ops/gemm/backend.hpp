@@ -13,7 +13,8 @@
 //
 // Without timing the choice is deterministic: $INERTIALNET_PLAN=clblast|packed|winograd forces
 // one backend everywhere (tests run every suite under each; `bench` compares them), otherwise CPU
-// devices use the packed kernels and every other device CLBlast.
+// devices use the winograd plan (the packed kernels, Winograd where it wins) and every other
+// device CLBlast. `packed` is the plan of the least memory on a CPU.
 //
 // $INERTIALNET_PLAN=auto opts in to timing: each GEMM layer of a model times every candidate of
 // gemm_candidates() on its real shape when the model is prepared and keeps the fastest, cached
