@@ -84,8 +84,8 @@ class TableBuilder {
   void add(const std::string& layer, std::vector<int64_t> shape, LayerKind kind, int64_t fan_in, double gain,
            bool bias) {
     const int64_t bias_size = kind == LayerKind::ConvTranspose2d ? shape[1] : shape[0];
-    specs_.push_back({prefix_ + layer + ".weight", std::move(shape), kind, false, fan_in, gain});
-    if (bias) specs_.push_back({prefix_ + layer + ".bias", {bias_size}, kind, true, fan_in, gain});
+    specs_.push_back({{prefix_ + layer + ".weight", std::move(shape)}, kind, false, fan_in, gain});
+    if (bias) specs_.push_back({{prefix_ + layer + ".bias", {bias_size}}, kind, true, fan_in, gain});
   }
 
   std::string prefix_;

@@ -51,7 +51,7 @@ std::vector<float> synthetic_tensor(const ParameterSpec& spec, uint64_t seed) {
 std::vector<HostTensor> synthetic_weights(ModelKind kind, uint64_t seed, const HeadConfig& head) {
   std::vector<HostTensor> tensors;
   for (const auto& spec : model_parameters(kind, head)) {
-    tensors.push_back({spec.name, spec.shape, synthetic_tensor(spec, seed)});
+    tensors.push_back({{spec.name, spec.shape}, synthetic_tensor(spec, seed)});
   }
   return tensors;
 }

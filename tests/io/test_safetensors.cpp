@@ -106,10 +106,10 @@ void expect_invalid_input(const std::function<void()>& f, std::initializer_list<
 TEST_F(SafetensorsTest, RoundTripKeepsNamesShapesValuesAndMetadata) {
   const std::string p = path("round.safetensors");
   std::vector<HostTensor> tensors = {
-      {"z.first", {2, 3}, {1.0f, -2.5f, 3.25f, std::numeric_limits<float>::denorm_min(), -0.0f, 1e30f}},
-      {"a.second", {3}, {7.0f, 8.0f, 9.0f}},
-      {"scalar", {}, {42.0f}},
-      {"empty", {0, 4}, {}},
+      {{"z.first", {2, 3}}, {1.0f, -2.5f, 3.25f, std::numeric_limits<float>::denorm_min(), -0.0f, 1e30f}},
+      {{"a.second", {3}}, {7.0f, 8.0f, 9.0f}},
+      {{"scalar", {}}, {42.0f}},
+      {{"empty", {0, 4}}, {}},
   };
   write_safetensors(p, tensors, {{"inertialnet.model", "FlowNet2-C"}, {"note", "ünïcode"}});
 
@@ -140,9 +140,9 @@ TEST_F(SafetensorsTest, RoundTripKeepsNamesShapesValuesAndMetadata) {
 // Weight files given together: the first that carries the key answers, with its path.
 TEST_F(SafetensorsTest, FindMetadataSearchesTheFilesInOrder) {
   const std::string a = path("a.safetensors"), b = path("b.safetensors"), c = path("c.safetensors");
-  write_safetensors(a, std::vector<HostTensor>{{"x", {1}, {1.0f}}});
-  write_safetensors(b, std::vector<HostTensor>{{"y", {1}, {2.0f}}}, {{"key", "from b"}});
-  write_safetensors(c, std::vector<HostTensor>{{"z", {1}, {3.0f}}}, {{"key", "from c"}});
+  write_safetensors(a, std::vector<HostTensor>{{{"x", {1}}, {1.0f}}});
+  write_safetensors(b, std::vector<HostTensor>{{{"y", {1}}, {2.0f}}}, {{"key", "from b"}});
+  write_safetensors(c, std::vector<HostTensor>{{{"z", {1}}, {3.0f}}}, {{"key", "from c"}});
   const auto found = find_metadata({a, b, c}, "key");
   ASSERT_TRUE(found.has_value());
   EXPECT_EQ(found->path, b);
@@ -157,9 +157,9 @@ TEST_F(SafetensorsTest, FindMetadataSearchesTheFilesInOrder) {
 // does not open is refused as it is by path.
 TEST_F(SafetensorsTest, FindMetadataInOpenFilesAnswersAsByPath) {
   const std::string a = path("a.safetensors"), b = path("b.safetensors"), c = path("c.safetensors");
-  write_safetensors(a, std::vector<HostTensor>{{"x", {1}, {1.0f}}});
-  write_safetensors(b, std::vector<HostTensor>{{"y", {1}, {2.0f}}}, {{"key", "from b"}});
-  write_safetensors(c, std::vector<HostTensor>{{"z", {1}, {3.0f}}}, {{"key", "from c"}});
+  write_safetensors(a, std::vector<HostTensor>{{{"x", {1}}, {1.0f}}});
+  write_safetensors(b, std::vector<HostTensor>{{{"y", {1}}, {2.0f}}}, {{"key", "from b"}});
+  write_safetensors(c, std::vector<HostTensor>{{{"z", {1}}, {3.0f}}}, {{"key", "from c"}});
   const std::vector<SafetensorsFile> files = open_safetensors({a, b, c});
   ASSERT_EQ(files.size(), 3u);
   EXPECT_EQ(files[0].path(), a);
@@ -182,7 +182,7 @@ TEST_F(SafetensorsTest, WriterPadsHeaderWithSpacesToAMultipleOfEight) {
   // Try several name lengths so that at least one header needs padding.
   for (int extra = 0; extra < 8; ++extra) {
     const std::string p = path("pad" + std::to_string(extra) + ".safetensors");
-    write_safetensors(p, std::vector<HostTensor>{{"t" + std::string(extra, 'x'), {1}, {1.5f}}});
+    write_safetensors(p, std::vector<HostTensor>{{{"t" + std::string(extra, 'x'), {1}}, {1.5f}}});
     const std::string bytes = read_all(p);
     ASSERT_GE(bytes.size(), 8u);
     uint64_t n = 0;
@@ -214,14 +214,14 @@ TEST_F(SafetensorsTest, WriterStreamsProducedTensors) {
 
 TEST_F(SafetensorsTest, WriterRejectsBadDeclarationsAndLeavesNoFiles) {
   const std::string p = path("bad.safetensors");
-  expect_invalid_input([&] { write_safetensors(p, std::vector<HostTensor>{{"a", {1}, {1}}, {"a", {1}, {2}}}); },
+  expect_invalid_input([&] { write_safetensors(p, std::vector<HostTensor>{{{"a", {1}}, {1}}, {{"a", {1}}, {2}}}); },
                        {p, "'a'", "twice"});
-  expect_invalid_input([&] { write_safetensors(p, std::vector<HostTensor>{{"a", {2, 2}, {1, 2, 3}}}); },
+  expect_invalid_input([&] { write_safetensors(p, std::vector<HostTensor>{{{"a", {2, 2}}, {1, 2, 3}}}); },
                        {p, "'a'", "[2, 2]", "4 elements", "3 values"});
-  expect_invalid_input([&] { write_safetensors(p, std::vector<HostTensor>{{"a", {-1}, {}}}); }, {"'a'", "[-1]"});
-  expect_invalid_input([&] { write_safetensors(p, std::vector<HostTensor>{{"__metadata__", {1}, {1}}}); },
+  expect_invalid_input([&] { write_safetensors(p, std::vector<HostTensor>{{{"a", {-1}}, {}}}); }, {"'a'", "[-1]"});
+  expect_invalid_input([&] { write_safetensors(p, std::vector<HostTensor>{{{"__metadata__", {1}}, {1}}}); },
                        {"reserved"});
-  expect_invalid_input([&] { write_safetensors(p, std::vector<HostTensor>{{"", {1}, {1}}}); }, {"empty name"});
+  expect_invalid_input([&] { write_safetensors(p, std::vector<HostTensor>{{{"", {1}}, {1}}}); }, {"empty name"});
   EXPECT_FALSE(exists(p));
 
   expect_invalid_input([&] { write_safetensors(dir_ + "/no/such/dir/x.safetensors", std::vector<HostTensor>{}); },
@@ -240,7 +240,7 @@ TEST_F(SafetensorsTest, WriterRejectsBadDeclarationsAndLeavesNoFiles) {
 
 TEST_F(SafetensorsTest, MoveKeepsTheMappingAlive) {
   const std::string p = path("move.safetensors");
-  write_safetensors(p, std::vector<HostTensor>{{"w", {2}, {3.0f, 4.0f}}});
+  write_safetensors(p, std::vector<HostTensor>{{{"w", {2}}, {3.0f, 4.0f}}});
   SafetensorsFile a(p);
   SafetensorsFile b(std::move(a));
   EXPECT_EQ(b.to_float32("w"), (std::vector<float>{3.0f, 4.0f}));
@@ -469,10 +469,10 @@ TEST_F(SafetensorsTest, HandWrittenValidFileReadsBack) {
 TEST_F(SafetensorsTest, CheckWeightsFitListsEveryProblemInOneError) {
   const std::string p = path("weights.safetensors");
   write_safetensors(p, std::vector<HostTensor>{
-                           {"conv1.weight", {64, 6, 7, 7}, std::vector<float>(64 * 6 * 49)},
-                           {"conv1.bias", {64}, std::vector<float>(64)},
-                           {"extra.a", {1}, {0}},
-                           {"extra.b", {1}, {0}},
+                           {{"conv1.weight", {64, 6, 7, 7}}, std::vector<float>(64 * 6 * 49)},
+                           {{"conv1.bias", {64}}, std::vector<float>(64)},
+                           {{"extra.a", {1}}, {0}},
+                           {{"extra.b", {1}}, {0}},
                        });
   SafetensorsFile file(p);
   const std::vector<TensorSpec> model = {

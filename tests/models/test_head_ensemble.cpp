@@ -166,7 +166,7 @@ TEST(HeadEnsemble, ReadFromOpenFilesAnswersAsByPath) {
   EXPECT_EQ(read_head_ensemble(files), 3);
   EXPECT_EQ(read_head_ensemble(open_safetensors({f.heads[0]})), 1);  // a plain head
   const std::string bad = (f.root / "ensemble_bad.safetensors").string();
-  write_safetensors(bad, std::vector<HostTensor>{{"head.fc2.bias", {3}, {0.0f, 0.0f, 0.0f}}},
+  write_safetensors(bad, std::vector<HostTensor>{{{"head.fc2.bias", {3}}, {0.0f, 0.0f, 0.0f}}},
                     {{kMetadataEnsemble, "{\"members\":1,\"version\":1}"}});
   const std::string message = invalid_input_message([&] { read_head_ensemble(open_safetensors({bad})); });
   EXPECT_NE(message.find(bad), std::string::npos) << message;

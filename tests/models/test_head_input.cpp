@@ -140,7 +140,7 @@ TEST(HeadInput, ReadFromOpenFilesAnswersAsByPath) {
   const std::filesystem::path root = testing::temporary_directory("head_input_files");
   const std::string plain = (root / "plain.safetensors").string(), head = (root / "head.safetensors").string();
   const std::string bad = (root / "bad.safetensors").string();
-  const std::vector<HostTensor> tensors{{"head.fc2.bias", {3}, {0.0f, 0.0f, 0.0f}}};
+  const std::vector<HostTensor> tensors{{{"head.fc2.bias", {3}}, {0.0f, 0.0f, 0.0f}}};
   write_safetensors(plain, tensors);
   write_safetensors(head, tensors, {{kMetadataHeadInput, head_input_to_json({HeadInput::Normalized, "dis", true})}});
   write_safetensors(bad, tensors, {{kMetadataHeadInput, "{\"convention\":\"pixels\"}"}});

@@ -81,7 +81,7 @@ TEST(Head, NonFiniteWeightsAreRefusedWhenLoaded) {
   for (const auto& [bad, text] : {std::pair<float, const char*>{std::numeric_limits<float>::quiet_NaN(), "holds nan"},
                                   {-std::numeric_limits<float>::infinity(), "holds -inf"}}) {
     const std::string path = dir + "/bad.safetensors";
-    write_safetensors(path, std::vector<HostTensor>{{"head.fc1.bias", {3}, {0.5f, bad, 1.0f}}});
+    write_safetensors(path, std::vector<HostTensor>{{{"head.fc1.bias", {3}}, {0.5f, bad, 1.0f}}});
     const std::string message =
         testing::invalid_input_message([&] { WeightSet::load(testing::test_device(), {path}); });
     EXPECT_NE(message.find(path), std::string::npos) << message;

@@ -140,7 +140,7 @@ TEST(SigmaCalibration, ReadFromOpenFilesAnswersAsByPath) {
   const std::filesystem::path root = testing::temporary_directory("sigma_calibration_files");
   const std::string plain = (root / "plain.safetensors").string(), head = (root / "head.safetensors").string();
   const std::string bad = (root / "bad.safetensors").string();
-  const std::vector<HostTensor> tensors{{"head.fc2.bias", {3}, {0.0f, 0.0f, 0.0f}}};
+  const std::vector<HostTensor> tensors{{{"head.fc2.bias", {3}}, {0.0f, 0.0f, 0.0f}}};
   write_safetensors(plain, tensors, std::map<std::string, std::string>{});
   write_safetensors(head, tensors,
                     {{kMetadataSigmaCalibration, R"({"floor_rad_s":[0.1,0.2,0.3],"pairs":5,"scale":[1,2,3],"version":1})"}});

@@ -169,7 +169,7 @@ TEST(SyntheticWeights, ValuesStayWithinTheirBounds) {
 }
 
 TEST(SyntheticWeights, DependsOnSeedAndName) {
-  ParameterSpec spec{"x.weight", {64}, LayerKind::Conv2d, false, 9, 1.0};
+  ParameterSpec spec{{"x.weight", {64}}, LayerKind::Conv2d, false, 9, 1.0};
   const auto a = synthetic_tensor(spec, 1);
   EXPECT_EQ(a, synthetic_tensor(spec, 1));
   EXPECT_NE(a, synthetic_tensor(spec, 2));
