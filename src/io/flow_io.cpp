@@ -26,6 +26,7 @@ namespace inertialnet {
 
 namespace {
 
+using io_detail::is_png;
 using io_detail::quoted;
 
 constexpr char kFloMagic[4] = {'P', 'I', 'E', 'H'};  // 202021.25f in little-endian bytes
@@ -353,15 +354,9 @@ std::vector<unsigned char> read_flow_bytes(const fs::path& path) {
   return bytes;
 }
 
-bool is_png(const std::vector<unsigned char>& bytes) {
-  return io_detail::image_format_of(bytes) == io_detail::ImageFormat::Png;
-}
-
+// `bytes` are a PNG's (is_png): only a PNG reaches OpenCV, whose other decoders (DICOM's) can end
+// the process on bad bytes.
 FlowField decode_kitti_flow_png(const fs::path& path, const std::vector<unsigned char>& bytes) {
-  // Only a PNG reaches OpenCV, whose other decoders (DICOM's) can end the process on bad bytes.
-  if (!is_png(bytes)) {
-    throw invalid_input("The KITTI flow file " + quoted(path) + " is not a PNG (its first bytes are not PNG's signature).");
-  }
   cv::Mat image;
   try {
     image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U, const_cast<unsigned char*>(bytes.data())),
@@ -393,7 +388,13 @@ FlowField decode_kitti_flow_png(const fs::path& path, const std::vector<unsigned
 
 }  // namespace
 
-FlowField read_kitti_flow_png(const fs::path& path) { return decode_kitti_flow_png(path, read_flow_bytes(path)); }
+FlowField read_kitti_flow_png(const fs::path& path) {
+  const std::vector<unsigned char> bytes = read_flow_bytes(path);
+  if (!is_png(bytes)) {
+    throw invalid_input("The KITTI flow file " + quoted(path) + " is not a PNG (its first bytes are not PNG's signature).");
+  }
+  return decode_kitti_flow_png(path, bytes);
+}
 
 FlowField read_flow_file(const fs::path& path) {
   const std::vector<unsigned char> bytes = read_flow_bytes(path);

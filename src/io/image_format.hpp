@@ -17,6 +17,8 @@ enum class ImageFormat { Unknown, Png, Jpeg, Bmp, Tiff, Pnm, WebP };
 
 ImageFormat image_format_of(const std::vector<unsigned char>& bytes);
 
+inline bool is_png(const std::vector<unsigned char>& bytes) { return image_format_of(bytes) == ImageFormat::Png; }
+
 // For a message about bytes of no format we read: what they look like when that is a format
 // people use ("a DICOM file", "an OpenEXR file", …), else empty.
 std::string foreign_image_format(const std::vector<unsigned char>& bytes);

@@ -29,6 +29,7 @@ namespace inertialnet {
 namespace {
 
 using io_detail::crc32_of;
+using io_detail::is_png;
 using io_detail::quoted;
 
 using Bytes = std::vector<unsigned char>;
@@ -108,8 +109,6 @@ std::string png_corruption(const Bytes& bytes) {
   }
   return {};
 }
-
-bool is_png(const Bytes& bytes) { return io_detail::image_format_of(bytes) == io_detail::ImageFormat::Png; }
 
 bool is_jpeg(const Bytes& bytes) { return io_detail::image_format_of(bytes) == io_detail::ImageFormat::Jpeg; }
 
