@@ -44,6 +44,20 @@ run(0 ${CLI} predict mixed --fx 50)
 expect_match("pair 2 \\(frames 1 → 2, t = 50000000 → 100000000 ns\\): geometric: decode_error: frame 2 \\(t = 100000000 ns\\) is 64x48 but frame 1 \\(t = 50000000 ns\\) is 96x64; every frame")
 expect_match("100000000,,,,decode_error")
 
+# 6b. A frame whose bytes are no frame format (the fuzzer's finding: "DICM" at byte 128 sent it to
+# OpenCV's DICOM decoder, whose assert aborted the process): its two pairs are decode_error rows
+# naming the file and what it is; the third pair is answered and the run completes.
+file(MAKE_DIRECTORY "${WORK}/dicom")
+file(COPY_FILE "${frame_a}" "${WORK}/dicom/frame1.png")
+file(COPY_FILE "${CMAKE_CURRENT_LIST_DIR}/../fuzz/regressions/image/gdcm_assert_dicm_at_byte_128.png"
+     "${WORK}/dicom/frame2.png")
+file(COPY_FILE "${frame_b}" "${WORK}/dicom/frame3.png")
+file(COPY_FILE "${frame_a}" "${WORK}/dicom/frame4.png")
+run(0 ${CLI} predict dicom --fx 50)
+expect_match("pair 2 \\(frames 1 → 2, [^)]*\\): geometric: decode_error: frame 1 [^:]*: The image \"[^\"]*dicom/frame2.png\" cannot be decoded: it is a DICOM file \\(\"DICM\" at byte 128\\); frames are PNG, JPEG")
+expect_match("2 of 3 pairs without an answer \\(decode_error 2\\)")
+expect_no_match("Assertion")
+
 # 7. A resolution far from the images' is refused before anything is allocated for it.
 copy_with(huge_resolution cam0/sensor.yaml "resolution: [96, 64]" "resolution: [100000, 100000]")
 run(2 ${CLI} predict huge_resolution)
