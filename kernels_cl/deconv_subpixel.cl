@@ -137,28 +137,34 @@ inline void store_direct_row(__global float* out, const int out_offset, float16 
   }
 }
 
-// One work-item computes one tile of windows (TILE_ROWS × SEG input pixels) for every panel of a
-// block of PANEL_BLOCK A panels (phases included), over the input channels in blocks of
-// CHANNEL_BLOCK: each channel block's input rows (TILE_ROWS + 2 rows of SEG + 2 columns, zeros
-// outside the image) are copied into a private buffer, which then serves every panel of the
-// block and each of its 2×2 taps from L1 (the packed GEMM's B panel, k = 162 for the reference,
-// is L1-resident the same way); the panels' accumulators are parked in a private array between
-// channel blocks. A panels are phase-major, `phase_panels` of MR rows per phase (rows past co
-// zero); A's column i·4 + ty·2 + tx is tap (ty, tx) of input channel i, whose B values are the
-// buffer's rows py + ty …, columns px + tx …: whole vectors, no packing.
-// Build options: -DMR, -DSEG, -DPANEL_BLOCK, -DCHANNEL_BLOCK, -DHAS_BIAS, -DACTIVATION.
+// One work-item computes a band of BAND tiles down the image (each TILE_ROWS × SEG input pixels)
+// for every panel of a block of PANEL_BLOCK A panels (phases included), over the input channels
+// in blocks of CHANNEL_BLOCK: each channel block's input rows for the whole band (BAND·TILE_ROWS
+// + 2 rows of SEG + 2 columns, zeros outside the image) are copied into a private buffer, which
+// then serves every tile of the band, every panel of the block and each of its 2×2 taps from L1
+// (the packed GEMM's B panel, k = 162 for the reference, is L1-resident the same way); the
+// accumulators of the band's tiles and panels are parked in a private array between channel
+// blocks. The band shares the rows two neighbouring tiles both read: one tile per work-item
+// copied three input rows per output row of deconv0 and spent a third of its time on the copy
+// (docs/performance.md, "A band of tiles per work-item"). A panels are phase-major,
+// `phase_panels` of MR rows per phase (rows past co zero); A's column i·4 + ty·2 + tx is tap
+// (ty, tx) of input channel i, whose B values are the buffer's rows py + ty …, columns px + tx …:
+// whole vectors, no packing.
+// Build options: -DMR, -DSEG, -DBAND, -DPANEL_BLOCK, -DCHANNEL_BLOCK, -DHAS_BIAS, -DACTIVATION.
 
+#define BAND_ROWS (BAND * TILE_ROWS)
 #define BUF_W (SEG + 2)
-#define BUF_ROWS (TILE_ROWS + 2)
+#define BUF_ROWS (BAND_ROWS + 2)
 #define BUF_PLANE (BUF_ROWS * BUF_W)
 
-#define PARK_LOAD(r) float16 lo##r = acc[(p * MR + r) * 2], hi##r = acc[(p * MR + r) * 2 + 1];
-#define PARK_STORE(r) acc[(p * MR + r) * 2] = lo##r; acc[(p * MR + r) * 2 + 1] = hi##r;
-#define STORE_DIRECT(r)                                                                                     \
-  store_direct_row(out, out_offset, acc[(p * MR + r) * 2], acc[(p * MR + r) * 2 + 1], c0 + r, channels, a0, \
-                   b0, py, px, height, width, bias, bias_offset);
+// Accumulator pair of row r of panel p of the band's tile j.
+#define ACC(r) acc[((j * PANEL_BLOCK + p) * MR + r) * 2]
+#define PARK_LOAD(r) float16 lo##r = ACC(r), hi##r = (&ACC(r))[1];
+#define PARK_STORE(r) ACC(r) = lo##r; (&ACC(r))[1] = hi##r;
+#define STORE_DIRECT(r) \
+  store_direct_row(out, out_offset, ACC(r), (&ACC(r))[1], c0 + r, channels, a0, b0, py, px, height, width, bias, bias_offset);
 
-// Global size (tiles across · tile rows, A panel blocks), work-groups of one work-item: the tiles
+// Global size (tiles across · bands, A panel blocks), work-groups of one work-item: the bands
 // of one panel block run back to back, so the block's weights stay in L2 while the input passes.
 __kernel void subpixel_direct(__global const float* restrict a_packed, const int a_offset,
                               __global const float* restrict x, const int x_offset,
@@ -168,25 +174,29 @@ __kernel void subpixel_direct(__global const float* restrict a_packed, const int
                               const int height, const int width) {
   const int tiles_across = (width + SEG - 1) / SEG;
   const int tile_index = get_global_id(0);
-  const int tile_row = tile_index / tiles_across, tile = tile_index - tile_row * tiles_across;
+  const int band = tile_index / tiles_across, tile = tile_index - band * tiles_across;
   const int first_panel = get_global_id(1) * PANEL_BLOCK;
   const int panels = min(PANEL_BLOCK, 4 * phase_panels - first_panel);
-  const int a0 = tile_row * TILE_ROWS, b0 = tile * SEG;
-  if (a0 >= height || panels <= 0) return;
+  const int top = band * BAND_ROWS, b0 = tile * SEG;
+  if (top >= height || panels <= 0) return;
+  // The band's tiles that start inside the image (the last band may be short).
+  const int band_tiles = min(BAND, (height - top + TILE_ROWS - 1) / TILE_ROWS);
   const int k = 4 * in_channels;
   const size_t plane = (size_t)height * width;
-  float16 acc[PANEL_BLOCK * MR * 2];
-  for (int q = 0; q < PANEL_BLOCK * MR * 2; ++q) acc[q] = (float16)(0.0f);
+  float16 acc[BAND * PANEL_BLOCK * MR * 2];
+  for (int q = 0; q < BAND * PANEL_BLOCK * MR * 2; ++q) acc[q] = (float16)(0.0f);
   float buf[CHANNEL_BLOCK * BUF_PLANE];
   // The SEG middle columns as whole vectors where the tile's columns are all inside the image.
   const bool full = b0 + SEG <= width;
+  // The copied rows: one above the band to one below its last tile.
+  const int buf_rows = band_tiles * TILE_ROWS + 2;
   for (int i0 = 0; i0 < in_channels; i0 += CHANNEL_BLOCK) {
     const int count = min(CHANNEL_BLOCK, in_channels - i0);
     for (int i = 0; i < count; ++i) {
       __global const float* src = x + x_offset + (size_t)(i0 + i) * plane;
-      for (int r = 0; r < BUF_ROWS; ++r) {
+      for (int r = 0; r < buf_rows; ++r) {
         float* dst = buf + i * BUF_PLANE + r * BUF_W;
-        const int y = a0 - 1 + r;
+        const int y = top - 1 + r;
         if (y < 0 || y >= height) {
           for (int q = 0; q < BUF_W; ++q) dst[q] = 0.0f;
           continue;
@@ -205,31 +215,36 @@ __kernel void subpixel_direct(__global const float* restrict a_packed, const int
         dst[SEG + 1] = b0 + SEG < width ? row[b0 + SEG] : 0.0f;
       }
     }
+    for (int j = 0; j < band_tiles; ++j) {
+      for (int p = 0; p < panels; ++p) {
+        const int panel = first_panel + p;
+        const int phase = panel / phase_panels;
+        const int py = phase >> 1, px = phase & 1;
+        __global const float* ap = a_packed + a_offset + (size_t)panel * k * MR + (size_t)i0 * 4 * MR;
+        EACH_ROW(PARK_LOAD)
+        const float* bp = buf + (j * TILE_ROWS + py) * BUF_W + px;
+        for (int i = 0; i < count; ++i) {
+          for (int t = 0; t < 4; ++t) {
+            const float* src = bp + (t >> 1) * BUF_W + (t & 1);
+            LOAD_B(src, BUF_W)
+            EACH_ROW(ACCUMULATE)
+            ap += MR;
+          }
+          bp += BUF_PLANE;
+        }
+        EACH_ROW(PARK_STORE)
+      }
+    }
+  }
+  for (int j = 0; j < band_tiles; ++j) {
+    const int a0 = top + j * TILE_ROWS;
     for (int p = 0; p < panels; ++p) {
       const int panel = first_panel + p;
       const int phase = panel / phase_panels;
       const int py = phase >> 1, px = phase & 1;
-      __global const float* ap = a_packed + a_offset + (size_t)panel * k * MR + (size_t)i0 * 4 * MR;
-      EACH_ROW(PARK_LOAD)
-      const float* bp = buf + py * BUF_W + px;
-      for (int i = 0; i < count; ++i) {
-        for (int t = 0; t < 4; ++t) {
-          const float* src = bp + (t >> 1) * BUF_W + (t & 1);
-          LOAD_B(src, BUF_W)
-          EACH_ROW(ACCUMULATE)
-          ap += MR;
-        }
-        bp += BUF_PLANE;
-      }
-      EACH_ROW(PARK_STORE)
+      const int c0 = (panel - phase * phase_panels) * MR;
+      EACH_ROW(STORE_DIRECT)
     }
-  }
-  for (int p = 0; p < panels; ++p) {
-    const int panel = first_panel + p;
-    const int phase = panel / phase_panels;
-    const int py = phase >> 1, px = phase & 1;
-    const int c0 = (panel - phase * phase_panels) * MR;
-    EACH_ROW(STORE_DIRECT)
   }
 }
 

@@ -53,7 +53,7 @@ PackedPanels subpixel_weights(Queue& queue, const Tensor& weight, Device* long_l
 namespace {
 
 // The direct form's blocks (kernels_cl/deconv_subpixel.cl, subpixel_direct): a work-item runs
-// one tile for kDirectPanelBlock A panels (every phase of FlowNetFusion's deconv0, whose four
+// a band of tiles for kDirectPanelBlock A panels (every phase of FlowNetFusion's deconv0, whose four
 // phases of 16 channels are 8 panels of MR = 8), over the input channels kDirectChannelBlock at a
 // time: 16 channels of a 32-wide tile's three input rows are 6.5 KiB, so they serve the 8 panels'
 // 4 taps from L1, and the 8 panels' parked accumulators are 8 KiB. Measured per layer at
@@ -61,6 +61,12 @@ namespace {
 // of 16 channels against 8 and 32.
 constexpr std::size_t kDirectPanelBlock = 8;
 constexpr int kDirectChannelBlock = 16;
+// Tiles per band (down the image): the band's tiles share the input rows they overlap, so a
+// channel block copies BAND·TILE_ROWS + 2 rows instead of 3·TILE_ROWS per tile; its parked
+// accumulators (BAND × 8 KiB at MR = 8) stay in L2. Fewer where the bands would leave fewer
+// than kDirectMinWorkItems work-items to share between the cores.
+constexpr int kDirectBand = 8;
+constexpr std::size_t kDirectMinWorkItems = 16;
 
 // The phase weights' rows per phase (co padded to whole A panels), checked against the layer.
 std::size_t checked_phase_rows(const Tensor& input, const PackedPanels& weights, const Tensor& output) {
@@ -93,16 +99,24 @@ void conv_transpose2d_subpixel_direct(Queue& queue, const Tensor& input, const P
   const auto phase_panels = phase_rows / static_cast<std::size_t>(weights.width);
   const std::size_t panels = 4 * phase_panels;
   const std::size_t block = std::min(kDirectPanelBlock, panels);
+  const std::size_t panel_blocks = (panels + block - 1) / block;
+  int band = std::min(kDirectBand, row_tiles);
+  const auto work_items = [&](int b) {
+    return static_cast<std::size_t>(tiles) * static_cast<std::size_t>((row_tiles + b - 1) / b) * panel_blocks;
+  };
+  while (band > 1 && work_items(band) < kDirectMinWorkItems) band /= 2;
+  const int bands = (row_tiles + band - 1) / band;
   const bool has_bias = bias.defined();
   Kernel& kernel = queue.kernel("deconv_subpixel", "subpixel_direct",
                                 KernelDefines()
                                     .add("MR", weights.width)
                                     .add("SEG", seg)
+                                    .add("BAND", band)
                                     .add("PANEL_BLOCK", static_cast<int>(block))
                                     .add("CHANNEL_BLOCK", kDirectChannelBlock)
                                     .add("HAS_BIAS", has_bias)
                                     .add(activation_defines(options.activation)));
-  const Range global(static_cast<std::size_t>(tiles) * static_cast<std::size_t>(row_tiles), (panels + block - 1) / block);
+  const Range global(static_cast<std::size_t>(tiles) * static_cast<std::size_t>(bands), panel_blocks);
   for (std::int64_t n = 0; n < input.n(); ++n) {
     const Tensor in_n = input.sample(n);
     const Tensor out_n = output.sample(n);

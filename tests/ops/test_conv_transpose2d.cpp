@@ -145,6 +145,14 @@ TEST(ConvTranspose2d, SubPixelDirectOnOddSizesSlicesAndBothWalks) {
     expect_deconv_matches({"deep_w" + std::to_string(w), 70, 21, 3, w, 4, 2, 1, true, ActivationSpec::leaky_relu(0.1f)},
                           {2, 0, 0, 0, 0, 0, direct});
   }
+  // Bands of tiles down the image (a work-item runs up to 8 tiles, sharing their copied input
+  // rows): 75 rows of 32-wide tiles are 9 bands of 8 and a band of 3; 150 rows of 8 × 4 tiles
+  // (co 64: 4 blocks of panels, enough work-items for bands of 8) 4 bands of 8 and one of 6, whose
+  // last tile has 2 rows.
+  expect_deconv_matches({"bands_h75", 20, 16, 75, 70, 4, 2, 1, true, ActivationSpec::leaky_relu(0.1f)},
+                        {1, 0, 0, 0, 0, 0, direct});
+  expect_deconv_matches({"bands_h150_w7", 20, 64, 150, 7, 4, 2, 1, true, ActivationSpec::leaky_relu(0.1f)},
+                        {2, 0, 0, 0, 0, 0, direct});
   // Whole channel blocks (ci 32) and whole panel blocks (co 16: 8 panels, FlowNetFusion's
   // deconv0) on rows of whole and partial 32-wide tiles, the first and last rows at the border.
   for (const int w : {64, 65}) {
