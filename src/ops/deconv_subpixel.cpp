@@ -55,10 +55,10 @@ namespace {
 // The direct form's blocks (kernels_cl/deconv_subpixel.cl, subpixel_direct): a work-item runs
 // a band of tiles for kDirectPanelBlock A panels (every phase of FlowNetFusion's deconv0, whose four
 // phases of 16 channels are 8 panels of MR = 8), over the input channels kDirectChannelBlock at a
-// time: 16 channels of a 32-wide tile's three input rows are 6.5 KiB, so they serve the 8 panels'
-// 4 taps from L1, and the 8 panels' parked accumulators are 8 KiB. Measured per layer at
-// 512×384 (docs/performance.md, "Issue 24, fifth pass"): blocks of 8 panels against 4 and 16,
-// of 16 channels against 8 and 32.
+// time: 16 channels of a band's ten input rows of 34 floats are 21 KiB, so they serve the 8
+// panels' 4 taps from L1, and a tile's 8 panels' parked accumulators are 8 KiB. Measured per
+// layer at 512×384 (docs/performance.md, "Issue 24, fifth pass" and "A band of tiles per
+// work-item"): blocks of 8 panels against 4 and 16, of 16 channels against 8 and 32.
 constexpr std::size_t kDirectPanelBlock = 8;
 constexpr int kDirectChannelBlock = 16;
 // Tiles per band (down the image): the band's tiles share the input rows they overlap, so a

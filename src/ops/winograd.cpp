@@ -47,7 +47,7 @@ bool winograd_deconv_eligible(const Shape& weight, int stride, int padding) {
 }
 
 bool winograd_deconv_preferred(const Shape& input, const Shape& weight, int stride, int padding) {
-  if (!winograd_deconv_eligible(weight, stride, padding)) return false;
+  if (!winograd_deconv_eligible(weight, stride, padding) || weight[1] < kWinogradDeconvMinOutputChannels) return false;
   return input.size() != 4 || ((input[2] + 3) / 4) * ((input[3] + 3) / 4) >= kWinogradDeconvMinTiles;
 }
 

@@ -82,13 +82,22 @@ bool winograd_deconv_eligible(const Shape& weight, int stride, int padding);
 // 4×4 output tiles of the 3×3 layer (its output is the input's size) from which an eligible
 // transposed convolution runs Winograd on that plan. Measured at 512×384 (docs/performance.md,
 // "Issue 24, seventh pass"): deconv2 (386 → 64 channels, 48×64 inputs, 192 tiles) 24 → 18.5 ms and
-// FlowNetFusion's deconv1 (96×128) and deconv0 (192×256) faster too, but deconv3 (770 → 128,
-// 24×32 inputs, 48 tiles: 512 rows of deep products over a panel and a half) 23 → 27–31 ms against
-// the direct sub-pixel form; the rule's threshold lies between the two.
+// FlowNetFusion's deconv1 (96×128) faster too, but deconv3 (770 → 128, 24×32 inputs, 48 tiles:
+// 512 rows of deep products over a panel and a half) 23 → 27–31 ms against the direct sub-pixel
+// form; the rule's threshold lies between the two.
 inline constexpr std::int64_t kWinogradDeconvMinTiles = 96;
 
-// Eligible, and on an NCHW `input` of at least kWinogradDeconvMinTiles tiles. An empty `input`
-// (size unknown) counts as large enough.
+// Output channels from which an eligible transposed convolution runs Winograd on that plan. The
+// input transform costs the same for any co, the products 4·co rows: with few output channels the
+// transform is most of the work, and the direct sub-pixel form (which reads each input row a few
+// times and has no transform) wins. Measured at 512×384 (docs/performance.md, "A band of tiles per
+// work-item"): FlowNetFusion's deconv0 (162 → 16) 23.9–24.8 ms on Winograd against 20.7 ms direct;
+// its deconv1 (128 → 32) 6.2–6.6 against 7.7–7.9, deconv2 (386 → 64) 7.7–9.8 against 11.0–11.1.
+inline constexpr std::int64_t kWinogradDeconvMinOutputChannels = 32;
+
+// Eligible, of at least kWinogradDeconvMinOutputChannels output channels, and on an NCHW `input`
+// of at least kWinogradDeconvMinTiles tiles. An empty `input` (size unknown) counts as large
+// enough.
 bool winograd_deconv_preferred(const Shape& input, const Shape& weight, int stride, int padding);
 
 // Eligible (either form), and on an NCHW `input` whose output has at least kWinogradMinTiles

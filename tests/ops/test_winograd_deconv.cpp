@@ -41,10 +41,12 @@ void expect_prepared_matches(const DeconvCase& c, const DeconvPlacement& p, bool
 }
 
 // The same prepared without the input's size (as for an unknown size): the rule counts it large
-// enough, so every eligible layer runs Winograd, small inputs on partial tiles.
+// enough, so every eligible layer of enough output channels runs Winograd, small inputs on
+// partial tiles (FlowNetFusion's deconv0, co = 16, keeps the sub-pixel form).
 void expect_unsized_prepared_matches(const DeconvCase& c) {
-  EXPECT_TRUE(testing::expect_deconv_matches(c, DeconvPlacement{}, DeconvRun{311, GemmBackend::Winograd, false}))
-      << c.name << ": not run as Winograd";
+  EXPECT_EQ(testing::expect_deconv_matches(c, DeconvPlacement{}, DeconvRun{311, GemmBackend::Winograd, false}),
+            detail::winograd_deconv_preferred({}, {c.ci, c.co, 4, 4}, 2, 1))
+      << c.name << ": not the expected form";
 }
 
 class FlowNetWinogradDeconvShapes : public ::testing::TestWithParam<DeconvCase> {};
@@ -77,50 +79,51 @@ INSTANTIATE_TEST_SUITE_P(FlowNet2, FlowNetWinogradDeconvShapes, ::testing::Value
 
 TEST(WinogradDeconv, FlowNet2HasEligibleLayers) {
   // deconv5 … deconv2 (FlowNetC's, shared by FlowNetS and FlowNetSD) and FlowNetFusion's deconv1
-  // and deconv0 (co = 16: 64 rows of the 3×3 layer).
+  // and deconv0 (co = 16: 64 rows of the 3×3 layer; eligible, though the channel rule leaves it
+  // on the direct sub-pixel form, and checked here prepared both ways).
   EXPECT_GE(flownet2_deconv_cases().size(), 6u);
 }
 
 TEST(WinogradDeconv, OddSizesBatchesAndEdges) {
   const auto leaky = ActivationSpec::leaky_relu(0.1f);
-  // Odd sizes: partial tiles on the right and bottom; co = 5: 20 rows, a partial row panel.
-  expect_prepared_matches(deconv("odd_37x45", 33, 5, 37, 45, true, leaky), {3});
+  // Odd sizes: partial tiles on the right and bottom; co = 35: 140 rows, a partial row panel.
+  expect_prepared_matches(deconv("odd_37x45", 33, 35, 37, 45, true, leaky), {3});
   // Rows of 16 whole tiles (64 input columns): each pair of column phases stored as whole vectors;
   // 131 and 67 leave a partial group at the right edge, 64 × 25 rows a partial tile row below.
-  // (Every case here has the size rule's 96 tiles.)
-  expect_prepared_matches(deconv("w64_h25", 32, 4, 25, 64, false, ActivationSpec::relu()), {2});
-  expect_prepared_matches(deconv("w131_h10", 40, 8, 10, 131, true, leaky), {1});
-  expect_prepared_matches(deconv("w67_h33", 35, 6, 33, 67, true, ActivationSpec::none()), {1});
-  expect_prepared_matches(deconv("one_row", 32, 4, 1, 390, true, leaky), {1});
-  expect_prepared_matches(deconv("one_column", 32, 4, 390, 1, true, leaky), {1});
+  // (Every case here has the size rule's 96 tiles and its 32 output channels.)
+  expect_prepared_matches(deconv("w64_h25", 32, 32, 25, 64, false, ActivationSpec::relu()), {2});
+  expect_prepared_matches(deconv("w131_h10", 40, 33, 10, 131, true, leaky), {1});
+  expect_prepared_matches(deconv("w67_h33", 35, 34, 33, 67, true, ActivationSpec::none()), {1});
+  expect_prepared_matches(deconv("one_row", 32, 32, 1, 390, true, leaky), {1});
+  expect_prepared_matches(deconv("one_column", 32, 32, 390, 1, true, leaky), {1});
 }
 
 TEST(WinogradDeconv, ChannelSlicesTileRangesAndDeepLayers) {
   const auto leaky = ActivationSpec::leaky_relu(0.1f);
   // Input and output as channel slices of wider tensors (FlowNet's decoders concatenate in place).
-  expect_prepared_matches(deconv("slice", 34, 6, 37, 70, true, leaky), {2, 3, 1, 5, 2});
+  expect_prepared_matches(deconv("slice", 34, 33, 37, 70, true, leaky), {2, 3, 1, 5, 2});
   // A budget of 40 tiles of 36·34 floats: ranges of 32 tiles, starting mid-row.
-  expect_prepared_matches(deconv("ranges", 34, 6, 41, 75, true, leaky), {2, 1, 1, 2, 2, 36 * 34 * 40});
+  expect_prepared_matches(deconv("ranges", 34, 33, 41, 75, true, leaky), {2, 1, 1, 2, 2, 36 * 34 * 40});
   // ci ≥ 384: U on the 14-row panels (pairs of column phases still within one work-item); 24×32
   // inputs (48 tiles: the second panel's low half alone), as FlowNet2's deconv3 at 512×384 (the
   // size rule leaves that layer on the sub-pixel form; prepared without the size it runs here).
-  expect_unsized_prepared_matches(deconv("deep_24x32", 390, 7, 24, 32, true, leaky));
-  expect_prepared_matches(deconv("deep_odd", 400, 5, 33, 70, false, leaky), {1});
+  expect_unsized_prepared_matches(deconv("deep_24x32", 390, 33, 24, 32, true, leaky));
+  expect_prepared_matches(deconv("deep_odd", 400, 33, 33, 70, false, leaky), {1});
 }
 
 // The product's row panels follow the device's tuned MR (`inertialnet tune` may store any of the
 // packed GEMM's candidates): with an even MR the two column phases of an output row are stored
 // together, with an odd one (MR = 1) each phase alone into every other pixel. Each form on rows of
-// whole tiles (w64_h25) and partial ones (odd_37x45), and panels that end mid-channel (co = 5:
-// 20 rows in panels of 6 or 12).
+// whole tiles (w64_h25) and partial ones (odd_37x45), and panels that end mid-channel (co = 35:
+// 140 rows in panels of 6 or 12, the last one partial).
 TEST(WinogradDeconv, AnyTileRowsOfTheDevicesTuning) {
   const auto leaky = ActivationSpec::leaky_relu(0.1f);
   for (const int mr : {1, 2, 6, 12}) {
     SCOPED_TRACE("MR " + std::to_string(mr));
     const testing::ScopedPackedTuning tuning({{"MR", mr}});
     ASSERT_EQ(packed_gemm_setting(testing::test_device(), "MR"), mr);
-    expect_prepared_matches(deconv("w64_h25", 32, 4, 25, 64, false, ActivationSpec::relu()), {2});
-    expect_prepared_matches(deconv("odd_37x45", 33, 5, 37, 45, true, leaky), {1});
+    expect_prepared_matches(deconv("w64_h25", 32, 32, 25, 64, false, ActivationSpec::relu()), {2});
+    expect_prepared_matches(deconv("odd_37x45", 33, 35, 37, 45, true, leaky), {1});
   }
 }
 
@@ -146,24 +149,30 @@ TEST(WinogradDeconv, OnlyFourByFourStrideTwoPaddingOneOfEnoughChannelsQualifies)
   EXPECT_FALSE(detail::winograd_deconv_eligible({32, 4, 3, 3}, 2, 1));
   EXPECT_FALSE(detail::winograd_deconv_eligible({2, 2, 4, 4}, 2, 1));  // FlowNet's flow up-sampling
   // The size rule: 96 tiles of the input (the 3×3 layer's output is the input's size). At
-  // 512×384 deconv2 (48×64 inputs, 192 tiles) and FlowNetFusion's deconv1 and deconv0 qualify,
-  // deconv3 (24×32, 48 tiles) and deconv4 (12×16, 12 tiles) do not.
+  // 512×384 deconv2 (48×64 inputs, 192 tiles) and FlowNetFusion's deconv1 and deconv0 are large
+  // enough, deconv3 (24×32, 48 tiles) and deconv4 (12×16, 12 tiles) are not.
   EXPECT_TRUE(detail::winograd_deconv_preferred({1, 386, 48, 64}, {386, 64, 4, 4}, 2, 1));
   EXPECT_FALSE(detail::winograd_deconv_preferred({1, 770, 24, 32}, {770, 128, 4, 4}, 2, 1));
   EXPECT_FALSE(detail::winograd_deconv_preferred({1, 1026, 12, 16}, {1026, 256, 4, 4}, 2, 1));
   EXPECT_TRUE(detail::winograd_deconv_preferred({}, {1026, 256, 4, 4}, 2, 1));
-  // Below the rule the winograd plan keeps the sub-pixel form, with its own bound.
-  expect_prepared_matches(deconv("tiles_96", 32, 4, 32, 47, true, ActivationSpec::none()), {1});
-  expect_prepared_matches(deconv("tiles_84", 32, 4, 28, 48, true, ActivationSpec::none()), {1}, false);
+  // The channel rule: 32 output channels. FlowNetFusion's deconv1 (128 → 32) qualifies, its deconv0
+  // (162 → 16, the largest input) does not, at any size.
+  EXPECT_TRUE(detail::winograd_deconv_preferred({1, 128, 96, 128}, {128, 32, 4, 4}, 2, 1));
+  EXPECT_FALSE(detail::winograd_deconv_preferred({1, 162, 192, 256}, {162, 16, 4, 4}, 2, 1));
+  EXPECT_FALSE(detail::winograd_deconv_preferred({}, {162, 31, 4, 4}, 2, 1));
+  // Below either rule the winograd plan keeps the sub-pixel form, with its own bound.
+  expect_prepared_matches(deconv("tiles_96", 32, 32, 32, 47, true, ActivationSpec::none()), {1});
+  expect_prepared_matches(deconv("tiles_84", 32, 32, 28, 48, true, ActivationSpec::none()), {1}, false);
+  expect_prepared_matches(deconv("co_31", 32, 31, 32, 47, true, ActivationSpec::none()), {1}, false);
   // Weights prepared for Winograd do not run a layer of another geometry.
   Queue& queue = testing::test_queue();
-  const Tensor w = Tensor::from_host(queue, {32, 4, 4, 4}, testing::random_vector(32 * 4 * 16, 9));
+  const Tensor w = Tensor::from_host(queue, {32, 32, 4, 4}, testing::random_vector(32 * 32 * 16, 9));
   const GemmWeights prepared = prepare_conv_transpose2d_weights(queue, w, GemmBackend::Winograd, Shape{}, 2, 1);
   ASSERT_EQ(prepared.winograd.size(), 1u);
   const Tensor in = Tensor::empty(queue, {1, 32, 8, 8});
   ConvTranspose2dOptions pad0{2, 0, ActivationSpec::none(), 0, &prepared};
   testing::expect_invalid_input(
-      [&] { conv_transpose2d(queue, in, w, Tensor(), Tensor::empty(queue, {1, 4, 18, 18}), pad0); },
+      [&] { conv_transpose2d(queue, in, w, Tensor(), Tensor::empty(queue, {1, 32, 18, 18}), pad0); },
       "prepared for Winograd");
 }
 
