@@ -397,9 +397,17 @@ FlowField read_kitti_flow_png(const fs::path& path) {
 }
 
 FlowField read_flow_file(const fs::path& path) {
-  const std::vector<unsigned char> bytes = read_flow_bytes(path);
-  if (bytes.size() >= 4 && std::memcmp(bytes.data(), kFloMagic, 4) == 0) return read_flo(path);
-  if (is_png(bytes)) return decode_kitti_flow_png(path, bytes);
+  // The format from the first 8 bytes (PNG's signature is the longer), then one read of the file
+  // by its reader: read_flo checks a .flo file's header against its size before reading its data.
+  std::vector<unsigned char> head(8);
+  {
+    std::ifstream in = io_detail::open_input_file(path, "The flow file");
+    in.read(reinterpret_cast<char*>(head.data()), static_cast<std::streamsize>(head.size()));
+    if (in.bad()) throw invalid_input("The flow file " + quoted(path) + " could not be read.");
+    head.resize(static_cast<std::size_t>(in.gcount()));
+  }
+  if (head.size() >= 4 && std::memcmp(head.data(), kFloMagic, 4) == 0) return read_flo(path);
+  if (is_png(head)) return decode_kitti_flow_png(path, read_flow_bytes(path));
   throw invalid_input("The file " + quoted(path) +
                       " is neither a Middlebury .flo file (magic \"PIEH\") nor a KITTI flow PNG.");
 }

@@ -436,6 +436,14 @@ TEST(KittiFlow, ReaderRefusesOtherImagesAndReadFlowFileKnowsBothFormats) {
   write_flo(dir / "f.flo", flow);
   const FlowField back = read_flow_file(dir / "f.flo");
   EXPECT_EQ(back.u, flow.u);
+  // Sniffed from its first bytes, a .flo goes to read_flo's checks: a header whose size the data
+  // does not fill, and a file of the magic alone (shorter than PNG's 8-byte signature).
+  write_bytes(dir / "short.flo", {'P', 'I', 'E', 'H', 200, 0, 0, 0, 100, 0, 0, 0, 1, 2, 3, 4});
+  EXPECT_TRUE(contains(invalid_input_message([&] { read_flow_file(dir / "short.flo"); }), "is truncated"));
+  write_bytes(dir / "magic.flo", {'P', 'I', 'E', 'H'});
+  EXPECT_TRUE(contains(invalid_input_message([&] { read_flow_file(dir / "magic.flo"); }), "too short for a .flo header"));
+  write_bytes(dir / "empty.flo", {});
+  EXPECT_TRUE(contains(invalid_input_message([&] { read_flow_file(dir / "empty.flo"); }), "neither a Middlebury"));
 }
 
 // --- legend -------------------------------------------------------------------------------------
