@@ -16,6 +16,7 @@
 
 #ifdef MR
 #include "packed_tile.cl"
+#include "direct_band.cl"
 #endif
 
 // A of the product from W [ci, co, 4, 4] (row-major [4·phase_rows, 4·ci]; pack_a() packs it):
@@ -37,18 +38,6 @@ __kernel void subpixel_weights(__global const float* restrict w, const int w_off
 }
 
 #ifdef MR
-
-// A tile row's 32 values with the bias of its channel and the activation, into t (both stores).
-inline void finish_tile_row(float16 lo, float16 hi, const int c, __global const float* bias, const int bias_offset,
-                            float* t) {
-#if HAS_BIAS
-  const float b = bias[bias_offset + c];
-  lo += b;
-  hi += b;
-#endif
-  vstore16(ACTIVATE(lo), 0, t);
-  vstore16(ACTIVATE(hi), 0, t + 16);
-}
 
 // One row of a tile (phase·phase_rows + c) over windows [first, first + cols) of the (H+1)×(W+1) grid.
 inline void store_phase_row(__global float* out, const int out_offset, float16 lo, float16 hi, const int row,
@@ -102,24 +91,6 @@ __kernel void gemm_packed_subpixel(__global const float* restrict a_packed, cons
 // from the input (no im2col panels, no border windows, no column matrix).
 #if defined(MR) && defined(SEG)
 
-// A tile is 32 windows of one phase: 32 / SEG input rows × SEG columns (SEG 32, 16 or 8, so that
-// narrow inputs fill the tile: deconv5's 8 columns take four rows).
-#define TILE_ROWS (32 / SEG)
-
-#if SEG == 32
-#define LOAD_B(src, pw) \
-  const float16 b_lo = vload16(0, src), b_hi = vload16(0, (src) + 16);
-#elif SEG == 16
-#define LOAD_B(src, pw) \
-  const float16 b_lo = vload16(0, src), b_hi = vload16(0, (src) + (pw));
-#elif SEG == 8
-#define LOAD_B(src, pw)                                                          \
-  const float16 b_lo = (float16)(vload8(0, src), vload8(0, (src) + (pw)));       \
-  const float16 b_hi = (float16)(vload8(0, (src) + 2 * (pw)), vload8(0, (src) + 3 * (pw)));
-#else
-#error "SEG must be 8, 16 or 32"
-#endif
-
 // One row of a direct tile: channel c of phase (py, px); lane q is input pixel
 // (a0 + q / SEG, b0 + q % SEG), output pixel (2a + py, 2b + px).
 inline void store_direct_row(__global float* out, const int out_offset, float16 lo, float16 hi, const int c,
@@ -137,32 +108,15 @@ inline void store_direct_row(__global float* out, const int out_offset, float16 
   }
 }
 
-// One work-item computes a band of BAND tiles down the image (each TILE_ROWS × SEG input pixels)
-// for every panel of a block of PANEL_BLOCK A panels (phases included), over the input channels
-// in blocks of CHANNEL_BLOCK: each channel block's input rows for the whole band (BAND·TILE_ROWS
-// + 2 rows of SEG + 2 columns, zeros outside the image) are copied into a private buffer, which
-// then serves every tile of the band, every panel of the block and each of its 2×2 taps from L1
-// (the packed GEMM's B panel, k = 162 for the reference, is L1-resident the same way); the
-// accumulators of the band's tiles and panels are parked in a private array between channel
-// blocks. The band shares the rows two neighbouring tiles both read: one tile per work-item
-// copied three input rows per output row of deconv0 and spent a third of its time on the copy
-// (docs/performance.md, "A band of tiles per work-item"). A panels are phase-major,
-// `phase_panels` of MR rows per phase (rows past co zero); A's column i·4 + ty·2 + tx is tap
-// (ty, tx) of input channel i, whose B values are the buffer's rows py + ty …, columns px + tx …:
-// whole vectors, no packing.
+// One work-item computes a band of BAND tiles down the image for every panel of a block of
+// PANEL_BLOCK A panels (phases included), the banded direct form of direct_band.cl. A panels are
+// phase-major, `phase_panels` of MR rows per phase (rows past co zero); A's column i·4 + ty·2 + tx
+// is tap (ty, tx) of input channel i, whose B values are the buffer's rows py + ty …, columns
+// px + tx …: whole vectors, no packing.
 // Build options: -DMR, -DSEG, -DBAND, -DPANEL_BLOCK, -DCHANNEL_BLOCK, -DHAS_BIAS, -DACTIVATION.
 
-#define BAND_ROWS (BAND * TILE_ROWS)
-#define BUF_W (SEG + 2)
-#define BUF_ROWS (BAND_ROWS + 2)
-#define BUF_PLANE (BUF_ROWS * BUF_W)
-
-// Accumulator pair of row r of panel p of the band's tile j.
-#define ACC(r) acc[((j * PANEL_BLOCK + p) * MR + r) * 2]
-#define PARK_LOAD(r) float16 lo##r = ACC(r), hi##r = (&ACC(r))[1];
-#define PARK_STORE(r) ACC(r) = lo##r; (&ACC(r))[1] = hi##r;
 #define STORE_DIRECT(r) \
-  store_direct_row(out, out_offset, ACC(r), (&ACC(r))[1], c0 + r, channels, a0, b0, py, px, height, width, bias, bias_offset);
+  store_direct_row(out, out_offset, ACC(r), (&ACC(r))[1], c0 + r, channels, a0, place.b0, py, px, height, width, bias, bias_offset);
 
 // Global size (tiles across · bands, A panel blocks), work-groups of one work-item: the bands
 // of one panel block run back to back, so the block's weights stay in L2 while the input passes.
@@ -172,74 +126,35 @@ __kernel void subpixel_direct(__global const float* restrict a_packed, const int
                               __global const float* restrict bias, const int bias_offset,
                               const int in_channels, const int channels, const int phase_panels,
                               const int height, const int width) {
-  const int tiles_across = (width + SEG - 1) / SEG;
-  const int tile_index = get_global_id(0);
-  const int band = tile_index / tiles_across, tile = tile_index - band * tiles_across;
-  const int first_panel = get_global_id(1) * PANEL_BLOCK;
-  const int panels = min(PANEL_BLOCK, 4 * phase_panels - first_panel);
-  const int top = band * BAND_ROWS, b0 = tile * SEG;
-  if (top >= height || panels <= 0) return;
-  // The band's tiles that start inside the image (the last band may be short).
-  const int band_tiles = min(BAND, (height - top + TILE_ROWS - 1) / TILE_ROWS);
+  const BandPlace place = band_place(4 * phase_panels, height, width);
+  if (place.tiles == 0) return;
   const int k = 4 * in_channels;
   const size_t plane = (size_t)height * width;
   float16 acc[BAND * PANEL_BLOCK * MR * 2];
-  for (int q = 0; q < BAND * PANEL_BLOCK * MR * 2; ++q) acc[q] = (float16)(0.0f);
+  zero_accumulators(acc);
   float buf[CHANNEL_BLOCK * BUF_PLANE];
-  // The SEG middle columns as whole vectors where the tile's columns are all inside the image.
-  const bool full = b0 + SEG <= width;
-  // The copied rows: one above the band to one below its last tile.
-  const int buf_rows = band_tiles * TILE_ROWS + 2;
   for (int i0 = 0; i0 < in_channels; i0 += CHANNEL_BLOCK) {
-    const int count = min(CHANNEL_BLOCK, in_channels - i0);
-    for (int i = 0; i < count; ++i) {
-      __global const float* src = x + x_offset + (size_t)(i0 + i) * plane;
-      for (int r = 0; r < buf_rows; ++r) {
-        float* dst = buf + i * BUF_PLANE + r * BUF_W;
-        const int y = top - 1 + r;
-        if (y < 0 || y >= height) {
-          for (int q = 0; q < BUF_W; ++q) dst[q] = 0.0f;
-          continue;
-        }
-        __global const float* row = src + (size_t)y * width;
-        dst[0] = b0 > 0 ? row[b0 - 1] : 0.0f;
-        if (full) {
-#if SEG == 8
-          vstore8(vload8(0, row + b0), 0, dst + 1);
-#else
-          for (int q = 0; q < SEG; q += 16) vstore16(vload16(0, row + b0 + q), 0, dst + 1 + q);
-#endif
-        } else {
-          for (int q = 0; q < SEG; ++q) dst[1 + q] = b0 + q < width ? row[b0 + q] : 0.0f;
-        }
-        dst[SEG + 1] = b0 + SEG < width ? row[b0 + SEG] : 0.0f;
-      }
-    }
-    for (int j = 0; j < band_tiles; ++j) {
-      for (int p = 0; p < panels; ++p) {
-        const int panel = first_panel + p;
+    const int count = copy_band(buf, x + x_offset, plane, i0, in_channels, place, height, width);
+    for (int j = 0; j < place.tiles; ++j) {
+      for (int p = 0; p < place.panels; ++p) {
+        const int panel = place.first_panel + p;
         const int phase = panel / phase_panels;
         const int py = phase >> 1, px = phase & 1;
         __global const float* ap = a_packed + a_offset + (size_t)panel * k * MR + (size_t)i0 * 4 * MR;
         EACH_ROW(PARK_LOAD)
         const float* bp = buf + (j * TILE_ROWS + py) * BUF_W + px;
         for (int i = 0; i < count; ++i) {
-          for (int t = 0; t < 4; ++t) {
-            const float* src = bp + (t >> 1) * BUF_W + (t & 1);
-            LOAD_B(src, BUF_W)
-            EACH_ROW(ACCUMULATE)
-            ap += MR;
-          }
+          for (int t = 0; t < 4; ++t) BAND_TAP(bp + (t >> 1) * BUF_W + (t & 1))
           bp += BUF_PLANE;
         }
         EACH_ROW(PARK_STORE)
       }
     }
   }
-  for (int j = 0; j < band_tiles; ++j) {
-    const int a0 = top + j * TILE_ROWS;
-    for (int p = 0; p < panels; ++p) {
-      const int panel = first_panel + p;
+  for (int j = 0; j < place.tiles; ++j) {
+    const int a0 = place.top + j * TILE_ROWS;
+    for (int p = 0; p < place.panels; ++p) {
+      const int panel = place.first_panel + p;
       const int phase = panel / phase_panels;
       const int py = phase >> 1, px = phase & 1;
       const int c0 = (panel - phase * phase_panels) * MR;

@@ -8,6 +8,7 @@
 #include "inertialnet/runtime/device.hpp"
 #include "inertialnet/ops/bias_activation.hpp"
 #include "inertialnet/ops/gemm/gemm.hpp"
+#include "ops/conv2d_banded.hpp"
 #include "ops/conv2d_slices.hpp"
 #include "ops/conv2d_splitk.hpp"
 #include "ops/op_support.hpp"
@@ -140,6 +141,24 @@ void conv2d(Queue& queue, const Tensor& input, const Tensor& weight, const Tenso
        detail::splitk_slices_preferred(device.info(), backend, weight.shape(), output_pixels))) {
     detail::report_backend(queue, "splitk_slices");
     detail::conv2d_slices(queue, input, weight, bias, output, options);
+    return;
+  }
+  if (options.algorithm == Conv2dAlgorithm::Banded ||
+      (options.algorithm == Conv2dAlgorithm::Default && uses_packed_kernels(backend) &&
+       detail::conv2d_banded_preferred(weight.shape(), options.stride, options.padding))) {
+    if (!detail::conv2d_banded_eligible(weight.shape(), options.stride, options.padding)) {
+      throw invalid_input("conv2d: the banded form runs 3×3 windows with stride 1 and padding 1, not weight " +
+                          to_string(weight.shape()) + " with stride " + std::to_string(options.stride) +
+                          " and padding " + std::to_string(options.padding));
+    }
+    detail::report_backend(queue, "banded");
+    const bool prepared = options.prepared && options.prepared->packed.data.defined();
+    const auto rows = static_cast<std::size_t>(weight.dim(0));
+    const std::size_t reduction = static_cast<std::size_t>(weight.numel()) / rows;
+    detail::conv2d_banded(queue, input,
+                          prepared ? options.prepared->packed
+                                   : pack_a(queue, Transpose::No, rows, reduction, MatrixView::of(weight, reduction)),
+                          bias, output, options.activation);
     return;
   }
   if (options.algorithm == Conv2dAlgorithm::ImplicitGemm) {

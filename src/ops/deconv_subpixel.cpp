@@ -6,6 +6,7 @@
 #include <string>
 
 #include "inertialnet/runtime/device.hpp"
+#include "ops/direct_band.hpp"
 #include "ops/op_support.hpp"
 
 namespace inertialnet::detail {
@@ -52,22 +53,6 @@ PackedPanels subpixel_weights(Queue& queue, const Tensor& weight, Device* long_l
 
 namespace {
 
-// The direct form's blocks (kernels_cl/deconv_subpixel.cl, subpixel_direct): a work-item runs
-// a band of tiles for kDirectPanelBlock A panels (every phase of FlowNetFusion's deconv0, whose four
-// phases of 16 channels are 8 panels of MR = 8), over the input channels kDirectChannelBlock at a
-// time: 16 channels of a band's ten input rows of 34 floats are 21 KiB, so they serve the 8
-// panels' 4 taps from L1, and a tile's 8 panels' parked accumulators are 8 KiB. Measured per
-// layer at 512×384 (docs/performance.md, "Issue 24, fifth pass" and "A band of tiles per
-// work-item"): blocks of 8 panels against 4 and 16, of 16 channels against 8 and 32.
-constexpr std::size_t kDirectPanelBlock = 8;
-constexpr int kDirectChannelBlock = 16;
-// Tiles per band (down the image): the band's tiles share the input rows they overlap, so a
-// channel block copies BAND·TILE_ROWS + 2 rows instead of 3·TILE_ROWS per tile; its parked
-// accumulators (BAND × 8 KiB at MR = 8) stay in L2. Fewer where the bands would leave fewer
-// than kDirectMinWorkItems work-items to share between the cores.
-constexpr int kDirectBand = 8;
-constexpr std::size_t kDirectMinWorkItems = 16;
-
 // The phase weights' rows per phase (co padded to whole A panels), checked against the layer.
 std::size_t checked_phase_rows(const Tensor& input, const PackedPanels& weights, const Tensor& output) {
   const auto in_channels = static_cast<std::size_t>(input.c());
@@ -91,32 +76,14 @@ void conv_transpose2d_subpixel_direct(Queue& queue, const Tensor& input, const P
   const int in_channels = static_cast<int>(input.c());
   const int out_channels = static_cast<int>(output.c());
   const int height = static_cast<int>(input.h()), width = static_cast<int>(input.w());
-  // A tile is 32 windows: SEG columns × 32 / SEG rows, SEG the narrowest of 8, 16, 32 that
-  // holds the row (so a narrow input still fills the tile's lanes).
-  const int seg = width <= 8 ? 8 : width <= 16 ? 16 : 32;
-  const int tile_rows = 32 / seg;
-  const int tiles = (width + seg - 1) / seg, row_tiles = (height + tile_rows - 1) / tile_rows;
   const auto phase_panels = phase_rows / static_cast<std::size_t>(weights.width);
-  const std::size_t panels = 4 * phase_panels;
-  const std::size_t block = std::min(kDirectPanelBlock, panels);
-  const std::size_t panel_blocks = (panels + block - 1) / block;
-  int band = std::min(kDirectBand, row_tiles);
-  const auto work_items = [&](int b) {
-    return static_cast<std::size_t>(tiles) * static_cast<std::size_t>((row_tiles + b - 1) / b) * panel_blocks;
-  };
-  while (band > 1 && work_items(band) < kDirectMinWorkItems) band /= 2;
-  const int bands = (row_tiles + band - 1) / band;
+  const DirectBand plan = plan_direct_band(height, width, 4 * phase_panels);
   const bool has_bias = bias.defined();
   Kernel& kernel = queue.kernel("deconv_subpixel", "subpixel_direct",
-                                KernelDefines()
+                                KernelDefines(plan.defines)
                                     .add("MR", weights.width)
-                                    .add("SEG", seg)
-                                    .add("BAND", band)
-                                    .add("PANEL_BLOCK", static_cast<int>(block))
-                                    .add("CHANNEL_BLOCK", kDirectChannelBlock)
                                     .add("HAS_BIAS", has_bias)
                                     .add(activation_defines(options.activation)));
-  const Range global(static_cast<std::size_t>(tiles) * static_cast<std::size_t>(bands), panel_blocks);
   for (std::int64_t n = 0; n < input.n(); ++n) {
     const Tensor in_n = input.sample(n);
     const Tensor out_n = output.sample(n);
@@ -124,7 +91,7 @@ void conv_transpose2d_subpixel_direct(Queue& queue, const Tensor& input, const P
     const Tensor bias_arg = has_bias ? bias : out_n;
     kernel.set_args(weights.data, in_n, out_n, bias_arg, in_channels, out_channels, static_cast<int>(phase_panels),
                     height, width);
-    queue.launch(kernel, global, Range(1, 1));
+    queue.launch(kernel, plan.global, Range(1, 1));
   }
 }
 

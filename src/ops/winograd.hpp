@@ -25,7 +25,8 @@ namespace inertialnet::detail {
 // Transformed elements per tile (6×6): one GEMM each.
 inline constexpr std::size_t kWinogradElements = 36;
 
-// Output channels from which a 3×3 stride-1 layer runs Winograd on the winograd plan.
+// Output channels from which a 3×3 stride-1 layer runs Winograd on the winograd plan (with
+// padding 1, from 17: up to 16 outputs of a deep input run the banded form, ops/conv2d_banded.hpp).
 inline constexpr std::int64_t kWinogradMinChannels = 16;
 // Input channels from which it does: each product's depth is ci, and with a shallow one the
 // transformed input (36·ci floats per 4×4 tile) and the 36 short products cost more than the 9·ci

@@ -14,6 +14,7 @@
 #include "support/conv_matches.hpp"
 #include "support/flownet_layers.hpp"
 #include "support/testing.hpp"
+#include "ops/conv2d_banded.hpp"
 
 namespace inertialnet {
 namespace {
@@ -126,7 +127,7 @@ TEST(Conv2d, ImplicitGemmRule) {
     implicit += expected && layer.co > kDirectConvMaxChannels;  // fewer outputs run the direct kernel
   }
   // FlowNetC's conv1 and conv_redir, FlowNetS's conv1, conv0 and conv1 of FlowNetSD and FlowNetFusion,
-  // FlowNetFusion's inter_conv0 (on the packed plan; the winograd plan runs it as Winograd).
+  // and FlowNetFusion's inter_conv0 by this rule (which both packed plans run in the banded form).
   EXPECT_EQ(implicit, 8);
   DeviceInfo small = device;
   small.local_memory_bytes = 32 * 1024;  // a GPU's: a panel of 576 rows (72 KiB) does not fit
@@ -174,6 +175,66 @@ TEST(Conv2d, FewOutputChannelsDirectKernelAtOddSizes) {
   expect_conv_matches({"direct_k1", 7, 3, 9, 50, 1, 1, 0, true, leaky}, {1});
   expect_conv_matches({"direct_k3p2", 3, 2, 11, 35, 3, 1, 2, false, ActivationSpec::none()}, {1});
   expect_conv_matches({"direct_slices", 6, 2, 13, 40, 3, 1, 1, true, leaky}, {3, 2, 3, 1, 4, 0});
+}
+
+// The banded direct form (3×3, stride 1, padding 1; the plan's choice for 4 < co ≤ 16 outputs of at
+// least 32 input channels on the packed plans): forced at odd sizes. Tiles of 32 columns, of 16 × 2
+// and of 8 × 4 rows (widths 7, 13, 37, 70: a partial last tile in each), bands of up to 8 tiles with
+// a short last band and a last tile that ends inside the image (heights 1, 5, 23, 75), channel
+// blocks of 16 with a remainder (ci 1, 17, 33), output channels 5 (one partial panel), 8, 16 and
+// 29 (partial panels after whole ones), with and without bias, each activation, batches, channel
+// slices on both sides, and the device's tuned MR of 1, 6 and 14.
+TEST(Conv2d, BandedFormAtOddSizes) {
+  const testing::ConvRun banded{Conv2dAlgorithm::Banded};
+  const auto leaky = ActivationSpec::leaky_relu(0.1f);
+  for (int w : {7, 13, 37, 70}) {
+    for (int h : {1, 5, 23, 75}) {
+      const std::string s = "_" + std::to_string(w) + "x" + std::to_string(h);
+      expect_conv_matches({"banded_co16" + s, 17, 16, h, w, 3, 1, 1, true, leaky}, {1}, banded);
+    }
+  }
+  for (int co : {5, 8, 29}) {
+    expect_conv_matches({"banded_co" + std::to_string(co), 33, co, 23, 37, 3, 1, 1, co != 8, ActivationSpec::relu()},
+                        {2}, banded);
+  }
+  expect_conv_matches({"banded_ci1_nobias", 1, 6, 9, 40, 3, 1, 1, false, ActivationSpec::none()}, {3}, banded);
+  expect_conv_matches({"banded_slices", 20, 12, 13, 70, 3, 1, 1, true, leaky}, {2, 2, 3, 1, 4, 0}, banded);
+  for (const int mr : {1, 6, 14}) {
+    SCOPED_TRACE("MR " + std::to_string(mr));
+    const testing::ScopedPackedTuning tuning({{"MR", mr}});
+    expect_conv_matches({"banded_mr_co15", 17, 15, 23, 37, 3, 1, 1, true, leaky}, {1}, banded);
+  }
+  // Forced on any other window, it refuses.
+  Queue& queue = testing::test_queue();
+  Device& d = testing::test_device();
+  Conv2dOptions strided{2, 1, ActivationSpec::none()};
+  strided.algorithm = Conv2dAlgorithm::Banded;
+  testing::expect_invalid_input(
+      [&] {
+        conv2d(queue, Tensor::empty(d, {1, 4, 8, 8}), Tensor::empty(d, {8, 4, 3, 3}), Tensor(),
+               Tensor::empty(d, {1, 8, 4, 4}), strided);
+      },
+      "banded form runs 3×3 windows with stride 1 and padding 1");
+}
+
+// Where the plan runs it (FlowNetFusion's inter_conv0, 82 → 16, alone in FlowNet2; not the
+// shallow few-channel layers such as the InertialNet head's conv1), and that layer at the real
+// 512×384 input under the plan's choice.
+TEST(Conv2d, BandedFormRuleAndFlowNet2sLayer) {
+  int banded = 0;
+  for (const auto& layer : flownet_layers::flownet2_layers(384, 512, flownet_layers::LayerKind::Conv)) {
+    const bool preferred = detail::conv2d_banded_preferred({layer.co, layer.ci, layer.k, layer.k}, layer.stride,
+                                                           layer.padding);
+    EXPECT_EQ(preferred, layer.name == "flownetfusion.inter_conv0") << layer.name;
+    banded += preferred;
+    if (preferred) expect_conv_matches(testing::conv_case_of(layer), ConvPlacement{});
+  }
+  EXPECT_EQ(banded, 1);
+  EXPECT_FALSE(detail::conv2d_banded_preferred({16, 2, 3, 3}, 1, 1));    // the head's conv1
+  EXPECT_FALSE(detail::conv2d_banded_preferred({4, 82, 3, 3}, 1, 1));    // the direct kernel's
+  EXPECT_FALSE(detail::conv2d_banded_preferred({17, 82, 3, 3}, 1, 1));   // more outputs
+  EXPECT_FALSE(detail::conv2d_banded_preferred({16, 82, 3, 3}, 2, 1));   // stride 2
+  EXPECT_TRUE(detail::conv2d_banded_preferred({5, 32, 3, 3}, 1, 1));
 }
 
 // FlowNet2's predict_flow layers at the real 512×384 input (FlowNetFusion's predict_flow0 at

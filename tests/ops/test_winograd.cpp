@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // Winograd F(4×4, 3×3) (the winograd plan's 3×3 stride-1 convolutions) against the direct
 // convolution of tests/reference/conv.cpp: every FlowNet2 3×3 stride-1 shape of ≥ 16 output and
-// ≥ 32 input channels at a 64×64 network input, odd sizes, batch 3, channel-slice inputs and
+// ≥ 32 input channels at a 64×64 network input but the one the banded form takes (16 outputs with
+// padding 1: ops/conv2d_banded.hpp), odd sizes, batch 3, channel-slice inputs and
 // outputs, tile ranges, other paddings, and the layers the plan leaves on the packed GEMM.
 //
 // Error bound: direct convolution is held to 1e-5 of (|reference| + sqrt(K)) (K = ci·9, the
@@ -17,6 +18,7 @@
 #include "inertialnet/ops/gemm/backend.hpp"
 #include "inertialnet/ops/gemm/plan.hpp"
 #include "ops/op_testing.hpp"
+#include "ops/conv2d_banded.hpp"
 #include "ops/winograd.hpp"
 #include "support/conv_matches.hpp"
 #include "support/flownet_layers.hpp"
@@ -46,7 +48,11 @@ TEST_P(FlowNetWinogradShapes, MatchTheReference) { expect_winograd_matches(GetPa
 std::vector<ConvCase> flownet2_winograd_cases() {
   std::vector<ConvCase> cases;
   for (const auto& l : flownet_layers::flownet2_layers(64, 64, flownet_layers::LayerKind::Conv)) {
-    if (l.k != 3 || l.stride != 1 || l.co < 16 || l.ci < 32) continue;
+    // FlowNetFusion's inter_conv0 (82 → 16) runs the banded form instead (ops/conv2d_banded.hpp).
+    if (l.k != 3 || l.stride != 1 || l.co < 16 || l.ci < 32 ||
+        detail::conv2d_banded_preferred({l.co, l.ci, l.k, l.k}, l.stride, l.padding)) {
+      continue;
+    }
     cases.push_back(testing::conv_case_of(l));
   }
   return cases;
@@ -61,8 +67,8 @@ TEST(Winograd, OddSizesBatchThree) {
   // Odd output sizes leave half tiles on the bottom row and the right column.
   const auto leaky = ActivationSpec::leaky_relu(0.1f);
   expect_winograd_matches({"odd_37x23", 35, 17, 37, 23, 3, 1, 1, true, leaky}, {3});
-  expect_winograd_matches({"odd_5x3", 32, 16, 5, 3, 3, 1, 1, false, ActivationSpec::relu()}, {3});
-  expect_winograd_matches({"one_pixel", 40, 16, 1, 1, 3, 1, 1, true, ActivationSpec::none()}, {3});
+  expect_winograd_matches({"odd_5x3", 32, 17, 5, 3, 3, 1, 1, false, ActivationSpec::relu()}, {3});
+  expect_winograd_matches({"one_pixel", 40, 17, 1, 1, 3, 1, 1, true, ActivationSpec::none()}, {3});
   expect_winograd_matches({"even_38x22", 33, 33, 38, 22, 3, 1, 1, true, leaky}, {3});
 }
 
@@ -72,11 +78,11 @@ TEST(Winograd, RowsOfSixteenWholeTilesStoreAsVectors) {
   // ranges that start mid-row take the per-pixel one, in the same call.
   const auto leaky = ActivationSpec::leaky_relu(0.1f);
   expect_winograd_matches({"wide_128x9", 32, 24, 9, 128, 3, 1, 1, true, leaky}, {2});
-  expect_winograd_matches({"wide_80x14", 33, 16, 14, 80, 3, 1, 1, false, ActivationSpec::relu()}, {1});
-  expect_winograd_matches({"wide_ranges", 32, 16, 16, 80, 3, 1, 1, true, leaky}, {1, 0, 0, 0, 0, 36 * 32 * 40});
+  expect_winograd_matches({"wide_80x14", 33, 24, 14, 80, 3, 1, 1, false, ActivationSpec::relu()}, {1});
+  expect_winograd_matches({"wide_ranges", 32, 24, 16, 80, 3, 1, 1, true, leaky}, {1, 0, 0, 0, 0, 36 * 32 * 40});
   // 160 columns: the middle group of 16 tiles reads its window rows as whole vectors (80 input
   // columns inside the plane), the outer ones pad with zeros.
-  expect_winograd_matches({"wide_160x7", 32, 16, 7, 160, 3, 1, 1, true, leaky}, {2});
+  expect_winograd_matches({"wide_160x7", 32, 24, 7, 160, 3, 1, 1, true, leaky}, {2});
 }
 
 TEST(Winograd, OtherPaddings) {
@@ -87,8 +93,8 @@ TEST(Winograd, OtherPaddings) {
 TEST(Winograd, WritesIntoAChannelSliceAndReadsFromOne) {
   const auto leaky = ActivationSpec::leaky_relu(0.1f);
   expect_winograd_matches({"slice", 36, 18, 37, 23, 3, 1, 1, true, leaky}, {3, 2, 3, 5, 4, 0});
-  expect_winograd_matches({"slice_first", 32, 16, 16, 16, 3, 1, 1, true, ActivationSpec::none()}, {3, 0, 1, 0, 7});
-  expect_winograd_matches({"slice_last", 32, 16, 16, 16, 3, 1, 1, true, ActivationSpec::none()}, {3, 1, 0, 7, 0});
+  expect_winograd_matches({"slice_first", 32, 24, 16, 16, 3, 1, 1, true, ActivationSpec::none()}, {3, 0, 1, 0, 7});
+  expect_winograd_matches({"slice_last", 32, 24, 16, 16, 3, 1, 1, true, ActivationSpec::none()}, {3, 1, 0, 7, 0});
 }
 
 TEST(Winograd, SmallBudgetProcessesTileRanges) {
@@ -96,7 +102,7 @@ TEST(Winograd, SmallBudgetProcessesTileRanges) {
   // one partial; a budget of 1 float processes one tile at a time.
   const auto leaky = ActivationSpec::leaky_relu(0.1f);
   expect_winograd_matches({"ranges", 40, 20, 37, 23, 3, 1, 1, true, leaky}, {3, 1, 1, 2, 2, 16 * 40 * 40});
-  expect_winograd_matches({"one_tile", 32, 16, 5, 4, 3, 1, 1, true, ActivationSpec::relu()}, {2, 0, 0, 0, 0, 1});
+  expect_winograd_matches({"one_tile", 32, 17, 5, 4, 3, 1, 1, true, ActivationSpec::relu()}, {2, 0, 0, 0, 0, 1});
 }
 
 TEST(Winograd, IneligibleLayersRunPacked) {
@@ -117,8 +123,10 @@ TEST(Winograd, SmallOutputsStayOnThePackedGemm) {
   EXPECT_TRUE(detail::winograd_preferred({}, {512, 512, 3, 3}, 1, 1));  // size unknown
   EXPECT_FALSE(detail::winograd_preferred({1, 512, 24, 32}, {512, 512, 3, 3}, 2, 1));
   const auto leaky = ActivationSpec::leaky_relu(0.1f);
-  expect_winograd_matches({"tiles_32", 32, 16, 16, 32, 3, 1, 1, true, leaky}, {1}, true, true);
-  expect_winograd_matches({"tiles_28", 32, 16, 16, 28, 3, 1, 1, true, leaky}, {2}, false, true);
+  expect_winograd_matches({"tiles_32", 32, 24, 16, 32, 3, 1, 1, true, leaky}, {1}, true, true);
+  expect_winograd_matches({"tiles_28", 32, 24, 16, 28, 3, 1, 1, true, leaky}, {2}, false, true);
+  // 16 outputs of 32 inputs and more run the banded form on the winograd plan (ops/conv2d_banded.hpp).
+  expect_winograd_matches({"banded_co16", 32, 16, 16, 32, 3, 1, 1, true, leaky}, {1}, false, true);
   expect_winograd_matches({"conv6_1_like", 64, 32, 6, 8, 3, 1, 1, true, leaky}, {1}, false, true);
 }
 
@@ -129,10 +137,10 @@ TEST(Winograd, InputTransformChannelBlocksAndEdgeVectors) {
   // left (padding 1) or right edge mid-vector; 132 with padding 0 has a group whose vectors all
   // lie inside. Batches and a tile range that starts mid-row, as in the network.
   const auto leaky = ActivationSpec::leaky_relu(0.1f);
-  expect_winograd_matches({"w70_ci45", 45, 16, 13, 70, 3, 1, 1, true, leaky}, {2});
+  expect_winograd_matches({"w70_ci45", 45, 24, 13, 70, 3, 1, 1, true, leaky}, {2});
   expect_winograd_matches({"w69_pad0", 33, 20, 10, 69, 3, 1, 0, false, ActivationSpec::relu()}, {1});
   expect_winograd_matches({"w132_pad0", 40, 16, 9, 132, 3, 1, 0, true, ActivationSpec::none()}, {2});
-  expect_winograd_matches({"w70_ranges", 45, 16, 21, 70, 3, 1, 1, true, leaky}, {1, 0, 0, 0, 0, 36 * 45 * 40});
+  expect_winograd_matches({"w70_ranges", 45, 24, 21, 70, 3, 1, 1, true, leaky}, {1, 0, 0, 0, 0, 36 * 45 * 40});
 }
 
 TEST(Winograd, DeepLayersUseTheWidestRegisterTile) {
@@ -151,7 +159,7 @@ TEST(Winograd, DeepLayersUseTheWidestRegisterTile) {
   expect_winograd_matches({"deep_co30_tiles", 384, 30, 16, 40, 3, 1, 1, false, ActivationSpec::none()}, {1}, true, true);
   // 24×32 outputs as FlowNet2's conv4_1: 48 tiles, the second 32-tile panel half padding, whose
   // products run on its low 16 columns alone (kernels_cl/winograd_gemm.cl); batch 2.
-  expect_winograd_matches({"conv4_1_like", 384, 16, 24, 32, 3, 1, 1, true, leaky}, {2}, true, true);
+  expect_winograd_matches({"conv4_1_like", 384, 24, 24, 32, 3, 1, 1, true, leaky}, {2}, true, true);
   Queue& queue = testing::test_queue();
   const Tensor w = Tensor::from_host(queue, {30, 384, 3, 3}, testing::random_vector(30 * 384 * 9, 7));
   const GemmWeights prepared = prepare_conv2d_weights(queue, w, GemmBackend::Winograd, 1, 1, Shape{});

@@ -22,7 +22,8 @@
 namespace inertialnet {
 
 // How a layer runs: Default is the plan's choice (the backend's GEMM or Winograd form; on CPUs the
-// direct kernel for ≤ kDirectConvMaxChannels outputs and the implicit GEMM where
+// direct kernel for ≤ kDirectConvMaxChannels outputs, the banded form for 3×3 stride-1 layers of
+// a few more, and the implicit GEMM where
 // implicit_gemm_preferred() says; on other devices the split-K forms where their rules say,
 // src/ops/conv2d_splitk.hpp); the others force one (tests). SplitKGroup (one work-group per few
 // pixels, the reduction split across its work-items) on a layer of more than
@@ -31,8 +32,10 @@ namespace inertialnet {
 // src/ops/conv2d_slices.hpp) takes any layer. Im2colGemm: the im2col columns (B panels on the
 // packed kernels) and the backend's GEMM, in ranges within max_column_floats. ImplicitGemm: the
 // packed kernels' implicit GEMM (ops/gemm/packed_gemm.hpp) on any backend; invalid_input where its
-// panel does not fit the device's local memory.
-enum class Conv2dAlgorithm { Default, SplitKGroup, SplitKSlices, Im2colGemm, ImplicitGemm };
+// panel does not fit the device's local memory. Banded: the banded direct form of a 3×3 stride-1
+// padding-1 layer (src/ops/conv2d_banded.hpp; by default on the packed backends for
+// kDirectConvMaxChannels < co ≤ 16 and ci ≥ 32); invalid_input on any other window.
+enum class Conv2dAlgorithm { Default, SplitKGroup, SplitKSlices, Im2colGemm, ImplicitGemm, Banded };
 
 struct Conv2dOptions {
   int stride = 1;

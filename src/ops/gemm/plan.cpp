@@ -5,6 +5,7 @@
 
 #include "inertialnet/ops/gemm/plan_cache.hpp"
 #include "inertialnet/runtime/device.hpp"
+#include "ops/conv2d_banded.hpp"
 #include "ops/deconv_subpixel.hpp"
 #include "ops/median_timing.hpp"
 #include "ops/winograd.hpp"
@@ -49,7 +50,9 @@ GemmWeights prepare_conv2d_weights(Queue& queue, const Tensor& weight, GemmBacke
   GemmWeights prepared;
   prepared.backend = backend;
   const auto rows = static_cast<std::size_t>(weight.dim(0));
-  if (backend == GemmBackend::Winograd && detail::winograd_preferred(input, weight.shape(), stride, padding)) {
+  // The banded form (few outputs, 3×3 stride 1) runs the packed weights on either packed backend.
+  const bool banded = uses_packed_kernels(backend) && detail::conv2d_banded_preferred(weight.shape(), stride, padding);
+  if (!banded && backend == GemmBackend::Winograd && detail::winograd_preferred(input, weight.shape(), stride, padding)) {
     prepared.winograd = detail::winograd_phase_eligible(weight.shape(), stride, padding)
                             ? detail::winograd_phase_weights(queue, weight, &queue.device())
                             : detail::winograd_weights(queue, weight, &queue.device());
