@@ -20,19 +20,23 @@ namespace {
 
 const std::string kOp = "conv2d";
 
+// The weights [co, ci·kh·kw] in MR-row panels: the prepared ones, else packed now (also a layer of
+// few outputs forced off the direct kernel, or forced into the banded form on another plan).
+PackedPanels packed_weights(Queue& queue, const Tensor& weight, const Conv2dOptions& options) {
+  if (options.prepared && options.prepared->packed.data.defined()) return options.prepared->packed;
+  const auto rows = static_cast<std::size_t>(weight.dim(0));
+  const std::size_t reduction = static_cast<std::size_t>(weight.numel()) / rows;
+  return pack_a(queue, Transpose::No, rows, reduction, MatrixView::of(weight, reduction));
+}
+
 // The packed backend: weights in MR-row panels (prepared once, or packed now), then either the
 // implicit GEMM (few output channels: each work-item builds its B panel in local memory) or
 // im2col writing the B panels of a range of output pixels and a GEMM; either store adds the bias,
 // applies the activation and writes the pixels of every output channel into the output view.
 void conv2d_packed(Queue& queue, const Tensor& input, const Tensor& weight, const Tensor& bias, const Tensor& output,
                    const Conv2dOptions& options) {
-  const bool prepared = options.prepared && options.prepared->packed.data.defined();
-  const auto rows = static_cast<std::size_t>(weight.dim(0));
-  const std::size_t reduction = static_cast<std::size_t>(weight.numel()) / rows;
-  // Packed now where they were not (also a layer of few outputs forced off the direct kernel).
-  const PackedPanels weights =
-      prepared ? options.prepared->packed
-               : pack_a(queue, Transpose::No, rows, reduction, MatrixView::of(weight, reduction));
+  const PackedPanels weights = packed_weights(queue, weight, options);
+  const std::size_t reduction = static_cast<std::size_t>(weight.numel()) / static_cast<std::size_t>(weight.dim(0));
   const auto out_h = static_cast<int>(output.h()), out_w = static_cast<int>(output.w());
   const std::size_t pixels = static_cast<std::size_t>(out_h) * static_cast<std::size_t>(out_w);
   const Im2colGeometry geometry{static_cast<int>(weight.dim(2)), static_cast<int>(weight.dim(3)), options.stride,
@@ -152,13 +156,7 @@ void conv2d(Queue& queue, const Tensor& input, const Tensor& weight, const Tenso
                           " and padding " + std::to_string(options.padding));
     }
     detail::report_backend(queue, "banded");
-    const bool prepared = options.prepared && options.prepared->packed.data.defined();
-    const auto rows = static_cast<std::size_t>(weight.dim(0));
-    const std::size_t reduction = static_cast<std::size_t>(weight.numel()) / rows;
-    detail::conv2d_banded(queue, input,
-                          prepared ? options.prepared->packed
-                                   : pack_a(queue, Transpose::No, rows, reduction, MatrixView::of(weight, reduction)),
-                          bias, output, options.activation);
+    detail::conv2d_banded(queue, input, packed_weights(queue, weight, options), bias, output, options.activation);
     return;
   }
   if (options.algorithm == Conv2dAlgorithm::ImplicitGemm) {
