@@ -109,10 +109,10 @@ inline void store_direct_row(__global float* out, const int out_offset, float16 
 }
 
 // One work-item computes a band of BAND tiles down the image for every panel of a block of
-// PANEL_BLOCK A panels (phases included), the banded direct form of direct_band.cl. A panels are
-// phase-major, `phase_panels` of MR rows per phase (rows past co zero); A's column i·4 + ty·2 + tx
-// is tap (ty, tx) of input channel i, whose B values are the buffer's rows py + ty …, columns
-// px + tx …: whole vectors, no packing.
+// PANEL_BLOCK A panels (phases included), the banded direct form of direct_band.cl. The a_panels
+// A panels are phase-major, a quarter of them (phase_panels) of MR rows per phase (rows past co
+// zero); A's column i·4 + ty·2 + tx is tap (ty, tx) of input channel i, whose B values are the
+// buffer's rows py + ty …, columns px + tx …: whole vectors, no packing.
 // Build options: -DMR, -DSEG, -DBAND, -DPANEL_BLOCK, -DCHANNEL_BLOCK, -DHAS_BIAS, -DACTIVATION.
 
 #define STORE_DIRECT(r) \
@@ -124,9 +124,10 @@ __kernel void subpixel_direct(__global const float* restrict a_packed, const int
                               __global const float* restrict x, const int x_offset,
                               __global float* restrict out, const int out_offset,
                               __global const float* restrict bias, const int bias_offset,
-                              const int in_channels, const int channels, const int phase_panels,
+                              const int in_channels, const int channels, const int a_panels,
                               const int height, const int width) {
-  const BandPlace place = band_place(4 * phase_panels, height, width);
+  const int phase_panels = a_panels / 4;  // the A panels are phase-major, whole panels per phase
+  const BandPlace place = band_place(a_panels, height, width);
   if (place.tiles == 0) return;
   const int k = 4 * in_channels;
   const size_t plane = (size_t)height * width;

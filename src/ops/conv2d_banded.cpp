@@ -26,23 +26,7 @@ void conv2d_banded(Queue& queue, const Tensor& input, const PackedPanels& weight
                         std::to_string(weights.depth) + "], the layer needs [" + std::to_string(out_channels) +
                         " × " + std::to_string(9 * in_channels) + "]");
   }
-  const int height = static_cast<int>(output.h()), width = static_cast<int>(output.w());
-  const DirectBand plan = plan_direct_band(height, width, weights.panels());
-  const bool has_bias = bias.defined();
-  Kernel& kernel = queue.kernel("conv2d_banded", "conv3x3_banded",
-                                KernelDefines(plan.defines)
-                                    .add("MR", weights.width)
-                                    .add("HAS_BIAS", has_bias)
-                                    .add(activation_defines(activation)));
-  for (std::int64_t n = 0; n < input.n(); ++n) {
-    const Tensor in_n = input.sample(n);
-    const Tensor out_n = output.sample(n);
-    // Without a bias the kernel never reads its bias argument; any valid buffer will do.
-    const Tensor bias_arg = has_bias ? bias : out_n;
-    kernel.set_args(weights.data, in_n, out_n, bias_arg, static_cast<int>(in_channels), static_cast<int>(out_channels),
-                    static_cast<int>(weights.panels()), height, width);
-    queue.launch(kernel, plan.global, Range(1, 1));
-  }
+  run_direct_band(queue, "conv2d_banded", "conv3x3_banded", weights, input, bias, output, activation);
 }
 
 }  // namespace inertialnet::detail

@@ -72,27 +72,8 @@ std::size_t checked_phase_rows(const Tensor& input, const PackedPanels& weights,
 void conv_transpose2d_subpixel_direct(Queue& queue, const Tensor& input, const PackedPanels& weights,
                                       const Tensor& bias, const Tensor& output,
                                       const ConvTranspose2dOptions& options) {
-  const std::size_t phase_rows = checked_phase_rows(input, weights, output);
-  const int in_channels = static_cast<int>(input.c());
-  const int out_channels = static_cast<int>(output.c());
-  const int height = static_cast<int>(input.h()), width = static_cast<int>(input.w());
-  const auto phase_panels = phase_rows / static_cast<std::size_t>(weights.width);
-  const DirectBand plan = plan_direct_band(height, width, 4 * phase_panels);
-  const bool has_bias = bias.defined();
-  Kernel& kernel = queue.kernel("deconv_subpixel", "subpixel_direct",
-                                KernelDefines(plan.defines)
-                                    .add("MR", weights.width)
-                                    .add("HAS_BIAS", has_bias)
-                                    .add(activation_defines(options.activation)));
-  for (std::int64_t n = 0; n < input.n(); ++n) {
-    const Tensor in_n = input.sample(n);
-    const Tensor out_n = output.sample(n);
-    // Without a bias the kernel never reads its bias argument; any valid buffer will do.
-    const Tensor bias_arg = has_bias ? bias : out_n;
-    kernel.set_args(weights.data, in_n, out_n, bias_arg, in_channels, out_channels, static_cast<int>(phase_panels),
-                    height, width);
-    queue.launch(kernel, plan.global, Range(1, 1));
-  }
+  checked_phase_rows(input, weights, output);
+  run_direct_band(queue, "deconv_subpixel", "subpixel_direct", weights, input, bias, output, options.activation);
 }
 
 void conv_transpose2d_subpixel(Queue& queue, const Tensor& input, const PackedPanels& weights, const Tensor& bias,
