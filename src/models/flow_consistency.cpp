@@ -54,6 +54,23 @@ int mark_inconsistent_flow(FlowField& forward, const FlowField& backward, double
   return marked;
 }
 
+int mark_flow_edge_band(FlowField& flow, int band_px) {
+  if (band_px < 0) throw invalid_input("flow edge band: the band must be 0 or more pixels, got " + std::to_string(band_px));
+  const int w = flow.width, h = flow.height;
+  int marked = 0;
+  for (int y = 0; y < h; ++y) {
+    const bool edge_row = y < band_px || y > h - 1 - band_px;
+    for (int x = 0; x < w; ++x) {
+      if (!edge_row && x >= band_px && x <= w - 1 - band_px) continue;
+      const std::size_t i = static_cast<std::size_t>(y) * w + x;
+      if (!is_unknown_flow(flow.u[i], flow.v[i])) ++marked;
+      flow.u[i] = kUnknownFlowValue;
+      flow.v[i] = kUnknownFlowValue;
+    }
+  }
+  return marked;
+}
+
 void require_flow_check_setting(double px_at_752_columns, const char* name) {
   // The upper bound: a round trip missing by more than kMaxFlowCheckPx pixels at 752 columns is
   // no flow at all, so a larger value only switches the check off silently (1e300 did) while

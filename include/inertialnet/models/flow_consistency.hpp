@@ -20,6 +20,14 @@ int mark_inconsistent_flow(FlowField& forward, const FlowField& backward, double
 // width; predict --flow-check, Python's flow_check), so that one setting means the same at every size.
 inline double flow_check_threshold_px(double px_at_752_columns, int width) { return px_at_752_columns * width / 752.0; }
 
+// Marks unknown every vector within `band_px` pixels of the image's edge (column or row index
+// below band_px, or above the last one minus band_px) and returns how many it marked that were
+// known. For DIS (DisFlow::edge_band_px): a patch search's vectors there are matched from patches
+// that overlap from one side only and extrapolated across the edge, and the geometric head fitted
+// to them is 10–50 % worse on every axis (docs/real_cameras.md, "DIS's edge band"). 0 marks
+// nothing; a negative band is invalid_input.
+int mark_flow_edge_band(FlowField& flow, int band_px);
+
 // Refuses (invalid_input) a check setting that is negative, not finite or above kMaxFlowCheckPx,
 // naming it as `name` (Python's keyword, say) and quoting the value; 0 means no check.
 inline constexpr int kMaxFlowCheckPx = 1000;
