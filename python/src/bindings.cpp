@@ -494,7 +494,7 @@ class PyFlowNet {
 };
 
 py::array_t<float> dis_flow(const py::array& first, const py::array& second, const std::string& order,
-                            double flow_check, const std::string& method) {
+                            double flow_check, const std::string& method, bool edge_band) {
   // "dis-fine": the DIS a recipe head since v3 learned from (models/dis_flow.hpp, DisVariant).
   if (method != "dis" && method != "dis-fine") {
     throw invalid_input("method '" + method.substr(0, 40) + "': expected dis or dis-fine");
@@ -509,6 +509,7 @@ py::array_t<float> dis_flow(const py::array& first, const py::array& second, con
     for (std::size_t i = 0; i < a.size() && !stop; ++i) {
       flows.push_back(dis.compute(a[i], b[i]));
       dis.check(flows.back(), a[i], b[i], flow_check);
+      if (edge_band) mark_flow_edge_band(flows.back(), dis.edge_band_px(a[i].width, a[i].height));
     }
   });
   if (first.ndim() != 4) return flow_to_array(flows.front());
@@ -1309,13 +1310,16 @@ PYBIND11_MODULE(_inertialnet, m) {
       .def_property_readonly("synthetic", &PyFlowNet::synthetic);
 
   m.def("dis_flow", &dis_flow, py::arg("img1"), py::arg("img2"), py::arg("order") = "rgb", py::arg("flow_check") = 0.0,
-        py::arg("method") = "dis",
+        py::arg("method") = "dis", py::arg("edge_band") = false,
         "OpenCV DIS optical flow (no weights) from img1 to img2: float32 (H, W, 2), or (N, H, W, 2) for batches.\n"
         "method='dis-fine' refines it down to the full resolution (--flow dis-fine: the flow of a head whose\n"
         "config['flow'] is 'dis-fine').\n"
         "flow_check > 0 also computes the flow back and marks each vector whose round trip misses by more than\n"
         "that many pixels (at 752 columns, scaled with the width) as unknown (NaN), as predict does for the\n"
-        "geometric head (its default 0.5); GeometricHead.rates skips unknown vectors.");
+        "geometric head (its default 0.5); GeometricHead.rates skips unknown vectors.\n"
+        "edge_band=True also marks the vectors within dis-fine's patch of the edge (8 px, at most an eighth of\n"
+        "the shorter side; none for dis yet) as unknown, as predict does for the geometric head:\n"
+        "dis_flow(a, b, flow_check=0.5, edge_band=True) is the flow predict's geometric head fits.");
 
   py::class_<PyGeometricHead>(m, "GeometricHead", "Angular velocity from flow by geometry alone (no weights).")
       .def(py::init<const py::object&, const std::string&, int>(), py::arg("device") = py::none(),

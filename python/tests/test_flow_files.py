@@ -117,6 +117,27 @@ def test_unknown_flow_is_nan_in_python_and_1e10_in_flo_files(tmp_path):
     assert np.array_equal(np.isnan(checked[..., 0]), np.isnan(checked[..., 1]))
 
 
+@pytest.mark.parametrize("method, band", [("dis", 0), ("dis-fine", 6)])
+def test_dis_flow_edge_band_marks_the_edges_only(method, band):
+    # 64x48 frames: dis-fine's band is an eighth of the 48 rows (its patch is 8 px); dis has none yet.
+    rng = np.random.default_rng(4)
+    frame = (rng.random((48, 64)) * 255).astype(np.uint8)
+    moved = np.roll(frame, 3, axis=1)
+    plain = inertialnet.dis_flow(frame, moved, method=method)
+    banded = inertialnet.dis_flow(frame, moved, method=method, edge_band=True)
+    edge = np.ones((48, 64), bool)
+    edge[band:48 - band, band:64 - band] = False
+    assert np.isnan(banded[edge]).all() and np.isfinite(plain).all()
+    np.testing.assert_array_equal(banded[~edge], plain[~edge])
+    # with a batch, each pair's band; with the check, both marks
+    both = inertialnet.dis_flow(np.stack([frame, frame])[..., None], np.stack([moved, moved])[..., None], method=method,
+                                flow_check=0.01, edge_band=True)
+    checked = inertialnet.dis_flow(frame, moved, method=method, flow_check=0.01)
+    assert both.shape == (2, 48, 64, 2)
+    for pair in both:
+        np.testing.assert_array_equal(np.isnan(pair[..., 0]), edge | np.isnan(checked[..., 0]))
+
+
 def test_kitti_round_trip_is_exact_to_one_64th_pixel(tmp_path):
     rng = np.random.default_rng(2)
     flow = rng.uniform(-500, 500, size=(41, 67, 2)).astype(np.float32)

@@ -44,15 +44,17 @@ def test_predict_flow_lk_matches_the_cli(cli, sequence, tmp_path):
         inertialnet.predict(sequence, flow="sparse")
 
 
-def test_dis_flow_and_geometric_head_step_by_step_match_the_cli(cli, sequence, tmp_path):
-    # pair by pair: the two-frame rates; DIS named (the weight-free default is Lucas-Kanade)
-    _, expected = cli_rates(cli, sequence, tmp_path, "--smooth", "off", "--flow", "dis")
+@pytest.mark.parametrize("method", ["dis", "dis-fine"])
+def test_dis_flow_and_geometric_head_step_by_step_match_the_cli(cli, sequence, tmp_path, method):
+    # pair by pair: the two-frame rates; DIS named (the weight-free default is Lucas-Kanade); with
+    # dis-fine, predict's geometric head leaves out its edge band as dis_flow(edge_band=True) does
+    _, expected = cli_rates(cli, sequence, tmp_path, "--smooth", "off", "--flow", method)
     seq = inertialnet.Sequence(sequence)
     camera, to_body, t = seq.camera, seq.camera_to_body, seq.timestamps_ns
     assert camera.width == 128 and to_body.shape == (3, 3)
     head = inertialnet.GeometricHead()
     for k in range(1, len(seq)):
-        flow = inertialnet.dis_flow(seq[k - 1], seq[k], flow_check=0.5)  # predict's default check
+        flow = inertialnet.dis_flow(seq[k - 1], seq[k], flow_check=0.5, method=method, edge_band=True)  # what predict fits
         assert flow.shape == (96, 128, 2) and flow.dtype == np.float32
         w = head.rates(flow, camera, dt=(t[k] - t[k - 1]) * 1e-9, camera_to_body=to_body)
         assert [csv_text(v) for v in w] == [csv_text(v) for v in expected[k - 1, 1:4]]

@@ -61,4 +61,9 @@ int DisFlow::check(FlowField& forward, const HostImage& first, const HostImage& 
   return mark_inconsistent_flow(forward, backward, flow_check_threshold_px(px_at_752_columns, forward.width));
 }
 
+int DisFlow::edge_band_px(int width, int height) const {
+  if (state_->dis->getFinestScale() != 0) return 0;  // Medium: not yet (dis_flow.hpp)
+  return std::max(0, std::min(state_->dis->getPatchSize(), std::min(width, height) / 8));
+}
+
 }  // namespace inertialnet

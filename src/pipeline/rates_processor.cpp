@@ -12,6 +12,7 @@
 #include "inertialnet/core/constants.hpp"
 #include "inertialnet/runtime/error.hpp"
 #include "inertialnet/models/dis_flow.hpp"
+#include "inertialnet/models/flow_consistency.hpp"
 #include "inertialnet/models/flownet.hpp"
 #include "inertialnet/models/head_ensemble.hpp"
 #include "inertialnet/models/inertialnet_head.hpp"
@@ -111,7 +112,7 @@ class RatesProcessor : public PairProcessor {
     const int width = current.image.width, height = current.image.height;
     auto t = Clock::now();
     Tensor flow;
-    Tensor checked;  // the DIS flow with its inconsistent vectors marked unknown: the geometric head's
+    Tensor checked;  // the DIS flow with its inconsistent and edge vectors marked unknown: the geometric head's
     std::string flow_problem;  // why the flow cannot be used, when it cannot
     if (flownet_) {
       const Shape shape{1, 3, height, width};
@@ -139,10 +140,12 @@ class RatesProcessor : public PairProcessor {
         flow_problem = non_finite_flow(planes);
         flow = upload(field);
         // Only the geometric head's solvers skip unknown vectors; the learned head and the saved
-        // flow get the flow as computed (an unknown marker is no input for a network).
-        if (geometric_ && options_.flow_check_px > 0 && flow_problem.empty()) {
+        // flow get the flow as computed (an unknown marker is no input for a network). The head's
+        // copy loses its inconsistent vectors and DIS's edge band (models/flow_consistency.hpp).
+        if (geometric_ && flow_problem.empty()) {
           FlowField marked = field;
           dis_->check(marked, previous.image, current.image, options_.flow_check_px);
+          mark_flow_edge_band(marked, dis_->edge_band_px(width, height));
           checked = upload(marked);
         }
       }

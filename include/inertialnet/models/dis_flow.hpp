@@ -52,6 +52,16 @@ class DisFlow {
   // non-finite setting is invalid_input. Returns how many vectors were marked.
   int check(FlowField& forward, const HostImage& first, const HostImage& second, double px_at_752_columns);
 
+  // How many pixels along each edge of a width × height frame this variant's vectors are left out
+  // of the geometric head's fit (mark_flow_edge_band, flow_consistency.hpp). Fine: the side of its
+  // finest-scale patch, 8 px, at most an eighth of the shorter side so that small frames keep
+  // their middle; on the synthetic selection sequences the patch side was better than no band on
+  // every axis and as good as any other (docs/real_cameras.md, "DIS's edge band"). Medium: 0 for
+  // now. Its band (16 px, its patches being matched at half resolution) measured better still,
+  // but the geometric head's σ model (src/models/rate_uncertainty.cpp) was fitted on Medium's
+  // flow without it and no longer covers the errors with it (same section).
+  int edge_band_px(int width, int height) const;
+
  private:
   struct State;
   std::unique_ptr<State> state_;
