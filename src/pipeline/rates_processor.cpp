@@ -142,10 +142,11 @@ class RatesProcessor : public PairProcessor {
         // Only the geometric head's solvers skip unknown vectors; the learned head and the saved
         // flow get the flow as computed (an unknown marker is no input for a network). The head's
         // copy loses its inconsistent vectors and DIS's edge band (models/flow_consistency.hpp).
-        if (geometric_ && flow_problem.empty()) {
+        const int band = dis_->edge_band_px(width, height);
+        if (geometric_ && (options_.flow_check_px > 0 || band > 0) && flow_problem.empty()) {
           FlowField marked = field;
           dis_->check(marked, previous.image, current.image, options_.flow_check_px);
-          mark_flow_edge_band(marked, dis_->edge_band_px(width, height));
+          mark_flow_edge_band(marked, band);
           checked = upload(marked);
         }
       }

@@ -22,10 +22,10 @@ inline double flow_check_threshold_px(double px_at_752_columns, int width) { ret
 
 // Marks unknown every vector within `band_px` pixels of the image's edge (column or row index
 // below band_px, or above the last one minus band_px) and returns how many it marked that were
-// known. For DIS (DisFlow::edge_band_px): a patch search's vectors there are matched from patches
-// that overlap from one side only and extrapolated across the edge, and the geometric head fitted
-// to them is 10–50 % worse on every axis (docs/real_cameras.md, "DIS's edge band"). 0 marks
-// nothing; a negative band is invalid_input.
+// known. For DIS (DisFlow::edge_band_px): a patch search's vectors there come from patches that
+// overlap from one side only and are extrapolated across the edge; with them the geometric head
+// was worse on 28 of 33 figures of the synthetic sequences, up to twice under blur
+// (docs/real_cameras.md, "DIS's edge band"). 0 marks nothing; a negative band is invalid_input.
 int mark_flow_edge_band(FlowField& flow, int band_px);
 
 // Refuses (invalid_input) a check setting that is negative, not finite or above kMaxFlowCheckPx,
