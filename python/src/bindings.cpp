@@ -127,6 +127,15 @@ std::int64_t integer_of(const py::handle& value, const char* name) {
   return n;
 }
 
+// A yes/no keyword: True or False (numpy's bools too); TypeError naming `name` for anything else,
+// where pybind11's bool conversion took NaN, 2 or 1e300 as True and None as False.
+bool flag_of(const py::handle& value, const char* name) {
+  if (py::isinstance<py::bool_>(value) || py::isinstance(value, py::module_::import("numpy").attr("bool_"))) {
+    return PyObject_IsTrue(value.ptr()) == 1;
+  }
+  throw py::type_error(std::string(name) + " must be True or False, not " + type_name(value));
+}
+
 // The CLI's wording for a number the user gave: "must be …, got -5" with the value as Python
 // prints it, so 1e-12 stays 1e-12.
 std::string got(double value) { return std::string(py::str(py::float_(value))); }
@@ -494,7 +503,7 @@ class PyFlowNet {
 };
 
 py::array_t<float> dis_flow(const py::array& first, const py::array& second, const std::string& order,
-                            double flow_check, const std::string& method, bool edge_band) {
+                            double flow_check, const std::string& method, const py::object& edge_band_flag) {
   // "dis-fine": the DIS a recipe head since v3 learned from (models/dis_flow.hpp, DisVariant).
   if (method != "dis" && method != "dis-fine") {
     throw invalid_input("method '" + method.substr(0, 40) + "': expected dis or dis-fine");
@@ -503,6 +512,7 @@ py::array_t<float> dis_flow(const py::array& first, const py::array& second, con
   const auto b = images_of(second, order, "img2");
   if (a.size() != b.size()) throw invalid_input("img1 and img2 hold different numbers of images.");
   require_flow_check_setting(flow_check, "flow_check");
+  const bool edge_band = flag_of(edge_band_flag, "edge_band");
   std::vector<FlowField> flows;
   run_interruptibly([&](const std::atomic<bool>& stop) {
     DisFlow dis(dis_variant(parse_flow_method(method)));

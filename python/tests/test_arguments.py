@@ -149,3 +149,19 @@ def test_flow_check_is_bounded_and_named(sequence, value):
     a = np.zeros((48, 64, 3), np.uint8)
     with pytest.raises(ValueError, match=r"flow_check should be from 0 \(off\) to 1000 pixels"):
         inertialnet.dis_flow(a, a, flow_check=value)
+
+
+@pytest.mark.parametrize("value", [float("nan"), 1e300, 2, None, "yes", []])
+def test_edge_band_is_true_or_false(value):
+    # pybind11's bool took NaN, 1e300 and 2 as True and None as False, and answered "yes" with its
+    # list of overloads; the keyword is a yes/no, so anything but a bool is a TypeError naming it.
+    a = np.zeros((48, 64, 3), np.uint8)
+    with pytest.raises(TypeError, match="edge_band must be True or False, not "):
+        inertialnet.dis_flow(a, a, method="dis-fine", edge_band=value)
+
+
+def test_edge_band_takes_numpy_bools():
+    a = (np.random.default_rng(5).random((48, 64)) * 255).astype(np.uint8)
+    for yes, no in [(True, False), (np.True_, np.False_)]:
+        assert np.isnan(inertialnet.dis_flow(a, a, method="dis-fine", edge_band=yes)).any()
+        assert not np.isnan(inertialnet.dis_flow(a, a, method="dis-fine", edge_band=no)).any()
