@@ -96,23 +96,22 @@ TEST(FlowConsistency, RefusesACheckSettingAboveTheBoundQuotingIt) {
 TEST(FlowEdgeBand, MarksExactlyTheBandAndCountsTheVectorsItTurnedUnknown) {
   const int w = 23, h = 17;
   for (const int band : {0, 1, 3, 8, 9, 40}) {
+    const auto in_band = [&](int x, int y) { return x < band || x > w - 1 - band || y < band || y > h - 1 - band; };
     FlowField f = uniform(w, h, 0.75f, -2.0f);
     const std::size_t pre[] = {0, 5 * w + 11, 16 * w + 22};  // a corner, the middle, the far corner
     for (const std::size_t i : pre) f.u[i] = f.v[i] = kUnknownFlowValue;
     int expected = 0;
     for (int y = 0; y < h; ++y)
       for (int x = 0; x < w; ++x) {
-        const bool in_band = x < band || x > w - 1 - band || y < band || y > h - 1 - band;
         const std::size_t i = static_cast<std::size_t>(y) * w + x;
-        if (in_band && std::find(std::begin(pre), std::end(pre), i) == std::end(pre)) ++expected;
+        if (in_band(x, y) && std::find(std::begin(pre), std::end(pre), i) == std::end(pre)) ++expected;
       }
     FlowField marked = f;
     EXPECT_EQ(mark_flow_edge_band(marked, band), expected) << "band " << band;
     for (int y = 0; y < h; ++y)
       for (int x = 0; x < w; ++x) {
-        const bool in_band = x < band || x > w - 1 - band || y < band || y > h - 1 - band;
         const std::size_t i = static_cast<std::size_t>(y) * w + x;
-        if (in_band) {
+        if (in_band(x, y)) {
           EXPECT_TRUE(is_unknown_flow(marked.u[i], marked.v[i])) << band << ": " << x << "," << y;
         } else {
           EXPECT_EQ(marked.u[i], f.u[i]) << band << ": " << x << "," << y;
