@@ -69,7 +69,7 @@ class PredictOptions:
             time_offset=number(self.time_offset), readout_time=float(self.readout_time),
             device=device_spec(self.device), max_pairs=self.max_pairs, lanes=int(self.lanes),
             decode_threads=int(self.decode_threads), keep_flow=self.keep_flow, flow_check=float(self.flow_check),
-            progress=self.progress, max_sigma=float(self.max_sigma), smooth=str(self.smooth), fuse=bool(self.fuse))
+            progress=self.progress, max_sigma=float(self.max_sigma), smooth=str(self.smooth), fuse=self.fuse)
 
 
 def device_spec(device) -> str:

@@ -922,13 +922,16 @@ py::tuple predict(const PredictSettings& settings, std::size_t max_pairs, int la
 // paths ("": none); T_cam_imu 16 numbers or a YAML path as --T-cam-imu takes it ("": none).
 std::string evaluate_json(const std::filesystem::path& rates, const std::filesystem::path& sequence,
                           const std::string& target, const std::string& head, const py::object& gyro_bias,
-                          bool camera_frame, const std::string& plot, bool series, const py::object& time_offset,
+                          const py::object& camera_frame_flag, const std::string& plot, const py::object& series_flag,
+                          const py::object& time_offset,
                           double time_offset_range, const py::object& readout_time, const std::string& imu,
                           const std::string& imu_time_unit, const std::string& T_cam_imu, const std::string& camchain,
                           const std::string& camera, double rate_hz, const std::string& calibration,
                           const std::string& calibration_camera, const std::vector<std::string>& imu_columns,
                           const std::vector<std::string>& imu_units, const std::string& image_topic,
                           const std::string& imu_topic, const std::string& camera_info_topic) {
+  const bool camera_frame = flag_of(camera_frame_flag, "camera_frame");
+  const bool series = flag_of(series_flag, "series");
   existing(rates, "the rates file");
   existing(sequence, "the sequence");
   EvalOptions options;
@@ -1149,12 +1152,12 @@ PythonPredictOptions python_predict_options(const std::string& sequence, const s
   s.bag.camera_info = text("camera_info_topic");
   s.rate_hz = rate_hz;
   s.device = text("device");
-  s.keep_flow = take("keep_flow").cast<bool>();
+  s.keep_flow = flag_of(take("keep_flow"), "keep_flow");
   s.flow_check_px = real("flow_check");
   require_flow_check_setting(s.flow_check_px, "flow_check");  // named as the keyword, not the library's words
   s.max_sigma_deg_s = real("max_sigma");  // predict --max-sigma, --smooth (issue 22)
   s.smooth = text("smooth");
-  s.fuse = take("fuse").cast<bool>();  // predict --fuse (issue 23)
+  s.fuse = flag_of(take("fuse"), "fuse");  // predict --fuse (issue 23)
   out.max_pairs = static_cast<std::size_t>(pairs);
   out.lanes = take("lanes").cast<int>();
   out.decode_threads = take("decode_threads").cast<int>();
@@ -1417,7 +1420,8 @@ PYBIND11_MODULE(_inertialnet, m) {
   m.def("read_flow", [](const std::filesystem::path& path) { return flow_to_array(read_flow_file(existing(path, "the flow file"))); },
         py::arg("path"), "A .flo or KITTI flow PNG file, recognised by its content, as float32 (H, W, 2); unknown flow is NaN.");
   m.def("flow_to_color",
-        [](const py::array& flow, float max_magnitude, bool legend, const std::string& order) {
+        [](const py::array& flow, float max_magnitude, const py::object& legend_flag, const std::string& order) {
+          const bool legend = flag_of(legend_flag, "legend");
           const ChannelOrder channels = parse_order(order);
           ColorImage image = flow_to_color(flow_from_array(flow), max_magnitude);
           if (legend && std::min(image.width, image.height) / 4 >= 8) {
@@ -1443,8 +1447,10 @@ PYBIND11_MODULE(_inertialnet, m) {
 
   m.def("synth",
         [](const std::filesystem::path& out, int frames, const std::string& motion, const py::object& seed, int width,
-           int height, bool noise, bool overwrite) {
+           int height, const py::object& noise, const py::object& overwrite) {
           SynthOptions o;
+          o.noise = flag_of(noise, "noise");
+          o.overwrite = flag_of(overwrite, "overwrite");
           o.frames = frames;
           o.motion = parse_synth_motion(motion);
           // A seed is any number from 0 up; pybind11 would answer a negative one with its overloads.
@@ -1456,8 +1462,6 @@ PYBIND11_MODULE(_inertialnet, m) {
           if (PyErr_Occurred()) throw py::error_already_set();  // OverflowError: above 2^64 − 1
           o.width = width;
           o.height = height;
-          o.noise = noise;
-          o.overwrite = overwrite;
           py::gil_scoped_release release;
           const SynthReport report = write_synthetic_sequence(out, o);
           return report.frames;

@@ -165,3 +165,43 @@ def test_edge_band_takes_numpy_bools():
     for yes, no in [(True, False), (np.True_, np.False_)]:
         assert np.isnan(inertialnet.dis_flow(a, a, method="dis-fine", edge_band=yes)).any()
         assert not np.isnan(inertialnet.dis_flow(a, a, method="dis-fine", edge_band=no)).any()
+
+
+BAD_FLAGS = [float("nan"), 1e300, 2, None, "yes", []]
+
+
+@pytest.mark.parametrize("value", BAD_FLAGS)
+@pytest.mark.parametrize("keyword", ["keep_flow", "fuse"])
+def test_predict_flags_are_true_or_false(sequence, keyword, value):
+    # As edge_band: pybind11's bool read NaN, 1e300 and 2 as True and None as False.
+    with pytest.raises(TypeError, match=keyword + " must be True or False, not "):
+        inertialnet.predict(sequence, max_pairs=1, **{keyword: value})
+
+
+@pytest.mark.parametrize("value", BAD_FLAGS)
+@pytest.mark.parametrize("keyword", ["camera_frame", "series"])
+def test_evaluate_flags_are_true_or_false(sequence, keyword, value):
+    rates = inertialnet.predict(sequence, max_pairs=2)
+    with pytest.raises(TypeError, match=keyword + " must be True or False, not "):
+        inertialnet.evaluate(rates, sequence, **{keyword: value})
+    assert inertialnet.evaluate(rates, sequence, **{keyword: np.True_})
+
+
+@pytest.mark.parametrize("value", BAD_FLAGS)
+def test_flow_to_color_legend_is_true_or_false(value):
+    flow = np.zeros((48, 64, 2), np.float32)
+    with pytest.raises(TypeError, match="legend must be True or False, not "):
+        inertialnet.flow_to_color(flow, legend=value)
+    assert inertialnet.flow_to_color(flow, legend=np.False_).shape == (48, 64, 3)
+
+
+@pytest.mark.parametrize("value", BAD_FLAGS)
+@pytest.mark.parametrize("keyword", ["noise", "overwrite"])
+def test_synth_flags_are_true_or_false_and_leave_a_sequence_as_it_was(tmp_path, keyword, value):
+    # overwrite=float("nan") was True: it replaced the sequence already there.
+    out = tmp_path / "seq"
+    assert inertialnet.synth(out, frames=2, width=64, height=48) == 2
+    before = {p: p.read_bytes() for p in sorted(out.rglob("*")) if p.is_file()}
+    with pytest.raises(TypeError, match=keyword + " must be True or False, not "):
+        inertialnet.synth(out, frames=3, width=64, height=48, seed=2, **{keyword: value})
+    assert {p: p.read_bytes() for p in sorted(out.rglob("*")) if p.is_file()} == before
