@@ -1469,5 +1469,5 @@ PYBIND11_MODULE(_inertialnet, m) {
         py::arg("out"), py::arg("frames") = 40, py::arg("motion") = "rotation", py::arg("seed") = 1,
         py::arg("width") = 752, py::arg("height") = 480, py::arg("noise") = true, py::arg("overwrite") = false,
         "Renders a synthetic EuRoC-layout sequence into `out` (as `inertialnet synth`); returns the frame count.");
-  m.attr("__version__") = "0.1.0";
+  m.attr("__version__") = build_versions().inertialnet;  // the library's, from CMake: one place
 }

@@ -5,6 +5,8 @@
 // Only the version macros: the runtime layer itself does not use OpenCV.
 #include <opencv2/core/version.hpp>
 
+#include "runtime/source_identity.hpp"
+
 namespace inertialnet {
 
 BuildVersions build_versions() {
@@ -13,6 +15,7 @@ BuildVersions build_versions() {
   v.clblast = std::to_string(CLBLAST_VERSION_MAJOR) + "." + std::to_string(CLBLAST_VERSION_MINOR) + "." +
               std::to_string(CLBLAST_VERSION_PATCH);
   v.opencv = CV_VERSION;
+  v.source = detail::source_identity();
   return v;
 }
 

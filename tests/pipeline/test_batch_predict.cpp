@@ -9,6 +9,7 @@
 
 #include "inertialnet/pipeline/batch_predict.hpp"
 #include "inertialnet/runtime/error.hpp"
+#include "inertialnet/runtime/version.hpp"
 
 using namespace inertialnet;
 namespace fs = std::filesystem;
@@ -110,5 +111,26 @@ TEST(BatchPredict, ProvenanceNamesTheWeightFreeFlowPredictRuns) {
       << lk_of(prediction_provenance(settings, 0));
   settings.flow = "dis";
   EXPECT_EQ(lk_of(prediction_provenance(settings, 0)), "(absent)");
+  fs::remove_all(root);
+}
+
+// The version (0.1.0) does not change with behaviour; the provenance also names the build by its
+// sources' SHA-256 (cmake/SourceIdentity.cmake), so a file another build wrote is computed again
+// (tests/cli/batch.cmake checks the recomputation, tests/source_identity.cmake the identity).
+TEST(BatchPredict, ProvenanceNamesTheBuildBySourceIdentity) {
+  const std::string identity = build_versions().source;
+  ASSERT_EQ(identity.size(), 64u) << identity;
+  EXPECT_EQ(identity.find_first_not_of("0123456789abcdef"), std::string::npos) << identity;
+  EXPECT_NE(identity, std::string(64, '0'));
+  const fs::path root = fs::temp_directory_path() / "inertialnet_test_batch_identity";
+  fs::remove_all(root);
+  fs::create_directories(root / "seq" / "mav0");
+  PredictSettings settings;
+  settings.sequence = root / "seq";
+  std::string recorded = "(absent)";
+  for (const auto& [key, value] : prediction_provenance(settings, 0)) {
+    if (key == "source") recorded = value;
+  }
+  EXPECT_EQ(recorded, "sha256 " + identity);
   fs::remove_all(root);
 }

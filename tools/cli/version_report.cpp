@@ -10,7 +10,8 @@ namespace inertialnet::cli {
 
 std::string version_report() {
   const BuildVersions v = build_versions();
-  std::string text = "inertialnet " + v.inertialnet + "\nbuilt with CLBlast " + v.clblast + ", OpenCV " + v.opencv + "\n";
+  std::string text = "inertialnet " + v.inertialnet + " (source sha256 " + v.source.substr(0, 16) +
+                     ")\nbuilt with CLBlast " + v.clblast + ", OpenCV " + v.opencv + "\n";
   std::vector<DeviceInfo> devices;
   try {
     devices = discover_devices();

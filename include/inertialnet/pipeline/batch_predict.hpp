@@ -8,6 +8,7 @@
 // What made a file is recorded in its sidecar, in a block "provenance" of its own beside
 // "metadata" (docs/cli.md, "Batches"):
 //   "provenance": {"tool": "inertialnet 0.1.0",
+//                  "source": "sha256 …",                      (the sources built: BuildVersions::source)
 //                  "sequence": "/data/MH_01_easy",            (where it was; not compared)
 //                  "inputs": "4211 files, fnv1a64 …",         (every file's relative path, size, mtime)
 //                  "weights": "flownet2.safetensors fnv1a64 …; …" (the bytes of each weights file)
