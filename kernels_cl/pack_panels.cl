@@ -5,6 +5,8 @@
 // so the GEMM needs no edge case in its inner loop.
 // Build options: -DWIDTH (MR for A, 32 for B); im2col_panels also -DKH, -DKW, -DSTRIDE, -DPAD.
 
+#include "common.cl"
+
 // Element (line i, depth q) of the source is src[src_offset + i·line_stride + q·depth_stride]:
 // A stored row-major is (lda, 1), A stored transposed (1, lda); B stored row-major is (1, ldb).
 // One work-item per line slot and block of DEPTH_BLOCK depth steps (few, large work-groups:

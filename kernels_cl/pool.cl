@@ -4,6 +4,8 @@
 // (n, c, y, x) of a tensor lives at offset + n * batch_stride + (c * H + y) * W + x, so both
 // tensors may be channel slices.
 
+#include "common.cl"
+
 #ifndef POOL_KERNEL
 #define POOL_KERNEL 2
 #endif

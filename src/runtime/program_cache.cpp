@@ -167,7 +167,13 @@ cl_program ProgramCache::program_from_source(const std::string& name, const std:
     }
     if (disk_enabled_) store_binary(program.get(), file, key);
   }
+  held_.push_back({name, defines});
   return programs_.emplace(key, std::move(program)).first->second.get();
+}
+
+std::vector<HeldProgram> ProgramCache::held_programs() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return held_;
 }
 
 ProgramHandle ProgramCache::build(const std::string& name, const std::string& source, const std::string& options) {

@@ -2,12 +2,17 @@
 // The FlowNet2 family against the independent PyTorch reference (tools/reference/), through
 // the committed fixtures: same synthetic weights (seed 1), same frames, every block's flow.
 // The reference computes in float64; we compute in float32.
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <cstdio>
 #include <filesystem>
+#include <string>
+#include <vector>
 
 #include "inertialnet/models/flownet.hpp"
 #include "inertialnet/io/safetensors.hpp"
+#include "inertialnet/runtime/program_cache.hpp"
 #include "models/flownet_graphs.hpp"
 #include "support/testing.hpp"
 
@@ -133,6 +138,32 @@ TEST(FlowNetWeights, AnotherModelsFileIsRefusedWithTheFullList) {
     EXPECT_NE(message.find("conv_redir.0.weight"), std::string::npos) << message;
     EXPECT_NE(message.find("wrong shape"), std::string::npos) << message;  // conv1 has 6 inputs in -S, 3 in -C
   }
+}
+
+// Every kernel the networks built (under this run's $INERTIALNET_PLAN: packed GEMM, CLBlast,
+// Winograd, …) compiles without a compiler warning, which PoCL prints on the user's terminal at a
+// first run. On a CPU without AVX-512 every float16 passed to a builtin (fma, vload16, shuffle2)
+// was one "changes the ABI" warning, 490 over the FlowNet2 run, until kernels_cl/common.cl
+// silenced -Wpsabi. Last in this file, so it reads what the fixtures above built; run alone, it
+// builds FlowNet2 itself.
+TEST(FlowNetKernels, EveryKernelTheNetworksBuiltCompilesWithoutWarnings) {
+  const auto held = [] {
+    std::vector<std::string> names;
+    for (const HeldProgram& p : testing::test_device().programs().held_programs()) names.push_back(p.name);
+    return names;
+  };
+  if (const auto names = held(); std::find(names.begin(), names.end(), "correlation") == names.end()) {
+    const WeightSet weights = WeightSet::synthetic(testing::test_device(), ModelKind::FlowNet2, kSeed);
+    FlowNet net(testing::test_device(), ModelKind::FlowNet2, weights);
+    net.compute(testing::test_queue(), frames().frame1, frames().frame2);
+  }
+  const std::vector<std::string> families = testing::expect_held_kernels_compile_without_warnings();
+  for (const char* family : {"correlation", "warp", "channel_norm", "upsample"}) {
+    EXPECT_NE(std::find(families.begin(), families.end(), family), families.end()) << family << " was not built";
+  }
+  std::string list;
+  for (const auto& family : families) list += " " + family;
+  std::printf("[ kernels  ] %zu families rebuilt without a warning:%s\n", families.size(), list.c_str());
 }
 
 }  // namespace

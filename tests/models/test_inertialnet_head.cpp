@@ -2,6 +2,7 @@
 // The InertialNet head against the PyTorch reference fixtures (tools/reference/head.py):
 // default hyper-parameters at two sizes (one odd, so the pools floor) and a custom
 // configuration, all with synthetic weights of seed 1 and the configuration from the fixture.
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <limits>
@@ -12,6 +13,7 @@
 #include "inertialnet/models/inertialnet_head.hpp"
 #include "inertialnet/io/safetensors.hpp"
 #include "inertialnet/io/safetensors_writer.hpp"
+#include "inertialnet/runtime/program_cache.hpp"
 #include "support/testing.hpp"
 
 namespace inertialnet {
@@ -88,6 +90,25 @@ TEST(Head, NonFiniteWeightsAreRefusedWhenLoaded) {
     EXPECT_NE(message.find("'head.fc1.bias'"), std::string::npos) << message;
     EXPECT_NE(message.find(std::string(text) + " at element 1"), std::string::npos) << message;
   }
+}
+
+// Every kernel the head fixtures built (conv, pool, the GEMV of fc1 and fc2, under this run's
+// $INERTIALNET_PLAN) compiles without a compiler warning, as FlowNetKernels checks for FlowNet2.
+// Last in this file; run alone, it runs the first fixture itself.
+TEST(HeadKernels, EveryKernelTheHeadBuiltCompilesWithoutWarnings) {
+  bool pooled = false;
+  for (const HeldProgram& p : testing::test_device().programs().held_programs()) pooled = pooled || p.name == "pool";
+  if (!pooled) {
+    Queue& queue = testing::test_queue();
+    const SafetensorsFile file(fixture("head_32x24.safetensors"));
+    const HeadConfig config = head_config_from_json(file.metadata().at(kMetadataHead));
+    const WeightSet weights = WeightSet::synthetic(testing::test_device(), ModelKind::InertialNetHead, 1, config);
+    InertialNetHead head(testing::test_device(), weights);
+    const auto& s = file.shape("flow");
+    head.compute(queue, Tensor::from_host(queue, Shape(s.begin(), s.end()), file.to_float32("flow")));
+  }
+  const std::vector<std::string> families = testing::expect_held_kernels_compile_without_warnings();
+  EXPECT_NE(std::find(families.begin(), families.end(), "pool"), families.end()) << "pool was not built";
 }
 
 }  // namespace

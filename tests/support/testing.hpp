@@ -36,9 +36,14 @@ class ScopedPackedTuning {
 };
 
 // The build log of the kernel family `family` (kernels_cl/<family>.cl as embedded) compiled for
-// the test device with `options`; a failed build is a test failure. For the tests that keep the
+// the test device with the library's options for it and `options`; a failed build is a test
+// failure. For the tests that keep the
 // kernels free of compiler warnings (PoCL prints them on every first compile).
 std::string kernel_build_log(const std::string& family, const std::string& options);
+// Rebuilds every embedded kernel family the test device's program cache holds, with the defines
+// it was built with (ProgramCache::held_programs), and fails the test on a compiler warning in
+// any (PoCL prints each on the user's first run); returns the families rebuilt.
+std::vector<std::string> expect_held_kernels_compile_without_warnings();
 
 // Uniform values in [lo, hi) from a fixed seed.
 std::vector<float> random_vector(std::size_t count, std::uint32_t seed, float lo = -1.0f, float hi = 1.0f);

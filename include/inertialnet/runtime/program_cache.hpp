@@ -55,6 +55,13 @@ struct ProgramCacheStats {
   std::size_t disk_rejected = 0;  // cache files ignored as corrupt, foreign or unloadable
 };
 
+// A program the cache holds, as it was asked for: the family (or program_from_source's name)
+// and the defines, without the options build_options() adds.
+struct HeldProgram {
+  std::string name;
+  std::string defines;
+};
+
 // The embedded kernel families ("elementwise", "correlation", …) and their sources.
 std::vector<std::string> embedded_kernel_families();
 std::string_view embedded_kernel_source(std::string_view family);  // invalid_input if unknown
@@ -64,7 +71,6 @@ const std::string& embedded_kernels_stamp();
 // The driver's build log of `program` for `device`, trailing blanks and NULs trimmed; "" when it
 // gives none. A failed build's error carries it; the tests read it for compiler warnings.
 std::string program_build_log(cl_program program, cl_device_id device);
-
 class ProgramCache {
  public:
   ProgramCache(const DeviceInfo& device, cl_context context, DiskCacheMode mode,
@@ -85,6 +91,9 @@ class ProgramCache {
   bool disk_cache_enabled() const { return disk_enabled_; }
   const std::filesystem::path& directory() const { return directory_; }
   ProgramCacheStats stats() const;
+  // Every program built or loaded so far, in the order first asked for (the tests rebuild those
+  // of a whole network run to read their compiler warnings).
+  std::vector<HeldProgram> held_programs() const;
 
  private:
   std::string cache_key(const std::string& source, const std::string& options) const;
@@ -99,6 +108,7 @@ class ProgramCache {
   std::filesystem::path directory_;
   mutable std::mutex mutex_;
   std::map<std::string, ProgramHandle> programs_;  // by cache key
+  std::vector<HeldProgram> held_;                  // the same programs, as asked for
   ProgramCacheStats stats_;
   bool announced_compile_ = false;  // the one "compiling OpenCL kernels" message per device
 };
