@@ -157,10 +157,11 @@ void require_batch_sequences_exist(const std::vector<BatchManifestEntry>& sequen
 
 Provenance prediction_provenance(const PredictSettings& s, std::size_t max_pairs) {
   Provenance p;
-  p.emplace_back("tool", "inertialnet " + build_versions().inertialnet);
+  const BuildVersions versions = build_versions();
+  p.emplace_back("tool", "inertialnet " + versions.inertialnet);
   // The version stays 0.1.0 across changes of behaviour: the sources' identity does not, so a file
   // another build wrote is computed again (a file without the entry, from before it, too).
-  p.emplace_back("source", "sha256 " + build_versions().source);
+  p.emplace_back("source", "sha256 " + versions.source);
   std::error_code ec;
   p.emplace_back("sequence", fs::absolute(s.sequence, ec).lexically_normal().string());
   p.emplace_back("inputs", inputs_fingerprint(s.sequence));

@@ -12,7 +12,6 @@
 
 #include "inertialnet/models/flownet.hpp"
 #include "inertialnet/io/safetensors.hpp"
-#include "inertialnet/runtime/program_cache.hpp"
 #include "models/flownet_graphs.hpp"
 #include "support/testing.hpp"
 
@@ -147,12 +146,7 @@ TEST(FlowNetWeights, AnotherModelsFileIsRefusedWithTheFullList) {
 // silenced -Wpsabi. Last in this file, so it reads what the fixtures above built; run alone, it
 // builds FlowNet2 itself.
 TEST(FlowNetKernels, EveryKernelTheNetworksBuiltCompilesWithoutWarnings) {
-  const auto held = [] {
-    std::vector<std::string> names;
-    for (const HeldProgram& p : testing::test_device().programs().held_programs()) names.push_back(p.name);
-    return names;
-  };
-  if (const auto names = held(); std::find(names.begin(), names.end(), "correlation") == names.end()) {
+  if (!testing::device_holds_program("correlation")) {
     const WeightSet weights = WeightSet::synthetic(testing::test_device(), ModelKind::FlowNet2, kSeed);
     FlowNet net(testing::test_device(), ModelKind::FlowNet2, weights);
     net.compute(testing::test_queue(), frames().frame1, frames().frame2);

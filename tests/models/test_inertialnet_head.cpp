@@ -13,7 +13,6 @@
 #include "inertialnet/models/inertialnet_head.hpp"
 #include "inertialnet/io/safetensors.hpp"
 #include "inertialnet/io/safetensors_writer.hpp"
-#include "inertialnet/runtime/program_cache.hpp"
 #include "support/testing.hpp"
 
 namespace inertialnet {
@@ -96,9 +95,7 @@ TEST(Head, NonFiniteWeightsAreRefusedWhenLoaded) {
 // $INERTIALNET_PLAN) compiles without a compiler warning, as FlowNetKernels checks for FlowNet2.
 // Last in this file; run alone, it runs the first fixture itself.
 TEST(HeadKernels, EveryKernelTheHeadBuiltCompilesWithoutWarnings) {
-  bool pooled = false;
-  for (const HeldProgram& p : testing::test_device().programs().held_programs()) pooled = pooled || p.name == "pool";
-  if (!pooled) {
+  if (!testing::device_holds_program("pool")) {
     Queue& queue = testing::test_queue();
     const SafetensorsFile file(fixture("head_32x24.safetensors"));
     const HeadConfig config = head_config_from_json(file.metadata().at(kMetadataHead));

@@ -40,14 +40,19 @@ std::string kernel_build_log(const std::string& family, const std::string& optio
     return "";
   }
   const cl_device_id id = device.id();
-  // As the library builds it (ProgramCache::build_options: the OpenCL C version, fp16, the 16-float
-  // split of kernels_cl/common.cl), so a warning the user would see is one the test sees.
+  // As the library builds it (ProgramCache::build_options: the OpenCL C version, fp16), so a
+  // warning the user would see is one the test sees.
   const std::string full = device.programs().build_options(options);
   const cl_int built = clBuildProgram(program, 1, &id, full.c_str(), nullptr, nullptr);
   const std::string log = program_build_log(program, id);
   clReleaseProgram(program);
   EXPECT_EQ(built, CL_SUCCESS) << family << " " << full << ":\n" << log;
   return log;
+}
+
+bool device_holds_program(const std::string& name) {
+  const std::vector<HeldProgram> held = test_device().programs().held_programs();
+  return std::any_of(held.begin(), held.end(), [&](const HeldProgram& p) { return p.name == name; });
 }
 
 std::vector<std::string> expect_held_kernels_compile_without_warnings() {

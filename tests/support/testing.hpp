@@ -40,6 +40,8 @@ class ScopedPackedTuning {
 // failure. For the tests that keep the
 // kernels free of compiler warnings (PoCL prints them on every first compile).
 std::string kernel_build_log(const std::string& family, const std::string& options);
+// Whether the test device's program cache holds a program of the family (or source) `name`.
+bool device_holds_program(const std::string& name);
 // Rebuilds every embedded kernel family the test device's program cache holds, with the defines
 // it was built with (ProgramCache::held_programs), and fails the test on a compiler warning in
 // any (PoCL prints each on the user's first run); returns the families rebuilt.

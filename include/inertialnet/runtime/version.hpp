@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // The versions of this library and of what it was built against, for `inertialnet --version`,
-// bug reports and the provenance of a batch's outputs. The OpenCL platforms and drivers are run-time facts: see discover_devices().
+// bug reports and the provenance of a batch's outputs. The OpenCL platforms and drivers are
+// run-time facts: see discover_devices().
 #pragma once
 
 #include <string>
