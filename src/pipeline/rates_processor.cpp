@@ -103,7 +103,7 @@ class RatesProcessor : public PairProcessor {
       const double textured = textured_fraction(frame->image);
       if (textured < kMinimumTexturedFraction) {
         char share[96];
-        std::snprintf(share, sizeof share, " shows almost no texture (%.2f %% of its pixels; at least %.1f %% needed)",
+        std::snprintf(share, sizeof share, " shows almost no texture (%.2f %% of its area; at least %.1f %% needed)",
                       100 * textured, 100 * kMinimumTexturedFraction);
         return unanswered(result, PairStatus::NoTexture, frame_name(*frame) + share + ": nothing for optical flow to follow");
       }

@@ -17,6 +17,7 @@
 
 #include "inertialnet/ops/motion_field.hpp"
 #include "inertialnet/runtime/error.hpp"
+#include "support/testing.hpp"
 
 namespace inertialnet {
 namespace {
@@ -45,18 +46,6 @@ double smooth_noise(double x, double y) {
 
 float texture(double x, double y) {
   return static_cast<float>(40 + 130 * smooth_noise(x / 5.0, y / 5.0) + 70 * smooth_noise(x / 13.0 + 100, y / 13.0 - 50));
-}
-
-// A gray frame (the three planes equal) whose pixel (x, y) shows texture at source(x, y).
-HostImage frame(int w, int h, const std::function<float(double, double)>& value) {
-  HostImage image;
-  image.width = w;
-  image.height = h;
-  image.data.resize(3 * image.plane_size());
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x)
-      for (int c = 0; c < 3; ++c) image.data[c * image.plane_size() + static_cast<std::size_t>(y) * w + x] = value(x, y);
-  return image;
 }
 
 bool on_grid(const SampleGrid& g, int stride, int x, int y) {
@@ -92,8 +81,8 @@ TEST(LkFlow, FollowsATranslationAndARotationAtTheGridPointsOnly) {
   const SampleGrid grid = SampleGrid::of(w, h, stride);
   for (const Motion& m : motions) {
     SCOPED_TRACE(m.name);
-    const HostImage first = frame(w, h, texture);
-    const HostImage second = frame(w, h, [&](double x, double y) {
+    const HostImage first = testing::grey_frame(w, h, texture);
+    const HostImage second = testing::grey_frame(w, h, [&](double x, double y) {
       double sx, sy;
       m.backward(x, y, sx, sy);
       return texture(sx, sy);
@@ -140,8 +129,8 @@ TEST(LkFlow, TheRoundTripLeavesOutAnOccludingPatchAndNoTextureIsNeverTracked) {
   // frame over the moving scene (an occluder entering).
   const auto flat = [](double x, double) { return x < 40; };
   const auto patch = [](double x, double y) { return x >= 95 && x < 125 && y >= 45 && y < 75; };
-  const HostImage first = frame(w, h, [&](double x, double y) { return flat(x, y) ? 128.0f : texture(x, y); });
-  const HostImage second = frame(w, h, [&](double x, double y) {
+  const HostImage first = testing::grey_frame(w, h, [&](double x, double y) { return flat(x, y) ? 128.0f : texture(x, y); });
+  const HostImage second = testing::grey_frame(w, h, [&](double x, double y) {
     if (flat(x, y)) return 128.0f;
     if (patch(x, y)) return texture(3.1 * y + 500, 2.3 * x - 400);
     return texture(x - du, y - dv);
@@ -184,8 +173,9 @@ TEST(LkFlow, TheRoundTripLeavesOutAnOccludingPatchAndNoTextureIsNeverTracked) {
 }
 
 TEST(LkFlow, RefusesFramesAndSettingsItCannotUse) {
-  const HostImage a = frame(40, 30, texture), b = frame(41, 30, texture), tiny = frame(15, 30, texture);
-  const HostImage c = frame(40, 30, texture);
+  const HostImage a = testing::grey_frame(40, 30, texture), b = testing::grey_frame(41, 30, texture);
+  const HostImage tiny = testing::grey_frame(15, 30, texture);
+  const HostImage c = testing::grey_frame(40, 30, texture);
   EXPECT_THROW(LkFlow().compute(a, b, 4, 0.5), Error);
   EXPECT_THROW(LkFlow().compute(tiny, tiny, 4, 0.5), Error);
   EXPECT_THROW(LkFlow().compute(a, c, 0, 0.5), Error);
@@ -197,7 +187,7 @@ TEST(LkFlow, RefusesFramesAndSettingsItCannotUse) {
   // The smallest frames it takes are tracked without an OpenCV assertion (the pyramid stops
   // where the window no longer fits).
   for (const auto& [w, h] : {std::pair{16, 16}, std::pair{17, 40}, std::pair{40, 16}}) {
-    const HostImage small = frame(w, h, texture);
+    const HostImage small = testing::grey_frame(w, h, texture);
     EXPECT_NO_THROW(LkFlow().compute(small, small, 2, 0.5)) << w << "x" << h;
   }
   LkFlowOptions bad;
@@ -220,10 +210,10 @@ TEST(LkFlow, SmoothingKeepsPixelNoiseOutOfTheTrack) {
     const double n = lattice(x + 7919LL * frame_index, y - 104729LL * frame_index) - 0.5;  // uniform in ±0.5
     return static_cast<float>(std::clamp(value + 24 * n, 0.0, 255.0));
   };
-  const HostImage first = frame(w, h, [&](double x, double y) {
+  const HostImage first = testing::grey_frame(w, h, [&](double x, double y) {
     return noisy(texture(x, y), static_cast<int>(x), static_cast<int>(y), 1);
   });
-  const HostImage second = frame(w, h, [&](double x, double y) {
+  const HostImage second = testing::grey_frame(w, h, [&](double x, double y) {
     return noisy(texture(x - du, y - dv), static_cast<int>(x), static_cast<int>(y), 2);
   });
   struct Track {

@@ -162,6 +162,19 @@ void expect_invalid_input(const std::function<void()>& call, const std::string& 
                                                      << "\", got: " << message;
 }
 
+HostImage grey_frame(int width, int height, const std::function<float(double, double)>& value) {
+  HostImage image;
+  image.width = width;
+  image.height = height;
+  image.data.resize(3 * image.plane_size());
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const float v = value(x, y);
+      for (int c = 0; c < 3; ++c) image.data[c * image.plane_size() + static_cast<std::size_t>(y) * width + x] = v;
+    }
+  return image;
+}
+
 std::string temporary_directory(const std::string& stem) {
   static std::vector<std::filesystem::path> created;
   static struct Cleanup {

@@ -82,6 +82,9 @@ inline bool contains(const std::string& text, const std::string& part) { return 
 // Runs `call` and expects an Error of kind InvalidInput whose message contains `needle`.
 void expect_invalid_input(const std::function<void()>& call, const std::string& needle);
 
+// A grey frame (the three planes equal) whose pixel (x, y) is value(x, y).
+HostImage grey_frame(int width, int height, const std::function<float(double, double)>& value);
+
 // A fresh, empty directory under the system temp dir, removed at process exit.
 std::string temporary_directory(const std::string& stem);
 
