@@ -12,7 +12,7 @@
 #include <memory>
 #include <random>
 
-#include "inertialnet/io/image_io.hpp"
+#include "inertialnet/io/frame_source.hpp"
 #include "inertialnet/models/texture.hpp"
 #include "inertialnet/synth/synthetic_sequence.hpp"
 #include "support/testing.hpp"
@@ -75,11 +75,7 @@ TEST(Texture, AnOrdinaryAndALowContrastSceneAreTextured) {
     options.texture_contrast = contrast;
     const auto dir = std::filesystem::path(testing::temporary_directory("texture")) / "seq";
     write_synthetic_sequence(dir, options);
-    std::filesystem::path first;
-    for (const auto& entry : std::filesystem::directory_iterator(dir / "mav0" / "cam0" / "data")) {
-      if (first.empty() || entry.path() < first) first = entry.path();
-    }
-    const HostImage image = load_rgb_image(first);
+    const HostImage image = open_frame_source(dir)->decode(0);
     const double share = textured_fraction(image);
     EXPECT_GE(share, kMinimumTexturedFraction) << "contrast " << contrast;
     if (contrast < 1) {
