@@ -7,7 +7,9 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <string>
+#include <utility>
 
 #include "inertialnet/core/constants.hpp"
 #include "inertialnet/runtime/error.hpp"
@@ -302,6 +304,17 @@ class RatesProcessor : public PairProcessor {
     return "";
   }
 
+  // The frame's textured_fraction(), measured once per frame where the lane sees consecutive pairs
+  // (one lane per device, a CPU's default): a pair's second frame is the next pair's first. The
+  // measure is a pass over the whole frame and its 4x4 block means (models/texture.hpp); frame
+  // indices are unique within a run, and a processor lives for one run.
+  double textured_share(const Frame& f) {
+    if (last_share_ && last_share_->first == f.index) return last_share_->second;
+    const double share = textured_fraction(f.image);
+    last_share_ = {f.index, share};
+    return share;
+  }
+
   // Frames too small for DIS or LK are a property of the sequence, not of one pair: bad input.
   void check_minimum_size(const Frame& f) const {
     const int minimum = dis_ ? kDisMinimumSide : kLkMinimumSide;
@@ -330,6 +343,7 @@ class RatesProcessor : public PairProcessor {
   std::vector<std::unique_ptr<InertialNetHead>> members_;
   std::unique_ptr<GeometricHead> geometric_;
   std::unique_ptr<HeadUncertainty> uncertainty_;  // with options_.fuse, made on the first pair
+  std::optional<std::pair<std::size_t, double>> last_share_;  // the last frame measured: its index, its share
 };
 
 }  // namespace
