@@ -11,25 +11,50 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <system_error>
 
 #include "inertialnet/runtime/error.hpp"
 
 namespace inertialnet::fuzz {
 
+// The process's scratch folder in the temporary directory, removed when the process exits
+// normally (libFuzzer ends a replay and a timed run with exit(0), which runs this destructor):
+// every CI pass starts 24 fuzz processes, and a folder left by each filled /tmp. A crash leaves
+// it, with the input that caused it.
+class ScratchFolder {
+ public:
+  ScratchFolder()
+      : path_(std::filesystem::temp_directory_path() / ("inertialnet-fuzz-" + std::to_string(::getpid()))) {
+    std::filesystem::create_directories(path_);
+  }
+  ~ScratchFolder() {
+    std::error_code ignored;  // nothing to report to at exit; a folder left behind is harmless
+    std::filesystem::remove_all(path_, ignored);
+  }
+  ScratchFolder(const ScratchFolder&) = delete;
+  ScratchFolder& operator=(const ScratchFolder&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
 // A per-process scratch file holding `data`, rewritten for every input (`name` keeps the
 // extension or the file name a reader looks at).
 inline std::filesystem::path as_file(const std::uint8_t* data, std::size_t size, const std::string& name) {
-  static const std::filesystem::path folder = [] {
-    const auto dir = std::filesystem::temp_directory_path() / ("inertialnet-fuzz-" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir);
-    return dir;
-  }();
-  const auto path = folder / name;
+  static const ScratchFolder folder;
+  const auto path = folder.path() / name;
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
+  out.close();
+  if (!out) {  // a reader given a stale or short file would be fuzzed on the wrong input
+    std::fprintf(stderr, "fuzz: cannot write the scratch input %s\n", path.c_str());
+    std::abort();
+  }
   return path;
 }
 
