@@ -30,6 +30,16 @@ struct Outcome {
   Vec3 peak_deg_s{};
 };
 
+// The weight-free path's options: DIS flow into the geometric head alone, for `camera`.
+RatesProcessorOptions weight_free_processor(const CameraIntrinsics& camera) {
+  RatesProcessorOptions processor;
+  processor.flow = FlowMethod::DIS;
+  processor.inertialnet_head = false;
+  processor.geometric_head = true;
+  processor.camera = camera;
+  return processor;
+}
+
 Outcome run(SynthOptions::Motion motion, std::uint64_t seed, bool body_frame, double texture_contrast = 1) {
   SynthOptions options;
   options.texture_contrast = texture_contrast;
@@ -42,11 +52,7 @@ Outcome run(SynthOptions::Motion motion, std::uint64_t seed, bool body_frame, do
   const SynthReport truth = write_synthetic_sequence(dir, options);
 
   auto source = open_frame_source(dir);
-  RatesProcessorOptions processor;
-  processor.flow = FlowMethod::DIS;
-  processor.inertialnet_head = false;
-  processor.geometric_head = true;
-  processor.camera = CameraIntrinsics::from_calibration(*source->calibration());
+  RatesProcessorOptions processor = weight_free_processor(CameraIntrinsics::from_calibration(*source->calibration()));
   // Half-size frames: the flow's own error is about half as many pixels.
   processor.geometric.robust_scale_px = 0.5;
   const Mat3 r_bs = source->calibration()->rotation_BS();
@@ -129,18 +135,13 @@ class SizedFrames : public FrameSource {
 };
 
 RatesProcessorOptions uniform_frames_processor(SizedFrames& source) {
-  RatesProcessorOptions processor;
-  processor.flow = FlowMethod::DIS;
-  processor.inertialnet_head = false;
-  processor.geometric_head = true;
   CameraIntrinsics camera;
   camera.width = source.decode(0).width;
   camera.height = source.decode(0).height;
   camera.fx = camera.fy = 50;
   camera.cx = (camera.width - 1) / 2.0;
   camera.cy = (camera.height - 1) / 2.0;
-  processor.camera = camera;
-  return processor;
+  return weight_free_processor(camera);
 }
 
 // The message DIS gives for frames too small: OpenCV's assertion text used to reach the user as a
@@ -209,11 +210,8 @@ TEST(WeightFree, ABlankFrameCostsItsTwoPairsWhicheverLaneTakesThem) {
   const std::set<std::size_t> blank{3, 6};
   const auto answers = [&](int lanes) {
     BlankedFrames source(open_frame_source(dir), blank);
-    RatesProcessorOptions processor;
-    processor.flow = FlowMethod::DIS;
-    processor.inertialnet_head = false;
-    processor.geometric_head = true;
-    processor.camera = CameraIntrinsics::from_calibration(*source.calibration());
+    const RatesProcessorOptions processor =
+        weight_free_processor(CameraIntrinsics::from_calibration(*source.calibration()));
     PipelineOptions pipeline;
     pipeline.lanes_per_device = lanes;
     std::map<std::size_t, EstimatorRates> out;
