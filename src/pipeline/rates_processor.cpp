@@ -101,18 +101,21 @@ class RatesProcessor : public PairProcessor {
       return unanswered(result, PairStatus::DecodeError, mismatch);
     }
     check_minimum_size(current);
+    // The gate's time is a stage of its own (--stats), so that the stages add up to the pair.
+    auto t = Clock::now();
     for (const Frame* frame : {&previous, &current}) {
-      const double textured = textured_fraction(frame->image);
+      const double textured = textured_share(*frame);
       if (textured < kMinimumTexturedFraction) {
+        lap(result, "texture_gate", t);
         char share[96];
         std::snprintf(share, sizeof share, " shows almost no texture (%.2f %% of its area; at least %.1f %% needed)",
                       100 * textured, 100 * kMinimumTexturedFraction);
         return unanswered(result, PairStatus::NoTexture, frame_name(*frame) + share + ": nothing for optical flow to follow");
       }
     }
+    t = lap(result, "texture_gate", t);
     Queue& q = *queue_;
     const int width = current.image.width, height = current.image.height;
-    auto t = Clock::now();
     Tensor flow;
     Tensor checked;  // the DIS flow with its inconsistent and edge vectors marked unknown: the geometric head's
     std::string flow_problem;  // why the flow cannot be used, when it cannot

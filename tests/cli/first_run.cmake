@@ -30,6 +30,8 @@ if(after_warmup MATCHES "compiled kernel family")
   message(FATAL_ERROR "kernels compiled after the warm-up pair: their time is counted in --stats")
 endif()
 expect_match("\npairs: 4 in ")
+# The texture gate is a stage of its own, so that the stages add up to the pair's time.
+expect_match("\ntexture_gate: [0-9.e+-]+ s \\(summed over lanes\\), [0-9.e+-]+ s per pair\n")
 
 # 2. Second run: served from the cache, silent about it; -v shows the loads.
 run(0 ${CLI} predict seq -o second.csv -v)
