@@ -71,6 +71,7 @@ const std::string& embedded_kernels_stamp();
 // The driver's build log of `program` for `device`, trailing blanks and NULs trimmed; "" when it
 // gives none. A failed build's error carries it; the tests read it for compiler warnings.
 std::string program_build_log(cl_program program, cl_device_id device);
+
 class ProgramCache {
  public:
   ProgramCache(const DeviceInfo& device, cl_context context, DiskCacheMode mode,
