@@ -23,20 +23,32 @@ std::string fixture(const std::string& name) {
   return (std::filesystem::path(root ? root : "tests/data") / "fixtures" / name).string();
 }
 
+// The head with synthetic weights of seed 1 and the fixture's configuration, run on its flow.
+struct FixtureRun {
+  explicit FixtureRun(const std::string& name)
+      : file(fixture(name)),
+        weights(WeightSet::synthetic(testing::test_device(), ModelKind::InertialNetHead, 1,
+                                     head_config_from_json(file.metadata().at(kMetadataHead)))),
+        head(testing::test_device(), weights) {
+    Queue& queue = testing::test_queue();
+    const auto& s = file.shape("flow");
+    const Tensor flow = Tensor::from_host(queue, Shape(s.begin(), s.end()), file.to_float32("flow"));
+    omega = head.compute(queue, flow).to_host(queue);
+  }
+  SafetensorsFile file;
+  WeightSet weights;
+  InertialNetHead head;
+  std::vector<float> omega;
+};
+
 class HeadFixture : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(HeadFixture, MatchesThePyTorchReference) {
-  Queue& queue = testing::test_queue();
-  const SafetensorsFile file(fixture(GetParam()));
-  const HeadConfig config = head_config_from_json(file.metadata().at(kMetadataHead));
-  const WeightSet weights = WeightSet::synthetic(testing::test_device(), ModelKind::InertialNetHead, 1, config);
-  InertialNetHead head(testing::test_device(), weights);
-  const auto& s = file.shape("flow");
-  const Tensor flow = Tensor::from_host(queue, Shape(s.begin(), s.end()), file.to_float32("flow"));
-  const auto omega = head.compute(queue, flow).to_host(queue);
+  FixtureRun run(GetParam());
   // GEMM-based layers against a float64 reference: fc1 reduces over thousands of terms.
-  EXPECT_TRUE(testing::all_close(head.features().to_host(queue), file.to_float32("features"), 1e-4, 1e-3));
-  EXPECT_TRUE(testing::all_close(omega, file.to_float32("omega"), 1e-4, 1e-4));
+  EXPECT_TRUE(testing::all_close(run.head.features().to_host(testing::test_queue()), run.file.to_float32("features"),
+                                 1e-4, 1e-3));
+  EXPECT_TRUE(testing::all_close(run.omega, run.file.to_float32("omega"), 1e-4, 1e-4));
 }
 
 INSTANTIATE_TEST_SUITE_P(Configurations, HeadFixture,
@@ -96,13 +108,7 @@ TEST(Head, NonFiniteWeightsAreRefusedWhenLoaded) {
 // Last in this file; run alone, it runs the first fixture itself.
 TEST(HeadKernels, EveryKernelTheHeadBuiltCompilesWithoutWarnings) {
   if (!testing::device_holds_program("pool")) {
-    Queue& queue = testing::test_queue();
-    const SafetensorsFile file(fixture("head_32x24.safetensors"));
-    const HeadConfig config = head_config_from_json(file.metadata().at(kMetadataHead));
-    const WeightSet weights = WeightSet::synthetic(testing::test_device(), ModelKind::InertialNetHead, 1, config);
-    InertialNetHead head(testing::test_device(), weights);
-    const auto& s = file.shape("flow");
-    head.compute(queue, Tensor::from_host(queue, Shape(s.begin(), s.end()), file.to_float32("flow")));
+    const FixtureRun run("head_32x24.safetensors");  // for the kernels it builds
   }
   const std::vector<std::string> families = testing::expect_held_kernels_compile_without_warnings();
   EXPECT_NE(std::find(families.begin(), families.end(), "pool"), families.end()) << "pool was not built";
