@@ -136,6 +136,40 @@ bool flag_of(const py::handle& value, const char* name) {
   throw py::type_error(std::string(name) + " must be True or False, not " + type_name(value));
 }
 
+// Arguments the function checks itself (flag_of, index_of, device_of, mat3_of, …) are taken as any
+// Python object, and pybind11 would name them "object" in the signatures help() and IDEs show.
+// These types accept any object as py::object does and carry the name of what the argument must
+// be, the same as the stubs in _inertialnet.pyi.
+template <typename Name>
+struct Checked : py::object {
+  using py::object::object;
+  static bool check_(py::handle h) { return h.ptr() != nullptr; }
+};
+struct FlagName {
+  static constexpr auto name = py::detail::const_name("bool");
+};
+struct IndexName {
+  static constexpr auto name = py::detail::const_name("typing.SupportsIndex");
+};
+struct DeviceName {
+  static constexpr auto name = py::detail::const_name("Device | str | int | None");
+};
+struct DeviceSpecName {
+  static constexpr auto name = py::detail::const_name("str | int");
+};
+struct IntervalName {
+  static constexpr auto name = py::detail::const_name("float | numpy.typing.ArrayLike");
+};
+struct RotationName {
+  static constexpr auto name = py::detail::const_name("numpy.typing.ArrayLike | None");
+};
+using FlagArg = Checked<FlagName>;          // True or False (numpy's bools too): flag_of
+using IndexArg = Checked<IndexName>;        // any Python integer: index_of, integer_of
+using DeviceArg = Checked<DeviceName>;      // device_of
+using DeviceSpecArg = Checked<DeviceSpecName>;
+using IntervalArg = Checked<IntervalName>;  // one dt, or one per pair of a batch
+using RotationArg = Checked<RotationName>;  // a 3x3 rotation matrix or None: mat3_of
+
 // The CLI's wording for a number the user gave: "must be …, got -5" with the value as Python
 // prints it, so 1e-12 stays 1e-12.
 std::string got(double value) { return std::string(py::str(py::float_(value))); }
@@ -399,15 +433,17 @@ struct PyDevice {
   }
 };
 
-// `device=` of every constructor: None (INERTIALNET_DEVICE, else the default), a spec string or
-// a Device.
+// `device=` of every constructor: None (INERTIALNET_DEVICE, else the default), a spec string, a
+// device index or a Device; anything else (a bool too, which Python counts as an int) is a
+// TypeError worded as predict's (_options.py).
 std::shared_ptr<Device> device_of(const py::object& device) {
   if (device.is_none()) return PyDevice("").device;
   if (py::isinstance<PyDevice>(device)) return device.cast<PyDevice&>().device;
-  if (py::isinstance<py::str>(device) || py::isinstance<py::int_>(device)) {
+  if (py::isinstance<py::str>(device) || (py::isinstance<py::int_>(device) && !py::isinstance<py::bool_>(device))) {
     return PyDevice(py::str(device).cast<std::string>()).device;
   }
-  throw invalid_input("device must be None, a device spec string (\"0\", \"cpu\", \"pocl\", …) or an inertialnet.Device");
+  throw py::type_error("device must be None, a device spec string, an index or an inertialnet.Device, not " +
+                       type_name(device));
 }
 
 std::vector<std::string> paths_of(const py::object& weights) {
@@ -503,7 +539,7 @@ class PyFlowNet {
 };
 
 py::array_t<float> dis_flow(const py::array& first, const py::array& second, const std::string& order,
-                            double flow_check, const std::string& method, const py::object& edge_band_flag) {
+                            double flow_check, const std::string& method, const FlagArg& edge_band_flag) {
   // "dis-fine": the DIS a recipe head since v3 learned from (models/dis_flow.hpp, DisVariant).
   if (method != "dis" && method != "dis-fine") {
     throw invalid_input("method '" + method.substr(0, 40) + "': expected dis or dis-fine");
@@ -575,7 +611,7 @@ std::optional<Mat3> mat3_of(const py::object& m) {
 
 class PyGeometricHead {
  public:
-  PyGeometricHead(const py::object& device, const std::string& solver, int stride) : device_(device_of(device)) {
+  PyGeometricHead(const DeviceArg& device, const std::string& solver, int stride) : device_(device_of(device)) {
     if (solver == "opengv") {
       options_.solver = GeometricSolver::OpenGV;
     } else if (solver != "motion-field") {
@@ -588,8 +624,8 @@ class PyGeometricHead {
   // ω in the camera frame, or with camera_to_body in the body frame as predict reports it: (3,)
   // for one flow (H, W, 2), (N, 3) for a batch (N, H, W, 2) as dis_flow and FlowNet.flow return
   // it, with one dt for all pairs or one per pair.
-  py::array_t<double> rates(const py::array& flow_array, const CameraIntrinsics& camera, const py::object& dt_object,
-                            const py::object& camera_to_body) {
+  py::array_t<double> rates(const py::array& flow_array, const CameraIntrinsics& camera, const IntervalArg& dt_object,
+                            const RotationArg& camera_to_body) {
     const auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(flow_array);
     if (!a || (a.ndim() != 3 && a.ndim() != 4) || a.shape(a.ndim() - 1) != 2) {
       throw invalid_input("the flow must be a float array (H, W, 2) or a batch (N, H, W, 2); got " +
@@ -1085,6 +1121,14 @@ py::tuple read_rates(const std::filesystem::path& path) {
 
 }  // namespace
 
+// The names of the Checked arguments, for pybind11's signatures.
+namespace pybind11::detail {
+template <typename Name>
+struct handle_type_name<Checked<Name>> {
+  static constexpr auto name = Name::name;
+};
+}  // namespace pybind11::detail
+
 namespace inertialnet {
 
 PythonPredictOptions python_predict_options(const std::string& sequence, const std::vector<std::string>& weights,
@@ -1262,7 +1306,7 @@ PYBIND11_MODULE(_inertialnet, m) {
   }, py::arg("spec") = "", "The devices a --device spec selects (\"\": $INERTIALNET_DEVICE, else the default).");
 
   py::class_<PyDevice>(m, "Device", "An opened OpenCL device, chosen by a --device spec string.")
-      .def(py::init([](const py::object& spec) {
+      .def(py::init([](const DeviceSpecArg& spec) {
              // An int is a device index, as the spec "3": Device(-1) gets the library's message for
              // "-1" instead of pybind11's list of overloads.
              if (py::isinstance<py::str>(spec)) return PyDevice(spec.cast<std::string>());
@@ -1335,7 +1379,7 @@ PYBIND11_MODULE(_inertialnet, m) {
         "dis_flow(a, b, flow_check=0.5, edge_band=True) is the flow predict's geometric head fits.");
 
   py::class_<PyGeometricHead>(m, "GeometricHead", "Angular velocity from flow by geometry alone (no weights).")
-      .def(py::init<const py::object&, const std::string&, int>(), py::arg("device") = py::none(),
+      .def(py::init<const DeviceArg&, const std::string&, int>(), py::arg("device") = py::none(),
            py::arg("solver") = "motion-field", py::arg("stride") = 4)
       .def("rates", &PyGeometricHead::rates, py::arg("flow"), py::arg("camera"), py::arg("dt"),
            py::arg("camera_to_body") = py::none(),
@@ -1420,7 +1464,7 @@ PYBIND11_MODULE(_inertialnet, m) {
   m.def("read_flow", [](const std::filesystem::path& path) { return flow_to_array(read_flow_file(existing(path, "the flow file"))); },
         py::arg("path"), "A .flo or KITTI flow PNG file, recognised by its content, as float32 (H, W, 2); unknown flow is NaN.");
   m.def("flow_to_color",
-        [](const py::array& flow, float max_magnitude, const py::object& legend_flag, const std::string& order) {
+        [](const py::array& flow, float max_magnitude, const FlagArg& legend_flag, const std::string& order) {
           const bool legend = flag_of(legend_flag, "legend");
           const ChannelOrder channels = parse_order(order);
           ColorImage image = flow_to_color(flow_from_array(flow), max_magnitude);
@@ -1446,8 +1490,8 @@ PYBIND11_MODULE(_inertialnet, m) {
         py::arg("path"), py::arg("flow"), py::arg("max_magnitude") = 0.0f, "flow_to_color() saved as a PNG.");
 
   m.def("synth",
-        [](const std::filesystem::path& out, int frames, const std::string& motion, const py::object& seed, int width,
-           int height, const py::object& noise, const py::object& overwrite) {
+        [](const std::filesystem::path& out, int frames, const std::string& motion, const IndexArg& seed, int width,
+           int height, const FlagArg& noise, const FlagArg& overwrite) {
           SynthOptions o;
           o.noise = flag_of(noise, "noise");
           o.overwrite = flag_of(overwrite, "overwrite");

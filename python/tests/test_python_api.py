@@ -119,6 +119,31 @@ def test_devices_by_index_and_object_everywhere(sequence):
     assert repr(inertialnet.GeometricHead(device=0)).endswith(f"on {device.name}>")
     with pytest.raises(TypeError, match="device must be None, a device spec string, an index"):
         inertialnet.predict(sequence, device=0.5)
+    # The native constructors answer as predict does: a bool is not a device index.
+    for wrong in (0.5, True):
+        with pytest.raises(TypeError, match="device must be None, a device spec string, an index"):
+            inertialnet.GeometricHead(device=wrong)
+
+
+def test_native_signatures_name_the_types_they_take():
+    """help() shows what an argument must be: the native functions that check an argument
+    themselves (True or False, an integer, a device, a rotation matrix) do not show it as object."""
+    import re
+
+    def signatures(obj):
+        for name in dir(obj):
+            if name.startswith("_") and name != "__init__":
+                continue
+            doc = getattr(getattr(obj, name), "__doc__", None) or ""
+            yield from (f"{name}: {line}" for line in doc.splitlines() if re.match(r"\w+\(", line))
+
+    native = inertialnet._native
+    public = [native] + [getattr(native, n) for n in dir(native) if isinstance(getattr(native, n), type)
+                         and not n.startswith("_")]
+    lines = [line for obj in public for line in signatures(obj)]
+    assert any(line.startswith("dis_flow: dis_flow(") for line in lines)
+    assert [line for line in lines if re.search(r"\w: object\b", line)] == []
+    assert "edge_band: bool = False" in next(line for line in lines if line.startswith("dis_flow:"))
 
 
 def test_stubs_name_what_the_native_module_has():
