@@ -55,9 +55,6 @@ run_target() {
   set -e
   runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
   if [ "$code" -ne 0 ]; then
-    # The report, for a CI log that outlives the build tree; whole, so that two failing targets'
-    # reports do not interleave.
-    tail -n 60 "$log" >"$results/$target.report"
     printf 'fuzz %s: FAILED after %s executions (exit %d): see %s and %s\n' "$target" "${runs:-?}" "$code" "$log" \
       "$findings" >"$results/$target.line"
   else
@@ -77,12 +74,13 @@ wait
 
 failed=0
 for target in "${targets[@]}"; do
-  if [ -f "$results/$target.report" ]; then
-    failed=1
-    cat "$results/$target.report" >&2
-  fi
-  if [ -f "$results/$target.line" ]; then
-    cat "$results/$target.line"
+  line="$results/$target.line"
+  if [ -f "$line" ]; then
+    if grep -q '^fuzz [^:]*: FAILED' "$line"; then
+      failed=1
+      tail -n 60 "$build/fuzz-findings/$target.log" >&2  # the report, for a CI log that outlives the build tree
+    fi
+    cat "$line"
   else
     failed=1  # the run itself did not finish (killed, or the shell failed before the line)
     printf 'fuzz %s: FAILED: no result (see %s)\n' "$target" "$build/fuzz-findings/$target.log"
